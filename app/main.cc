@@ -1,0 +1,66 @@
+// kincal: measure how accurately a robot moves, find out why it is wrong, and
+// fix its model. One binary, each subcommand a thin layer over the libraries.
+
+#include <exception>
+#include <iostream>
+
+#include "app/command.h"
+#include "data/error.h"
+#include "data/provenance.h"
+
+namespace kincal::app {
+
+void PrintJson(nlohmann::json result) {
+  result["command"] = CommandLine();
+  result["kincal_version"] = ToolVersion();
+  std::cout << result.dump() << std::endl;
+}
+
+}  // namespace kincal::app
+
+int main(int argc, char** argv) {
+  kincal::SetCommandLine(argc, argv);
+  CLI::App app{
+      "kincal: robot accuracy measurement, calibration and diagnosis.\n"
+      "Units at every interface: mm, degrees, seconds."};
+  app.require_subcommand(1);
+  kincal::app::Runner run;
+  kincal::app::AddSimulateCommand(app, &run);
+  kincal::app::AddCalibrateCommand(app, &run);
+  kincal::app::AddEvaluateCommand(app, &run);
+  kincal::app::AddSensitivityCommand(app, &run);
+  kincal::app::AddDiagnoseCommand(app, &run);
+  kincal::app::AddCamcalCommand(app, &run);
+  kincal::app::AddTrackCommand(app, &run);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::CallForHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForAllHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForVersion& e) {
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    app.exit(e);  // prints the message and usage
+    return 2;
+  } catch (const kincal::InputError& e) {
+    std::cerr << "kincal: error: " << e.what() << std::endl;
+    return 2;
+  }
+  if (!run) {
+    std::cerr << "kincal: error: no command given (see kincal --help)\n";
+    return 2;
+  }
+  try {
+    return run();
+  } catch (const kincal::InputError& e) {
+    std::cerr << "kincal: error: " << e.what() << std::endl;
+    return 2;
+  } catch (const CLI::ParseError& e) {
+    std::cerr << "kincal: error: " << e.what() << std::endl;
+    return 2;
+  } catch (const std::exception& e) {
+    std::cerr << "kincal: failure: " << e.what() << std::endl;
+    return 1;
+  }
+}

@@ -1,0 +1,288 @@
+#ifndef KINCAL_CALIB_CHAIN_H_
+#define KINCAL_CALIB_CHAIN_H_
+
+// The one kinematic chain type of kincal: rows in standard DH, modified DH or
+// URDF form, plus per-joint error models (the diagnosis' model extensions)
+// and a drift term. Forward kinematics is templated on the scalar so Ceres
+// autodiff and plain evaluation share one implementation.
+//
+// Internal units: mm and radians (see docs/CONVENTIONS.md). Interface
+// conversions happen in Chain::FromRobot / Chain::ToRobot and ParamInfo.
+
+#include <Eigen/Core>
+#include <array>
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "data/observations.h"
+#include "data/robot.h"
+
+namespace kincal {
+
+// Row geometry block, 6 numbers in internal units:
+//   dh / mdh: [theta_rad, d_mm, a_mm, alpha_rad, beta_rad, (unused)]
+//   urdf:     [x_mm, y_mm, z_mm, roll_rad, pitch_rad, yaw_rad]
+constexpr int kRowBlockSize = 6;
+// Per-joint error block (model extensions), internal units:
+//   [gain (1), backlash (rad|mm, full width), compliance (rad|mm per mm of
+//    unit-mass torque), cyclic_cos (rad), cyclic_sin (rad)]
+constexpr int kJointErrorBlockSize = 5;
+enum JointErrorIndex { kGain = 0, kBacklash, kCompliance, kCyclicCos, kCyclicSin };
+// Drift block: tip drift in the base frame, mm per hour.
+constexpr int kDriftBlockSize = 3;
+// Measuring frame block (meas_from_base): [rx, ry, rz (angle-axis, rad),
+// tx, ty, tz (mm)].
+constexpr int kFrameBlockSize = 6;
+
+using RowBlock = std::array<double, kRowBlockSize>;
+using JointErrorBlock = std::array<double, kJointErrorBlockSize>;
+
+struct ChainRow {
+  std::string name;  // joint name, or "tool"
+  JointType type = JointType::kRevolute;
+  Eigen::Vector3d axis = Eigen::Vector3d::UnitZ();  // URDF joints only
+  RowBlock p{};                                     // geometry, internal units
+};
+
+struct Chain {
+  std::string name;
+  Convention convention = Convention::kDh;
+  Eigen::Vector3d gravity = Eigen::Vector3d(0, 0, -1);
+  std::vector<ChainRow> rows;                  // joints in order, tool last
+  std::vector<JointErrorBlock> joint_errors;   // one per joint, zero = none
+  std::array<double, kDriftBlockSize> drift{};  // mm per hour
+  double bound_length_mm = 5.0;
+  double bound_angle_rad = 5.0 * M_PI / 180.0;
+
+  int num_joints() const { return static_cast<int>(rows.size()) - 1; }
+  int tool_row() const { return num_joints(); }
+
+  // Converts a robot description (mm, deg) into the internal chain; the
+  // robot's extensions fill joint_errors / drift, row beta fills axis tilt.
+  static Chain FromRobot(const Robot& robot);
+  // Writes the chain's values back into `description` (mm, deg); non-zero
+  // joint errors and drift become `extensions:` entries.
+  Robot ToRobot(const Robot& description) const;
+
+  // Reading units (mm | deg) <-> internal (mm | rad) for joint j.
+  double ReadingToInternal(int joint, double reading) const;
+  double InternalToReading(int joint, double value) const;
+  bool HasJointErrors() const;
+};
+
+// Everything about one pose that the error models need beside the readings.
+struct PoseInput {
+  std::vector<double> q;    // joint readings, internal units (rad | mm)
+  std::vector<double> s;    // approach direction per joint: +1, -1, 0 unknown
+  std::vector<double> tau;  // gravity torque about each joint axis (see below)
+  double t_h = 0.0;         // hours since the first timed row (0 if untimed)
+};
+
+// Builds PoseInputs for the rows of `obs` (in visit order). `s` follows the
+// spec: the sign of the joint's last motion before the pose; a joint that did
+// not move keeps its previous sign; unknown (0) before the first motion.
+// `tau` is computed with `chain`'s geometry (normally the nominal robot) and
+// the read joint values: for a revolute joint, (z x (p_tip - o)) . g_unit (mm,
+// torque of a unit mass at the tip); for a prismatic joint, z . g_unit.
+std::vector<PoseInput> MakePoseInputs(const Chain& chain,
+                                      const Observations& obs);
+
+// ---------------------------------------------------------------------------
+// Templated kinematics.
+
+template <typename T>
+using Mat4 = Eigen::Matrix<T, 4, 4>;
+template <typename T>
+using Vec3 = Eigen::Matrix<T, 3, 1>;
+
+namespace internal {
+template <typename T>
+Mat4<T> RotZ(const T& a) {
+  using std::cos;
+  using std::sin;
+  Mat4<T> m = Mat4<T>::Identity();
+  m(0, 0) = cos(a);
+  m(0, 1) = -sin(a);
+  m(1, 0) = sin(a);
+  m(1, 1) = cos(a);
+  return m;
+}
+template <typename T>
+Mat4<T> RotX(const T& a) {
+  using std::cos;
+  using std::sin;
+  Mat4<T> m = Mat4<T>::Identity();
+  m(1, 1) = cos(a);
+  m(1, 2) = -sin(a);
+  m(2, 1) = sin(a);
+  m(2, 2) = cos(a);
+  return m;
+}
+template <typename T>
+Mat4<T> RotY(const T& a) {
+  using std::cos;
+  using std::sin;
+  Mat4<T> m = Mat4<T>::Identity();
+  m(0, 0) = cos(a);
+  m(0, 2) = sin(a);
+  m(2, 0) = -sin(a);
+  m(2, 2) = cos(a);
+  return m;
+}
+template <typename T>
+Mat4<T> Trans(const T& x, const T& y, const T& z) {
+  Mat4<T> m = Mat4<T>::Identity();
+  m(0, 3) = x;
+  m(1, 3) = y;
+  m(2, 3) = z;
+  return m;
+}
+// Rotation by angle a about the unit axis u (Rodrigues).
+template <typename T>
+Mat4<T> RotAxis(const Eigen::Vector3d& u, const T& a) {
+  using std::cos;
+  using std::sin;
+  const T c = cos(a), s = sin(a), v = T(1) - c;
+  Mat4<T> m = Mat4<T>::Identity();
+  m(0, 0) = c + u.x() * u.x() * v;
+  m(0, 1) = u.x() * u.y() * v - u.z() * s;
+  m(0, 2) = u.x() * u.z() * v + u.y() * s;
+  m(1, 0) = u.y() * u.x() * v + u.z() * s;
+  m(1, 1) = c + u.y() * u.y() * v;
+  m(1, 2) = u.y() * u.z() * v - u.x() * s;
+  m(2, 0) = u.z() * u.x() * v - u.y() * s;
+  m(2, 1) = u.z() * u.y() * v + u.x() * s;
+  m(2, 2) = c + u.z() * u.z() * v;
+  return m;
+}
+}  // namespace internal
+
+// The transform of one row, previous frame <- next frame, for joint value q
+// (internal units; q = 0 for the tool row). The DH variant is chosen by
+// `convention`:
+//   dh:   Rz(theta + q) Tz(d + q) Tx(a) Rx(alpha) Ry(beta)
+//   mdh:  Rx(alpha) Ry(beta) Tx(a) Rz(theta + q) Tz(d + q)
+//   urdf: T(x, y, z) Rz(yaw) Ry(pitch) Rx(roll) R(axis, q) | T(axis q)
+// where "+ q" applies to theta for revolute and to d for prismatic joints.
+template <typename T>
+Mat4<T> RowTransform(Convention convention, const ChainRow& row, const T* p,
+                     const T& q) {
+  using internal::RotAxis;
+  using internal::RotX;
+  using internal::RotY;
+  using internal::RotZ;
+  using internal::Trans;
+  const T zero(0);
+  const bool revolute = row.type == JointType::kRevolute;
+  const bool prismatic = row.type == JointType::kPrismatic;
+  switch (convention) {
+    case Convention::kDh: {
+      const T theta = revolute ? p[0] + q : p[0];
+      const T d = prismatic ? p[1] + q : p[1];
+      return RotZ(theta) * Trans(p[2], zero, d) * RotX(p[3]) * RotY(p[4]);
+    }
+    case Convention::kMdh: {
+      const T theta = revolute ? p[0] + q : p[0];
+      const T d = prismatic ? p[1] + q : p[1];
+      return RotX(p[3]) * RotY(p[4]) * Trans(p[2], zero, zero) * RotZ(theta) *
+             Trans(zero, zero, d);
+    }
+    case Convention::kUrdf: {
+      Mat4<T> m = Trans(p[0], p[1], p[2]) * RotZ(p[5]) * RotY(p[4]) * RotX(p[3]);
+      if (revolute) return m * RotAxis(row.axis, q);
+      if (prismatic) {
+        return m * Trans(T(row.axis.x()) * q, T(row.axis.y()) * q,
+                         T(row.axis.z()) * q);
+      }
+      return m;
+    }
+  }
+  return Mat4<T>::Identity();
+}
+
+// The joint value FK uses for a reading (docs/CONVENTIONS.md):
+//   q = (1 + gain) q_read - s backlash / 2 + compliance tau
+//       + cyclic_cos cos(q_read) + cyclic_sin sin(q_read)
+// `err` may be null (no error model). Cyclic terms apply to revolute joints.
+template <typename T>
+T ModelJointValue(JointType type, double q_read, double s, double tau,
+                  const T* err) {
+  if (err == nullptr) return T(q_read);
+  T q = (T(1) + err[kGain]) * q_read - T(0.5 * s) * err[kBacklash] +
+        err[kCompliance] * tau;
+  if (type == JointType::kRevolute) {
+    q += err[kCyclicCos] * std::cos(q_read) + err[kCyclicSin] * std::sin(q_read);
+  }
+  return q;
+}
+
+// base_from_tip for model joint values q (internal units), rows[i] pointing
+// at row i's geometry block (tool last).
+template <typename T>
+Mat4<T> BaseFromTip(const Chain& chain, const T* const* rows, const T* q) {
+  Mat4<T> m = Mat4<T>::Identity();
+  for (int i = 0; i < chain.num_joints(); ++i) {
+    m = m * RowTransform(chain.convention, chain.rows[i], rows[i], q[i]);
+  }
+  return m * RowTransform(chain.convention, chain.rows[chain.tool_row()],
+                          rows[chain.tool_row()], T(0));
+}
+
+// The needle tip in the base frame for one pose: error model, FK, drift.
+// `joint_errors` (one block per joint) and `drift` may be null.
+template <typename T>
+Vec3<T> TipInBase(const Chain& chain, const T* const* rows,
+                  const T* const* joint_errors, const T* drift,
+                  const PoseInput& in) {
+  constexpr int kMaxJoints = 16;
+  T q[kMaxJoints];
+  for (int j = 0; j < chain.num_joints(); ++j) {
+    q[j] = ModelJointValue<T>(chain.rows[j].type, in.q[j], in.s[j], in.tau[j],
+                              joint_errors ? joint_errors[j] : nullptr);
+  }
+  const Mat4<T> m = BaseFromTip(chain, rows, q);
+  Vec3<T> p(m(0, 3), m(1, 3), m(2, 3));
+  if (drift != nullptr) {
+    for (int k = 0; k < 3; ++k) p[k] += drift[k] * in.t_h;
+  }
+  return p;
+}
+
+// p_in_meas = meas_from_base * p_in_base with frame = [angle-axis, t].
+template <typename T>
+Vec3<T> ApplyFrame(const T* frame, const Vec3<T>& p_in_base) {
+  using std::cos;
+  using std::sin;
+  using std::sqrt;
+  // Rodrigues with the small-angle branch, as ceres::AngleAxisRotatePoint.
+  const T theta2 = frame[0] * frame[0] + frame[1] * frame[1] + frame[2] * frame[2];
+  Vec3<T> r;
+  if (theta2 > T(1e-24)) {
+    const T theta = sqrt(theta2);
+    const T c = cos(theta), s = sin(theta);
+    const Vec3<T> w(frame[0] / theta, frame[1] / theta, frame[2] / theta);
+    const Vec3<T> wxp = w.cross(p_in_base);
+    const T wdp = w.dot(p_in_base);
+    r = p_in_base * c + wxp * s + w * (wdp * (T(1) - c));
+  } else {
+    const Vec3<T> w(frame[0], frame[1], frame[2]);
+    r = p_in_base + w.cross(p_in_base);
+  }
+  return Vec3<T>(r[0] + frame[3], r[1] + frame[4], r[2] + frame[5]);
+}
+
+// Plain-double conveniences over the templated functions above.
+Eigen::Vector3d TipInBase(const Chain& chain, const PoseInput& in,
+                          bool with_errors = true);
+Eigen::Matrix4d BaseFromTipAt(const Chain& chain,
+                              const std::vector<double>& q_internal);
+// Frames of every joint axis (base_from_link before joint j's motion), used
+// for gravity torques: origin and unit axis of joint j in the base frame.
+void JointAxesInBase(const Chain& chain, const std::vector<double>& q_internal,
+                     std::vector<Eigen::Vector3d>* origins,
+                     std::vector<Eigen::Vector3d>* axes);
+
+}  // namespace kincal
+
+#endif  // KINCAL_CALIB_CHAIN_H_

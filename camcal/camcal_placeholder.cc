@@ -1,0 +1,2 @@
+// Placeholder translation unit; replaced by the camera model code.
+namespace kincal {}

@@ -1,0 +1,251 @@
+#include "data/observations.h"
+
+#include <map>
+#include <set>
+#include <sstream>
+
+#include "data/atomic_file.h"
+#include "data/csv.h"
+#include "data/error.h"
+#include "data/provenance.h"
+#include "data/yaml_util.h"
+
+namespace kincal {
+
+int Observations::CountWithPoints() const {
+  int n = 0;
+  for (const auto& r : rows) n += r.has_point ? 1 : 0;
+  return n;
+}
+
+int Observations::CountWithFixedPoint() const {
+  int n = 0;
+  for (const auto& r : rows) n += r.fixed_point.empty() ? 0 : 1;
+  return n;
+}
+
+bool Observations::AnyTime() const {
+  for (const auto& r : rows) {
+    if (r.HasTime()) return true;
+  }
+  return false;
+}
+
+namespace {
+std::string JoinNames(const std::vector<std::string>& names) {
+  std::string s;
+  for (const auto& n : names) s += (s.empty() ? "" : ", ") + n;
+  return s;
+}
+}  // namespace
+
+Observations ParseObservationsCsv(const std::string& text,
+                                  const std::string& file,
+                                  const std::vector<std::string>& joint_names) {
+  const std::vector<CsvLine> lines = TokenizeCsv(text, file);
+  if (lines.empty()) {
+    throw InputError(file, 0, 0,
+                     "empty file: expected a header line 'pose," +
+                         JoinNames(joint_names) + ",x,y,z' and rows");
+  }
+  // Header: map each column to its role.
+  enum Role { kPose, kJoint, kX, kY, kZ, kFixed, kTime };
+  struct Column {
+    Role role;
+    int joint = -1;
+    std::string name;
+  };
+  std::vector<Column> columns;
+  std::set<std::string> seen;
+  const CsvLine& header = lines[0];
+  for (const CsvField& f : header.fields) {
+    const std::string& name = f.text;
+    if (name.empty()) {
+      throw InputError(file, header.line, f.column, "empty column name in header");
+    }
+    if (!seen.insert(name).second) {
+      throw InputError(file, header.line, f.column,
+                       "duplicate column '" + name + "'");
+    }
+    Column c;
+    c.name = name;
+    if (name == "pose") {
+      c.role = kPose;
+    } else if (name == "x") {
+      c.role = kX;
+    } else if (name == "y") {
+      c.role = kY;
+    } else if (name == "z") {
+      c.role = kZ;
+    } else if (name == "fixed_point") {
+      c.role = kFixed;
+    } else if (name == "t") {
+      c.role = kTime;
+    } else {
+      c.role = kJoint;
+      for (size_t j = 0; j < joint_names.size(); ++j) {
+        if (joint_names[j] == name) c.joint = static_cast<int>(j);
+      }
+      if (c.joint < 0) {
+        throw InputError(file, header.line, f.column,
+                         "unknown column '" + name +
+                             "': expected pose, the robot's joints (" +
+                             JoinNames(joint_names) +
+                             "), x, y, z, fixed_point or t");
+      }
+    }
+    columns.push_back(c);
+  }
+  if (!seen.count("pose")) {
+    throw InputError(file, header.line, 1, "header has no 'pose' column");
+  }
+  for (const auto& j : joint_names) {
+    if (!seen.count(j)) {
+      throw InputError(file, header.line, header.end_column,
+                       "header has no column for joint '" + j + "'");
+    }
+  }
+  const int xyz_count = static_cast<int>(seen.count("x") + seen.count("y") +
+                                         seen.count("z"));
+  if (xyz_count != 0 && xyz_count != 3) {
+    throw InputError(file, header.line, header.end_column,
+                     "header has only some of x, y, z: give all three or none");
+  }
+
+  Observations obs;
+  obs.source = file;
+  obs.joint_names = joint_names;
+  std::set<std::string> pose_ids;
+  for (size_t li = 1; li < lines.size(); ++li) {
+    const CsvLine& line = lines[li];
+    if (line.fields.size() != columns.size()) {
+      throw InputError(file, line.line,
+                       line.fields.size() > columns.size()
+                           ? line.fields[columns.size()].column
+                           : line.end_column,
+                       "expected " + std::to_string(columns.size()) +
+                           " columns as in the header, got " +
+                           std::to_string(line.fields.size()));
+    }
+    Observation o;
+    o.line = line.line;
+    o.q.assign(joint_names.size(), 0.0);
+    int xyz_given = 0;
+    int first_xyz_column = 0;
+    for (size_t c = 0; c < columns.size(); ++c) {
+      const CsvField& f = line.fields[c];
+      const Column& col = columns[c];
+      double v = 0.0;
+      switch (col.role) {
+        case kPose:
+          if (f.text.empty()) {
+            throw InputError(file, line.line, f.column, "empty pose id");
+          }
+          if (!pose_ids.insert(f.text).second) {
+            throw InputError(file, line.line, f.column,
+                             "duplicate pose id '" + f.text + "'");
+          }
+          o.pose = f.text;
+          break;
+        case kJoint:
+          if (!ParseFiniteDouble(f.text, &v)) {
+            throw InputError(file, line.line, f.column,
+                             "column '" + col.name +
+                                 "': expected a finite number (joint reading), "
+                                 "got '" + f.text + "'");
+          }
+          o.q[col.joint] = v;
+          break;
+        case kX:
+        case kY:
+        case kZ:
+          if (f.text.empty()) {
+            if (first_xyz_column == 0) first_xyz_column = f.column;
+            break;
+          }
+          if (!ParseFiniteDouble(f.text, &v)) {
+            throw InputError(file, line.line, f.column,
+                             "column '" + col.name +
+                                 "': expected a finite number (mm) or empty, "
+                                 "got '" + f.text + "'");
+          }
+          o.p_in_meas[col.role - kX] = v;
+          ++xyz_given;
+          if (first_xyz_column == 0) first_xyz_column = f.column;
+          break;
+        case kFixed:
+          o.fixed_point = f.text;
+          break;
+        case kTime:
+          if (f.text.empty()) break;
+          if (!ParseFiniteDouble(f.text, &v)) {
+            throw InputError(file, line.line, f.column,
+                             "column 't': expected a finite number (s) or "
+                             "empty, got '" + f.text + "'");
+          }
+          o.t_s = v;
+          break;
+      }
+    }
+    if (xyz_given != 0 && xyz_given != 3) {
+      throw InputError(file, line.line, first_xyz_column,
+                       "x, y, z: give all three or leave all three empty");
+    }
+    o.has_point = xyz_given == 3;
+    obs.rows.push_back(o);
+  }
+  if (obs.rows.empty()) {
+    throw InputError(file, lines[0].line, 0,
+                     "no observation rows after the header");
+  }
+  return obs;
+}
+
+Observations ReadObservationsCsv(const std::string& path,
+                                 const std::vector<std::string>& joint_names) {
+  return ParseObservationsCsv(ReadFile(path), path, joint_names);
+}
+
+std::string FormatObservationsCsv(const Observations& obs,
+                                  const std::vector<std::string>& comment) {
+  bool points = false, fixed = false, time = false;
+  for (const auto& r : obs.rows) {
+    points = points || r.has_point;
+    fixed = fixed || !r.fixed_point.empty();
+    time = time || r.HasTime();
+  }
+  std::ostringstream os;
+  os << "# written by " << ToolVersion() << ": " << CommandLine() << "\n";
+  for (const auto& c : comment) os << "# " << c << "\n";
+  os << "pose";
+  for (const auto& j : obs.joint_names) os << "," << j;
+  if (points) os << ",x,y,z";
+  if (fixed) os << ",fixed_point";
+  if (time) os << ",t";
+  os << "\n";
+  for (const auto& r : obs.rows) {
+    os << CsvQuote(r.pose);
+    for (double q : r.q) os << "," << FormatDouble(q);
+    if (points) {
+      if (r.has_point) {
+        for (int k = 0; k < 3; ++k) os << "," << FormatDouble(r.p_in_meas[k]);
+      } else {
+        os << ",,,";
+      }
+    }
+    if (fixed) os << "," << CsvQuote(r.fixed_point);
+    if (time) os << "," << (r.HasTime() ? FormatDouble(r.t_s) : "");
+    os << "\n";
+  }
+  return os.str();
+}
+
+Observations Subset(const Observations& obs, const std::vector<int>& indices) {
+  Observations out;
+  out.source = obs.source;
+  out.joint_names = obs.joint_names;
+  for (int i : indices) out.rows.push_back(obs.rows.at(i));
+  return out;
+}
+
+}  // namespace kincal

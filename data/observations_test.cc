@@ -1,0 +1,123 @@
+#include "data/observations.h"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include "data/error.h"
+
+namespace kincal {
+namespace {
+
+using ::testing::HasSubstr;
+
+const std::vector<std::string> kJoints = {"j1", "j2", "j3", "j4", "j5"};
+
+const char* kGood =
+    "# a comment\n"
+    "pose,j1,j2,j3,j4,j5,x,y,z,fixed_point,t\n"
+    "0,78.4602,36.0462,95.4866,153.0275,-45.1143,1.5,2.5,3.5,hole_0,0.0\n"
+    "1,70,30,90,150,-40,,,,hole_0,1.5\n"
+    "p2,71,31,91,151,-41,4,5,6,,\n";
+
+std::string ErrorOf(const std::string& text) {
+  try {
+    ParseObservationsCsv(text, "o.csv", kJoints);
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "(no error)";
+}
+
+TEST(ObservationsTest, ReadsAllColumns) {
+  const Observations obs = ParseObservationsCsv(kGood, "o.csv", kJoints);
+  ASSERT_EQ(obs.rows.size(), 3u);
+  EXPECT_EQ(obs.rows[0].pose, "0");
+  EXPECT_DOUBLE_EQ(obs.rows[0].q[4], -45.1143);
+  EXPECT_TRUE(obs.rows[0].has_point);
+  EXPECT_DOUBLE_EQ(obs.rows[0].p_in_meas.z(), 3.5);
+  EXPECT_FALSE(obs.rows[1].has_point);
+  EXPECT_EQ(obs.rows[1].fixed_point, "hole_0");
+  EXPECT_DOUBLE_EQ(obs.rows[1].t_s, 1.5);
+  EXPECT_TRUE(obs.rows[2].fixed_point.empty());
+  EXPECT_FALSE(obs.rows[2].HasTime());
+  EXPECT_EQ(obs.rows[2].line, 5);
+  EXPECT_EQ(obs.CountWithPoints(), 2);
+}
+
+TEST(ObservationsTest, ColumnsInAnyOrderMapToRobotOrder) {
+  const Observations obs = ParseObservationsCsv(
+      "j5,j4,pose,j3,j2,j1\n5,4,a,3,2,1\n", "o.csv", kJoints);
+  EXPECT_EQ(obs.rows[0].q, (std::vector<double>{1, 2, 3, 4, 5}));
+}
+
+TEST(ObservationsTest, AcceptsCrlfAndBom) {
+  std::string crlf;
+  for (char c : std::string(kGood)) {
+    if (c == '\n') crlf += '\r';
+    crlf += c;
+  }
+  const Observations a = ParseObservationsCsv(kGood, "o.csv", kJoints);
+  const Observations b = ParseObservationsCsv("\xEF\xBB\xBF" + crlf, "o.csv", kJoints);
+  ASSERT_EQ(a.rows.size(), b.rows.size());
+  for (size_t i = 0; i < a.rows.size(); ++i) {
+    EXPECT_EQ(a.rows[i].pose, b.rows[i].pose);
+    EXPECT_EQ(a.rows[i].q, b.rows[i].q);
+    EXPECT_EQ(a.rows[i].fixed_point, b.rows[i].fixed_point);
+  }
+}
+
+TEST(ObservationsTest, RejectsEveryRuleWithPosition) {
+  const std::string h = "pose,j1,j2,j3,j4,j5,x,y,z\n";
+  EXPECT_THAT(ErrorOf(""), HasSubstr("o.csv: empty file"));
+  EXPECT_THAT(ErrorOf("# only a comment\n"), HasSubstr("empty file"));
+  EXPECT_THAT(ErrorOf(h), HasSubstr("no observation rows"));
+  EXPECT_THAT(ErrorOf(h + "0,1,2,3,4,5,1,2\n"),
+              HasSubstr("o.csv:2:16: expected 9 columns as in the header, got 8"));
+  EXPECT_THAT(ErrorOf(h + "0,1,2,3,4,5,1,2,3,9\n"),
+              HasSubstr("o.csv:2:19: expected 9 columns"));
+  EXPECT_THAT(ErrorOf(h + "0,1,2,x3,4,5,1,2,3\n"),
+              HasSubstr("o.csv:2:7: column 'j3': expected a finite number"));
+  EXPECT_THAT(ErrorOf(h + "0,1,2,nan,4,5,1,2,3\n"),
+              HasSubstr("o.csv:2:7: column 'j3'"));
+  EXPECT_THAT(ErrorOf(h + "0,1,2,inf,4,5,1,2,3\n"), HasSubstr("finite"));
+  EXPECT_THAT(ErrorOf(h + "0,1,2,,4,5,1,2,3\n"), HasSubstr("o.csv:2:7:"));
+  EXPECT_THAT(ErrorOf(h + "0,1,2,3,4,5,1,NaN,3\n"),
+              HasSubstr("o.csv:2:15: column 'y'"));
+  EXPECT_THAT(ErrorOf("pose,j1,j2,j3,j4,j6\n0,1,2,3,4,5\n"),
+              HasSubstr("o.csv:1:18: unknown column 'j6'"));
+  EXPECT_THAT(ErrorOf("pose,j1,j2,j3,j4\n0,1,2,3,4\n"),
+              HasSubstr("header has no column for joint 'j5'"));
+  EXPECT_THAT(ErrorOf("j1,j2,j3,j4,j5\n1,2,3,4,5\n"),
+              HasSubstr("no 'pose' column"));
+  EXPECT_THAT(ErrorOf("pose,j1,j2,j3,j4,j5,j2\n0,1,2,3,4,5,6\n"),
+              HasSubstr("o.csv:1:21: duplicate column 'j2'"));
+  EXPECT_THAT(ErrorOf(h + "0,1,2,3,4,5,1,2,3\n0,1,2,3,4,5,1,2,3\n"),
+              HasSubstr("o.csv:3:1: duplicate pose id '0'"));
+  EXPECT_THAT(ErrorOf(h + "0,1,2,3,4,5,1,,3\n"),
+              HasSubstr("o.csv:2:13: x, y, z: give all three"));
+  EXPECT_THAT(ErrorOf("pose,j1,j2,j3,j4,j5,x,y\n0,1,2,3,4,5,1,2\n"),
+              HasSubstr("only some of x, y, z"));
+  EXPECT_THAT(ErrorOf(h + ",1,2,3,4,5,1,2,3\n"), HasSubstr("empty pose id"));
+  EXPECT_THAT(ErrorOf("pose,j1,j2,j3,j4,j5,t\n0,1,2,3,4,5,noon\n"),
+              HasSubstr("column 't'"));
+  EXPECT_THAT(ErrorOf(h + "\"0,1,2,3,4,5,1,2,3\n"),
+              HasSubstr("unterminated quoted field"));
+}
+
+TEST(ObservationsTest, FormatThenParseIsIdentity) {
+  const Observations obs = ParseObservationsCsv(kGood, "o.csv", kJoints);
+  const Observations back =
+      ParseObservationsCsv(FormatObservationsCsv(obs), "back.csv", kJoints);
+  ASSERT_EQ(back.rows.size(), obs.rows.size());
+  for (size_t i = 0; i < obs.rows.size(); ++i) {
+    EXPECT_EQ(back.rows[i].pose, obs.rows[i].pose);
+    EXPECT_EQ(back.rows[i].q, obs.rows[i].q);
+    EXPECT_EQ(back.rows[i].has_point, obs.rows[i].has_point);
+    EXPECT_EQ(back.rows[i].p_in_meas, obs.rows[i].p_in_meas);
+    EXPECT_EQ(back.rows[i].fixed_point, obs.rows[i].fixed_point);
+    EXPECT_EQ(back.rows[i].HasTime(), obs.rows[i].HasTime());
+  }
+}
+
+}  // namespace
+}  // namespace kincal

@@ -1,0 +1,287 @@
+#include "data/robot.h"
+
+#include <cmath>
+#include <set>
+#include <sstream>
+
+#include "data/atomic_file.h"
+#include "data/error.h"
+#include "data/provenance.h"
+#include "data/yaml_util.h"
+
+namespace kincal {
+
+const char* ToString(JointType type) {
+  switch (type) {
+    case JointType::kRevolute:
+      return "revolute";
+    case JointType::kPrismatic:
+      return "prismatic";
+    case JointType::kFixed:
+      return "fixed";
+  }
+  return "?";
+}
+
+const char* ToString(Convention convention) {
+  switch (convention) {
+    case Convention::kDh:
+      return "dh";
+    case Convention::kMdh:
+      return "mdh";
+    case Convention::kUrdf:
+      return "urdf";
+  }
+  return "?";
+}
+
+int Robot::JointIndex(const std::string& joint_name) const {
+  for (size_t i = 0; i < joints.size(); ++i) {
+    if (joints[i].name == joint_name) return static_cast<int>(i);
+  }
+  return -1;
+}
+
+std::vector<std::string> Robot::JointNames() const {
+  std::vector<std::string> names;
+  for (const auto& j : joints) names.push_back(j.name);
+  return names;
+}
+
+namespace {
+
+// Fields every extension cause may carry (interface units, see robot.h).
+const std::map<std::string, std::vector<std::string>>& ExtensionFields() {
+  static const std::map<std::string, std::vector<std::string>> fields = {
+      {"backlash", {"width"}},     {"compliance", {"per_torque"}},
+      {"cyclic", {"cos", "sin"}},  {"gain", {"g"}},
+      {"drift", {"vx", "vy", "vz"}}};
+  return fields;
+}
+
+void ReadGeometry(const YamlReader& r, const YAML::Node& node,
+                  Convention convention, const std::string& what,
+                  RobotRow* row) {
+  if (convention == Convention::kUrdf) {
+    const auto xyz = r.Numbers(r.Required(node, "xyz", what), what + ".xyz", 3, 3);
+    const auto rpy = r.Numbers(r.Required(node, "rpy", what), what + ".rpy", 3, 3);
+    row->xyz_mm = Eigen::Vector3d(xyz[0], xyz[1], xyz[2]);
+    row->rpy_deg = Eigen::Vector3d(rpy[0], rpy[1], rpy[2]);
+    if (row->type != JointType::kFixed) {
+      const auto axis =
+          r.Numbers(r.Required(node, "axis", what), what + ".axis", 3, 3);
+      Eigen::Vector3d a(axis[0], axis[1], axis[2]);
+      if (a.norm() < 1e-9) r.Fail(node["axis"], what + ".axis: must not be zero");
+      row->axis = a.normalized();
+    }
+    return;
+  }
+  row->d_mm = r.Number(r.Required(node, "d", what), what + ".d");
+  row->alpha_deg = r.Number(r.Required(node, "alpha", what), what + ".alpha");
+  row->a_mm = r.Number(r.Required(node, "a", what), what + ".a");
+  row->theta_deg = r.Number(r.Required(node, "theta", what), what + ".theta");
+  row->beta_deg = r.NumberOr(node, "beta", 0.0, what);
+}
+
+}  // namespace
+
+Robot ParseRobotYaml(const std::string& text, const std::string& file) {
+  YamlReader r(file);
+  const YAML::Node root = r.Load(text);
+  if (!root.IsDefined() || root.IsNull()) {
+    throw InputError(file, 0, 0, "empty file: expected a robot description");
+  }
+  r.ExpectMap(root, "robot file");
+  r.CheckKeys(root,
+              {"kincal_robot", "name", "convention", "gravity", "joints",
+               "tool", "bounds", "extensions"},
+              "robot file");
+  const YAML::Node version = r.Required(root, "kincal_robot", "robot file");
+  if (r.Integer(version, "kincal_robot") != 1) {
+    r.Fail(version, "kincal_robot: unsupported format version " +
+                        version.Scalar() + " (this tool reads version 1)");
+  }
+  Robot robot;
+  robot.name = root["name"] ? r.String(root["name"], "name") : "robot";
+  const YAML::Node conv = root["convention"];
+  if (conv) {
+    const std::string c = r.String(conv, "convention");
+    if (c == "dh")
+      robot.convention = Convention::kDh;
+    else if (c == "mdh")
+      robot.convention = Convention::kMdh;
+    else if (c == "urdf")
+      robot.convention = Convention::kUrdf;
+    else
+      r.Fail(conv, "convention: expected 'dh', 'mdh' or 'urdf', got '" + c + "'");
+  }
+  if (root["gravity"]) {
+    const auto g = r.Numbers(root["gravity"], "gravity", 3, 3);
+    Eigen::Vector3d gv(g[0], g[1], g[2]);
+    if (gv.norm() < 1e-12) r.Fail(root["gravity"], "gravity: must not be zero");
+    robot.gravity = gv.normalized();
+  }
+
+  const YAML::Node joints = r.Required(root, "joints", "robot file");
+  r.ExpectSequence(joints, "joints");
+  if (joints.size() == 0) r.Fail(joints, "joints: expected at least one joint");
+  std::set<std::string> names;
+  for (size_t i = 0; i < joints.size(); ++i) {
+    const YAML::Node j = joints[i];
+    const std::string what = "joints[" + std::to_string(i) + "]";
+    r.ExpectMap(j, what);
+    r.CheckKeys(j,
+                {"name", "type", "d", "alpha", "a", "theta", "beta", "xyz",
+                 "rpy", "axis", "limits"},
+                what);
+    RobotRow row;
+    row.name = r.String(r.Required(j, "name", what), what + ".name");
+    if (row.name == "tool" || row.name == "frame" || row.name == "drift" ||
+        row.name == "point") {
+      r.Fail(j["name"], what + ".name: '" + row.name + "' is reserved");
+    }
+    if (!names.insert(row.name).second) {
+      r.Fail(j["name"], what + ".name: duplicate joint name '" + row.name + "'");
+    }
+    const std::string type = r.String(r.Required(j, "type", what), what + ".type");
+    if (type == "revolute")
+      row.type = JointType::kRevolute;
+    else if (type == "prismatic")
+      row.type = JointType::kPrismatic;
+    else
+      r.Fail(j["type"], what + ".type: expected 'revolute' or 'prismatic', got '" +
+                            type + "'");
+    ReadGeometry(r, j, robot.convention, what, &row);
+    if (j["limits"]) {
+      const auto lim = r.Numbers(j["limits"], what + ".limits", 2, 2);
+      if (!(lim[0] < lim[1])) {
+        r.Fail(j["limits"], what + ".limits: expected [lower, upper] with lower < upper");
+      }
+      row.lower = lim[0];
+      row.upper = lim[1];
+    }
+    robot.joints.push_back(row);
+  }
+
+  robot.tool.name = "tool";
+  robot.tool.type = JointType::kFixed;
+  if (root["tool"]) {
+    const YAML::Node t = root["tool"];
+    r.ExpectMap(t, "tool");
+    r.CheckKeys(t, {"d", "alpha", "a", "theta", "beta", "xyz", "rpy"}, "tool");
+    ReadGeometry(r, t, robot.convention, "tool", &robot.tool);
+  }
+  if (root["bounds"]) {
+    const YAML::Node b = root["bounds"];
+    r.ExpectMap(b, "bounds");
+    r.CheckKeys(b, {"length", "angle"}, "bounds");
+    robot.bound_length_mm = r.NumberOr(b, "length", 5.0, "bounds");
+    robot.bound_angle_deg = r.NumberOr(b, "angle", 5.0, "bounds");
+    if (robot.bound_length_mm <= 0 || robot.bound_angle_deg <= 0) {
+      r.Fail(b, "bounds: length and angle must be positive");
+    }
+  }
+  if (root["extensions"] && !root["extensions"].IsNull()) {
+    const YAML::Node ext = root["extensions"];
+    r.ExpectSequence(ext, "extensions");
+    for (size_t i = 0; i < ext.size(); ++i) {
+      const YAML::Node e = ext[i];
+      const std::string what = "extensions[" + std::to_string(i) + "]";
+      r.ExpectMap(e, what);
+      Extension x;
+      x.cause = r.String(r.Required(e, "cause", what), what + ".cause");
+      const auto it = ExtensionFields().find(x.cause);
+      if (it == ExtensionFields().end()) {
+        r.Fail(e["cause"], what + ".cause: unknown cause '" + x.cause +
+                               "' (expected backlash, compliance, cyclic, gain "
+                               "or drift; axis tilt is a row's beta)");
+      }
+      if (x.cause != "drift") {
+        x.joint = r.String(r.Required(e, "joint", what), what + ".joint");
+        if (robot.JointIndex(x.joint) < 0) {
+          r.Fail(e["joint"], what + ".joint: no joint named '" + x.joint + "'");
+        }
+      }
+      for (const auto& kv : e) {
+        const std::string key = kv.first.Scalar();
+        if (key == "cause" || key == "joint") continue;
+        bool known = false;
+        for (const auto& f : it->second) known = known || f == key;
+        if (!known) {
+          r.Fail(kv.first, what + ": unknown field '" + key + "' for cause " +
+                               x.cause);
+        }
+        x.values[key] = r.Number(kv.second, what + "." + key);
+      }
+      for (const auto& f : it->second) {
+        if (!x.values.count(f)) r.Fail(e, what + ": missing field '" + f + "'");
+      }
+      robot.extensions.push_back(x);
+    }
+  }
+  return robot;
+}
+
+Robot ReadRobotYaml(const std::string& path) {
+  return ParseRobotYaml(ReadFile(path), path);
+}
+
+namespace {
+std::string Vec(const Eigen::Vector3d& v) {
+  return "[" + FormatDouble(v.x()) + ", " + FormatDouble(v.y()) + ", " +
+         FormatDouble(v.z()) + "]";
+}
+
+std::string Geometry(const Robot& robot, const RobotRow& row) {
+  std::ostringstream os;
+  if (robot.convention == Convention::kUrdf) {
+    os << "xyz: " << Vec(row.xyz_mm) << ", rpy: " << Vec(row.rpy_deg);
+    if (row.type != JointType::kFixed) os << ", axis: " << Vec(row.axis);
+  } else {
+    os << "d: " << FormatDouble(row.d_mm)
+       << ", alpha: " << FormatDouble(row.alpha_deg)
+       << ", a: " << FormatDouble(row.a_mm)
+       << ", theta: " << FormatDouble(row.theta_deg);
+    if (row.beta_deg != 0.0) os << ", beta: " << FormatDouble(row.beta_deg);
+  }
+  return os.str();
+}
+}  // namespace
+
+std::string FormatRobotYaml(const Robot& robot,
+                            const std::vector<std::string>& comment) {
+  std::ostringstream os;
+  os << "# written by " << ToolVersion() << ": " << CommandLine() << "\n";
+  for (const auto& c : comment) os << "# " << c << "\n";
+  os << "kincal_robot: 1\n";
+  os << "name: " << robot.name << "\n";
+  os << "convention: " << ToString(robot.convention) << "\n";
+  os << "gravity: " << Vec(robot.gravity) << "\n";
+  os << "joints:\n";
+  for (const auto& j : robot.joints) {
+    os << "  - {name: " << j.name << ", type: " << ToString(j.type) << ", "
+       << Geometry(robot, j);
+    if (j.HasLimits()) {
+      os << ", limits: [" << FormatDouble(j.lower) << ", "
+         << FormatDouble(j.upper) << "]";
+    }
+    os << "}\n";
+  }
+  os << "tool: {" << Geometry(robot, robot.tool) << "}\n";
+  os << "bounds: {length: " << FormatDouble(robot.bound_length_mm)
+     << ", angle: " << FormatDouble(robot.bound_angle_deg) << "}\n";
+  if (!robot.extensions.empty()) {
+    os << "extensions:\n";
+    for (const auto& e : robot.extensions) {
+      os << "  - {cause: " << e.cause;
+      if (!e.joint.empty()) os << ", joint: " << e.joint;
+      for (const auto& kv : e.values) {
+        os << ", " << kv.first << ": " << FormatDouble(kv.second);
+      }
+      os << "}\n";
+    }
+  }
+  return os.str();
+}
+
+}  // namespace kincal

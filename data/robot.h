@@ -1,0 +1,80 @@
+#ifndef KINCAL_DATA_ROBOT_H_
+#define KINCAL_DATA_ROBOT_H_
+
+#include <Eigen/Core>
+#include <limits>
+#include <map>
+#include <string>
+#include <vector>
+
+namespace kincal {
+
+enum class JointType { kRevolute, kPrismatic, kFixed };
+enum class Convention { kDh, kMdh, kUrdf };
+
+const char* ToString(JointType type);
+const char* ToString(Convention convention);
+
+// One row of the kinematic chain, in interface units (mm, deg). Which fields
+// are used depends on Robot::convention (see docs/CONVENTIONS.md):
+//   dh:   Rz(theta + q) Tz(d + q) Tx(a) Rx(alpha) Ry(beta)
+//   mdh:  Rx(alpha) Ry(beta) Tx(a) Rz(theta + q) Tz(d + q)
+//   urdf: T(xyz) Rz(yaw) Ry(pitch) Rx(roll) * joint motion about/along `axis`
+struct RobotRow {
+  std::string name;  // joint name, or "tool" for the fixed last row
+  JointType type = JointType::kRevolute;
+  double theta_deg = 0.0;
+  double d_mm = 0.0;
+  double a_mm = 0.0;
+  double alpha_deg = 0.0;
+  double beta_deg = 0.0;  // Hayati twist; 0 unless identified (axis_tilt)
+  Eigen::Vector3d xyz_mm = Eigen::Vector3d::Zero();
+  Eigen::Vector3d rpy_deg = Eigen::Vector3d::Zero();
+  Eigen::Vector3d axis = Eigen::Vector3d::UnitZ();
+  // Joint limits in reading units (mm or deg); NaN when the file has none.
+  double lower = std::numeric_limits<double>::quiet_NaN();
+  double upper = std::numeric_limits<double>::quiet_NaN();
+  bool HasLimits() const { return lower == lower && upper == upper; }
+};
+
+// A model extension identified by the diagnosis (`extensions:` in robot.yaml).
+// `values` holds the cause's fields in interface units, e.g.
+//   backlash: {width}            deg or mm (full clearance width)
+//   compliance: {per_torque}     deg per (mm x unit mass) of gravity torque
+//   cyclic: {cos, sin}           deg, first harmonic of the read joint angle
+//   gain: {g}                    dimensionless, q = (1 + g) q_read
+//   drift: {vx, vy, vz}          mm per hour, tip drift in the base frame
+// axis_tilt is not an extension entry: it is the row's `beta`.
+struct Extension {
+  std::string cause;
+  std::string joint;  // empty for drift
+  std::map<std::string, double> values;
+};
+
+struct Robot {
+  std::string name;
+  Convention convention = Convention::kDh;
+  Eigen::Vector3d gravity = Eigen::Vector3d(0, 0, -1);  // unit, base frame
+  std::vector<RobotRow> joints;                         // chain order
+  RobotRow tool;  // fixed last row (type kFixed, name "tool")
+  double bound_length_mm = 5.0;
+  double bound_angle_deg = 5.0;
+  std::vector<Extension> extensions;
+
+  int JointIndex(const std::string& name) const;  // -1 when absent
+  std::vector<std::string> JointNames() const;
+};
+
+// Reads robot.yaml (format version 1, docs in ../shared/spec/formats.md).
+// Throws InputError with file:line:column on any invalid content.
+Robot ReadRobotYaml(const std::string& path);
+Robot ParseRobotYaml(const std::string& text, const std::string& file_label);
+
+// Serialises a robot as robot.yaml, with a "# <command>" provenance header and
+// free `comment` lines (without '#').
+std::string FormatRobotYaml(const Robot& robot,
+                            const std::vector<std::string>& comment = {});
+
+}  // namespace kincal
+
+#endif  // KINCAL_DATA_ROBOT_H_

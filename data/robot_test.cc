@@ -1,0 +1,133 @@
+#include "data/robot.h"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include "data/error.h"
+#include "tests/testing/paths.h"
+
+namespace kincal {
+namespace {
+
+using ::testing::HasSubstr;
+
+const char* kSpecExample = R"(kincal_robot: 1                 # format version
+name: BH-7
+convention: dh                  # standard DH
+gravity: [0, 0, -1]
+joints:
+  - {name: j1, type: prismatic, d: 0,    alpha: 0,   a: 0,   theta: 0}
+  - {name: j2, type: revolute,  d: 0,    alpha: 0,   a: 200, theta: 0}
+  - {name: j3, type: revolute,  d: 0,    alpha: 0,   a: 200, theta: 0}
+  - {name: j4, type: revolute,  d: -170, alpha: -90, a: 0,   theta: -90}
+  - {name: j5, type: revolute,  d: 145,  alpha: -90, a: 0,   theta: 0}
+tool: {d: 150, alpha: 0, a: 0, theta: 0}
+bounds: {length: 5, angle: 5}
+)";
+
+std::string ErrorOf(const std::string& text) {
+  try {
+    ParseRobotYaml(text, "r.yaml");
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "(no error)";
+}
+
+TEST(RobotYamlTest, ReadsSpecExample) {
+  const Robot r = ParseRobotYaml(kSpecExample, "spec.yaml");
+  EXPECT_EQ(r.name, "BH-7");
+  ASSERT_EQ(r.joints.size(), 5u);
+  EXPECT_EQ(r.joints[0].type, JointType::kPrismatic);
+  EXPECT_DOUBLE_EQ(r.joints[3].d_mm, -170);
+  EXPECT_DOUBLE_EQ(r.joints[3].alpha_deg, -90);
+  EXPECT_DOUBLE_EQ(r.joints[3].theta_deg, -90);
+  EXPECT_DOUBLE_EQ(r.tool.d_mm, 150);
+  EXPECT_DOUBLE_EQ(r.bound_length_mm, 5);
+  EXPECT_FALSE(r.joints[0].HasLimits());
+}
+
+TEST(RobotYamlTest, BundledBh7IsTable1) {
+  const Robot file =
+      ReadRobotYaml(testing::SourceDir() + "/data/robots/bh7.yaml");
+  const Robot spec = ParseRobotYaml(kSpecExample, "spec.yaml");
+  ASSERT_EQ(file.joints.size(), spec.joints.size());
+  for (size_t i = 0; i < spec.joints.size(); ++i) {
+    EXPECT_EQ(file.joints[i].name, spec.joints[i].name);
+    EXPECT_EQ(file.joints[i].d_mm, spec.joints[i].d_mm);
+    EXPECT_EQ(file.joints[i].a_mm, spec.joints[i].a_mm);
+    EXPECT_EQ(file.joints[i].alpha_deg, spec.joints[i].alpha_deg);
+    EXPECT_EQ(file.joints[i].theta_deg, spec.joints[i].theta_deg);
+    EXPECT_TRUE(file.joints[i].HasLimits());
+  }
+}
+
+TEST(RobotYamlTest, MdhAndUrdfConventions) {
+  std::string mdh = kSpecExample;
+  mdh.replace(mdh.find("convention: dh"), 14, "convention: mdh");
+  EXPECT_EQ(ParseRobotYaml(mdh, "m.yaml").convention, Convention::kMdh);
+  const Robot u = ParseRobotYaml(
+      "kincal_robot: 1\nconvention: urdf\njoints:\n"
+      "  - {name: a, type: revolute, xyz: [0, 0, 333], rpy: [0, 0, 0], "
+      "axis: [0, 0, 2]}\ntool: {xyz: [0, 0, 107], rpy: [0, 0, 45]}\n",
+      "u.yaml");
+  EXPECT_EQ(u.convention, Convention::kUrdf);
+  EXPECT_DOUBLE_EQ(u.joints[0].axis.z(), 1.0);
+  EXPECT_DOUBLE_EQ(u.tool.rpy_deg.z(), 45.0);
+}
+
+TEST(RobotYamlTest, WriteThenReadIsIdentity) {
+  Robot r = ParseRobotYaml(kSpecExample, "spec.yaml");
+  r.joints[2].a_mm = 194.9624123456789;
+  r.joints[1].beta_deg = 0.0123;
+  r.extensions.push_back({"backlash", "j3", {{"width", 0.42}}});
+  const Robot back = ParseRobotYaml(FormatRobotYaml(r), "back.yaml");
+  EXPECT_EQ(back.joints[2].a_mm, r.joints[2].a_mm);
+  EXPECT_EQ(back.joints[1].beta_deg, 0.0123);
+  ASSERT_EQ(back.extensions.size(), 1u);
+  EXPECT_EQ(back.extensions[0].joint, "j3");
+  EXPECT_EQ(back.extensions[0].values.at("width"), 0.42);
+}
+
+TEST(RobotYamlTest, RejectsBadInputWithPosition) {
+  // Each case: text, expected message fragment (with line:column).
+  const std::string base = kSpecExample;
+  auto replace = [&](const std::string& from, const std::string& to) {
+    std::string s = base;
+    s.replace(s.find(from), from.size(), to);
+    return s;
+  };
+  EXPECT_THAT(ErrorOf(""), HasSubstr("empty file"));
+  EXPECT_THAT(ErrorOf("kincal_robot: 2\njoints: []\n"),
+              HasSubstr("r.yaml:1:15: kincal_robot: unsupported format version"));
+  EXPECT_THAT(ErrorOf(replace("a: 200, theta: 0}", "a: abc, theta: 0}")),
+              HasSubstr("r.yaml:7:"));
+  EXPECT_THAT(ErrorOf(replace("a: 200, theta: 0}", "a: abc, theta: 0}")),
+              HasSubstr("expected a number, got 'abc'"));
+  EXPECT_THAT(ErrorOf(replace("a: 200, theta: 0}", "a: nan, theta: 0}")),
+              HasSubstr("finite"));
+  EXPECT_THAT(ErrorOf(replace("name: j2", "name: j1")),
+              HasSubstr("duplicate joint name 'j1'"));
+  EXPECT_THAT(ErrorOf(replace("type: prismatic", "type: spherical")),
+              HasSubstr("r.yaml:6:"));
+  EXPECT_THAT(ErrorOf(replace("convention: dh", "convention: xx")),
+              HasSubstr("convention: expected 'dh', 'mdh' or 'urdf'"));
+  EXPECT_THAT(ErrorOf(replace("bounds:", "bonds:")),
+              HasSubstr("r.yaml:12:1: robot file: unknown key 'bonds'"));
+  EXPECT_THAT(ErrorOf(replace("a: 0,   theta: -90}", "a: 0}")),
+              HasSubstr("missing required key 'theta'"));
+  EXPECT_THAT(ErrorOf(replace("gravity: [0, 0, -1]", "gravity: [0, 0]")),
+              HasSubstr("expected 3 numbers, got 2"));
+  EXPECT_THAT(ErrorOf("kincal_robot: 1\njoints: [\n"), HasSubstr("invalid YAML"));
+  EXPECT_THAT(ErrorOf(base + "extensions:\n  - {cause: magic, joint: j3}\n"),
+              HasSubstr("unknown cause 'magic'"));
+  EXPECT_THAT(ErrorOf(base + "extensions:\n  - {cause: backlash, joint: j9, width: 1}\n"),
+              HasSubstr("no joint named 'j9'"));
+}
+
+TEST(RobotYamlTest, MissingFileIsInputError) {
+  EXPECT_THROW(ReadRobotYaml("/nonexistent/robot.yaml"), InputError);
+}
+
+}  // namespace
+}  // namespace kincal
