@@ -1,17 +1,182 @@
+// kincal calibrate: geometry + base-to-measuring-frame transform from
+// measured points (or the seed's single-point objective with --method paper).
+
+#include <cstdio>
+#include <iostream>
+#include <memory>
+#include <sstream>
+
+#include "app/app_util.h"
 #include "app/command.h"
+#include "calib/calibrate.h"
+#include "data/atomic_file.h"
+#include "data/csv.h"
+#include "data/error.h"
+#include "data/urdf.h"
 
 namespace kincal::app {
+namespace {
 
-// Not built yet: registers the subcommand so usage is stable; exits 1.
+struct CalibrateArgs {
+  std::string robot, obs, out, method = "lsq", root, tip;
+  std::vector<std::string> distances, free;
+  CalibrateOptions options;
+  bool json = false;
+};
+
+FixedDistance ParseDistance(const std::string& text) {
+  std::vector<std::string> parts;
+  std::stringstream ss(text);
+  for (std::string p; std::getline(ss, p, ',');) parts.push_back(p);
+  FixedDistance d;
+  if (parts.size() != 3 || parts[0].empty() || parts[1].empty() ||
+      !ParseFiniteDouble(parts[2], &d.distance_mm) || d.distance_mm <= 0) {
+    throw InputError("--fixed-distance '" + text +
+                     "': expected LABEL_A,LABEL_B,DISTANCE_MM");
+  }
+  d.a = parts[0];
+  d.b = parts[1];
+  return d;
+}
+
+int RunCalibrate(CalibrateArgs args) {
+  const Robot nominal = ReadRobot(args.robot, args.root, args.tip);
+  const Observations obs = ReadObservationsCsv(args.obs, nominal.JointNames());
+  if (args.method == "paper") {
+    args.options.method = CalibrateOptions::kPaper;
+  } else if (args.method == "lsq") {
+    args.options.method = CalibrateOptions::kLeastSquares;
+  } else {
+    throw InputError("--method: expected 'lsq' or 'paper', got '" +
+                     args.method + "'");
+  }
+  if (args.options.loss != "none" && args.options.loss != "huber" &&
+      args.options.loss != "cauchy") {
+    throw InputError("--loss: expected none, huber or cauchy");
+  }
+  for (const auto& d : args.distances) {
+    args.options.distances.push_back(ParseDistance(d));
+  }
+  args.options.extra_params = args.free;
+  const CalibrateResult r = Calibrate(nominal, obs, args.options);
+
+  if (!args.out.empty()) {
+    std::ostringstream note;
+    note << "calibrated by " << r.method << " from " << args.obs << ": train RMS "
+         << r.train.rms_mm << " mm (" << r.train.n << " poses), held-out RMS "
+         << r.heldout.rms_mm << " mm (" << r.heldout.n << " poses)";
+    std::vector<std::string> comment = {note.str()};
+    std::string held;
+    for (const auto& name : r.identifiability.UnidentifiableNames()) {
+      held += (held.empty() ? "" : ", ") + name;
+    }
+    if (!held.empty()) comment.push_back("held at nominal (not identifiable): " + held);
+    WriteFileAtomic(args.out, FormatRobotYaml(r.calibrated, comment));
+  }
+
+  const Identifiability& id = r.identifiability;
+  nlohmann::json j;
+  j["method"] = r.method;
+  j["train_rms_mm"] = Number(r.train.rms_mm);
+  j["heldout_rms_mm"] = r.heldout.n > 0 ? Number(r.heldout.rms_mm) : nullptr;
+  j["train"] = StatsJson(r.train);
+  j["heldout"] = StatsJson(r.heldout);
+  j["identifiable"] = id.IdentifiableNames();
+  j["unidentifiable"] = id.UnidentifiableNames();
+  j["weakly_identifiable"] = id.weak;
+  j["relations"] = id.relations;
+  j["condition_number"] = Number(id.condition);
+  j["parameters"] = ParametersJson(r.fit, [&] {
+    ModelState s;
+    s.chain = Chain::FromRobot(nominal);
+    return s;
+  }());
+  j["sigma0_mm"] = Number(r.fit.sigma0_mm);
+  j["termination"] = r.fit.termination;
+  j["converged"] = r.fit.converged;
+  j["iterations"] = r.fit.iterations;
+  j["fit_seconds"] = r.fit.seconds;
+  j["seconds"] = r.seconds;
+  j["seed"] = args.options.seed;
+  j["holdout_fraction"] = args.options.holdout_fraction;
+  if (r.has_epsilon) {
+    j["epsilon"] = {{"mean_mm", r.epsilon.mean_mm},
+                    {"max_mm", r.epsilon.max_mm},
+                    {"std_mm", r.epsilon.std_mm},
+                    {"n", r.epsilon.n}};
+  }
+  if (!r.distance_errors_mm.empty()) j["distance_errors_mm"] = r.distance_errors_mm;
+  if (!args.out.empty()) j["out"] = args.out;
+  if (args.json) {
+    PrintJson(j);
+    return 0;
+  }
+  std::printf("kincal calibrate (%s): %d training poses, %d held out\n",
+              r.method.c_str(), r.train.n, r.heldout.n);
+  std::printf("  train RMS    %.4f mm   (mean %.4f, max %.4f)\n", r.train.rms_mm,
+              r.train.mean_mm, r.train.max_mm);
+  if (r.heldout.n > 0) {
+    std::printf("  held-out RMS %.4f mm   (mean %.4f, max %.4f)\n",
+                r.heldout.rms_mm, r.heldout.mean_mm, r.heldout.max_mm);
+  }
+  if (r.has_epsilon) {
+    std::printf("  epsilon (mean distance to the fixed point) %.4f mm, max %.4f, std %.4f\n",
+                r.epsilon.mean_mm, r.epsilon.max_mm, r.epsilon.std_mm);
+  }
+  std::printf("  %zu identifiable parameters, %zu held at nominal; %s\n",
+              id.identifiable.size(), id.unidentifiable.size(),
+              r.fit.termination.c_str());
+  for (const auto& rel : id.relations) std::printf("    %s\n", rel.c_str());
+  std::printf("  %-14s %12s %12s %10s\n", "parameter", "nominal", "value", "sigma");
+  for (const auto& p : j["parameters"]) {
+    if (!p.contains("nominal")) continue;
+    std::printf("  %-14s %12.4f %12.4f %10.4f %s\n",
+                p["name"].get<std::string>().c_str(), p["nominal"].get<double>(),
+                p["value"].get<double>(),
+                p["sigma"].is_null() ? NAN : p["sigma"].get<double>(),
+                p["unit"].get<std::string>().c_str());
+  }
+  if (!args.out.empty()) std::printf("  wrote %s\n", args.out.c_str());
+  std::printf("  %.3f s\n", r.seconds);
+  return 0;
+}
+
+}  // namespace
+
 void AddCalibrateCommand(CLI::App& app, Runner* run) {
-  CLI::App* sub = app.add_subcommand("calibrate", "(not implemented yet)");
-  sub->allow_extras();
-  sub->callback([run] {
-    *run = [] {
-      std::fprintf(stderr, "kincal calibrate: not implemented yet\n");
-      return 1;
-    };
-  });
+  auto args = std::make_shared<CalibrateArgs>();
+  CLI::App* sub = app.add_subcommand(
+      "calibrate",
+      "Fit robot geometry and the base-to-measuring-frame transform to "
+      "measured tip points (Ceres LM), or the seed's single-point objective");
+  sub->add_option("--robot", args->robot, "nominal robot.yaml or .urdf")
+      ->required();
+  sub->add_option("--root", args->root, "URDF root link");
+  sub->add_option("--tip", args->tip, "URDF tip link");
+  sub->add_option("--obs", args->obs, "observations.csv")->required();
+  sub->add_option("--out", args->out, "calibrated robot.yaml to write");
+  sub->add_option("--method", args->method,
+                  "lsq (least squares, default) | paper (eq. 9, direct search)")
+      ->capture_default_str();
+  sub->add_option("--holdout", args->options.holdout_fraction,
+                  "fraction of poses held out of the fit")
+      ->capture_default_str();
+  sub->add_option("--seed", args->options.seed, "seed of the held-out split")
+      ->capture_default_str();
+  sub->add_option("--loss", args->options.loss, "none | huber | cauchy")
+      ->capture_default_str();
+  sub->add_option("--loss-scale", args->options.loss_scale_mm,
+                  "robust loss scale, mm")
+      ->capture_default_str();
+  sub->add_option("--rank-tol", args->options.identifiability.tolerance,
+                  "identifiability threshold (sine of the angle to the span)")
+      ->capture_default_str();
+  sub->add_option("--fixed-distance", args->distances,
+                  "known distance between fixed points: A,B,MM (repeatable)");
+  sub->add_option("--free", args->free,
+                  "extra parameters to fit, e.g. j2.beta (repeatable)");
+  sub->add_flag("--json", args->json, "print one JSON object");
+  sub->callback([run, args] { *run = [args] { return RunCalibrate(*args); }; });
 }
 
 }  // namespace kincal::app

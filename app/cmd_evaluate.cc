@@ -1,17 +1,70 @@
+// kincal evaluate: fit only the base-to-measuring-frame transform, then report
+// the position error of a (calibrated) robot model on new data.
+
+#include <cstdio>
+#include <memory>
+#include <sstream>
+
+#include "app/app_util.h"
 #include "app/command.h"
+#include "calib/evaluate.h"
+#include "data/atomic_file.h"
+#include "data/csv.h"
+#include "data/provenance.h"
+#include "data/urdf.h"
+#include "data/yaml_util.h"
 
 namespace kincal::app {
+namespace {
 
-// Not built yet: registers the subcommand so usage is stable; exits 1.
+struct EvaluateArgs {
+  std::string robot, obs, residuals, root, tip;
+  bool json = false;
+};
+
+int RunEvaluate(const EvaluateArgs& args) {
+  const Robot robot = ReadRobot(args.robot, args.root, args.tip);
+  const Observations obs = ReadObservationsCsv(args.obs, robot.JointNames());
+  const EvaluateResult r = Evaluate(robot, obs);
+  if (!args.residuals.empty()) {
+    std::ostringstream os;
+    os << "# written by " << ToolVersion() << ": " << CommandLine() << "\n";
+    os << "pose,error_mm\n";
+    for (size_t i = 0; i < r.rows.size(); ++i) {
+      os << CsvQuote(obs.rows[r.rows[i]].pose) << ","
+         << FormatDouble(r.errors_mm[i]) << "\n";
+    }
+    WriteFileAtomic(args.residuals, os.str());
+  }
+  if (args.json) {
+    nlohmann::json j = StatsJson(r.stats);
+    j["extensions"] = robot.extensions.size();
+    PrintJson(j);
+    return 0;
+  }
+  std::printf("kincal evaluate: %d poses, frame registered only\n", r.stats.n);
+  std::printf("  RMS %.4f mm, mean %.4f, max %.4f, std %.4f\n", r.stats.rms_mm,
+              r.stats.mean_mm, r.stats.max_mm, r.stats.std_mm);
+  return 0;
+}
+
+}  // namespace
+
 void AddEvaluateCommand(CLI::App& app, Runner* run) {
-  CLI::App* sub = app.add_subcommand("evaluate", "(not implemented yet)");
-  sub->allow_extras();
-  sub->callback([run] {
-    *run = [] {
-      std::fprintf(stderr, "kincal evaluate: not implemented yet\n");
-      return 1;
-    };
-  });
+  auto args = std::make_shared<EvaluateArgs>();
+  CLI::App* sub = app.add_subcommand(
+      "evaluate",
+      "Register only the measuring frame and report the tip position error "
+      "of a robot model (with its extensions) on observations");
+  sub->add_option("--robot", args->robot, "robot.yaml (calibrated) or .urdf")
+      ->required();
+  sub->add_option("--root", args->root, "URDF root link");
+  sub->add_option("--tip", args->tip, "URDF tip link");
+  sub->add_option("--obs", args->obs, "observations.csv")->required();
+  sub->add_option("--residuals", args->residuals,
+                  "write per-pose errors to this CSV");
+  sub->add_flag("--json", args->json, "print one JSON object");
+  sub->callback([run, args] { *run = [args] { return RunEvaluate(*args); }; });
 }
 
 }  // namespace kincal::app

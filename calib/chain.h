@@ -10,6 +10,7 @@
 // conversions happen in Chain::FromRobot / Chain::ToRobot and ParamInfo.
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 #include <array>
 #include <cmath>
 #include <string>
@@ -229,6 +230,89 @@ Mat4<T> BaseFromTip(const Chain& chain, const T* const* rows, const T* q) {
                           rows[chain.tool_row()], T(0));
 }
 
+namespace internal {
+// Rotations and translations applied to a point, without building matrices.
+template <typename T>
+Vec3<T> RotZApply(const T& a, const Vec3<T>& x) {
+  using std::cos;
+  using std::sin;
+  const T c = cos(a), s = sin(a);
+  return Vec3<T>(c * x[0] - s * x[1], s * x[0] + c * x[1], x[2]);
+}
+template <typename T>
+Vec3<T> RotXApply(const T& a, const Vec3<T>& x) {
+  using std::cos;
+  using std::sin;
+  const T c = cos(a), s = sin(a);
+  return Vec3<T>(x[0], c * x[1] - s * x[2], s * x[1] + c * x[2]);
+}
+template <typename T>
+Vec3<T> RotYApply(const T& a, const Vec3<T>& x) {
+  using std::cos;
+  using std::sin;
+  const T c = cos(a), s = sin(a);
+  return Vec3<T>(c * x[0] + s * x[2], x[1], -s * x[0] + c * x[2]);
+}
+template <typename T>
+Vec3<T> RotAxisApply(const Eigen::Vector3d& u, const T& a, const Vec3<T>& x) {
+  using std::cos;
+  using std::sin;
+  const T c = cos(a), s = sin(a);
+  const Vec3<T> uu = u.cast<T>();
+  return x * c + uu.cross(x) * s + uu * (uu.dot(x) * (T(1) - c));
+}
+}  // namespace internal
+
+// The same transform as RowTransform, applied to a point x (next frame) to
+// give it in the previous frame; cheaper than the matrix for autodiff.
+template <typename T>
+Vec3<T> RowApply(Convention convention, const ChainRow& row, const T* p,
+                 const T& q, const Vec3<T>& x) {
+  using internal::RotAxisApply;
+  using internal::RotXApply;
+  using internal::RotYApply;
+  using internal::RotZApply;
+  const bool revolute = row.type == JointType::kRevolute;
+  const bool prismatic = row.type == JointType::kPrismatic;
+  switch (convention) {
+    case Convention::kDh: {  // Rz(theta + q) Tz(d + q) Tx(a) Rx(alpha) Ry(beta)
+      Vec3<T> y = RotXApply(p[3], RotYApply(p[4], x));
+      y[0] += p[2];
+      y[2] += prismatic ? p[1] + q : p[1];
+      return RotZApply(revolute ? p[0] + q : p[0], y);
+    }
+    case Convention::kMdh: {  // Rx(alpha) Ry(beta) Tx(a) Rz(theta + q) Tz(d + q)
+      Vec3<T> y = x;
+      y[2] += prismatic ? p[1] + q : p[1];
+      y = RotZApply(revolute ? p[0] + q : p[0], y);
+      y[0] += p[2];
+      return RotXApply(p[3], RotYApply(p[4], y));
+    }
+    case Convention::kUrdf: {  // T(xyz) Rz(yaw) Ry(pitch) Rx(roll) [joint]
+      Vec3<T> y = x;
+      if (revolute) y = RotAxisApply(row.axis, q, y);
+      if (prismatic) {
+        for (int k = 0; k < 3; ++k) y[k] += T(row.axis[k]) * q;
+      }
+      y = RotZApply(p[5], RotYApply(p[4], RotXApply(p[3], y)));
+      return Vec3<T>(y[0] + p[0], y[1] + p[1], y[2] + p[2]);
+    }
+  }
+  return x;
+}
+
+// The tip (origin of the last frame) in the base frame for model joint
+// values q: rows applied to the point from the tool back to the base.
+template <typename T>
+Vec3<T> TipPosition(const Chain& chain, const T* const* rows, const T* q) {
+  Vec3<T> p = RowApply(chain.convention, chain.rows[chain.tool_row()],
+                       rows[chain.tool_row()], T(0), Vec3<T>(T(0), T(0), T(0)));
+  for (int i = chain.num_joints() - 1; i >= 0; --i) {
+    p = RowApply(chain.convention, chain.rows[i], rows[i], q[i], p);
+  }
+  return p;
+}
+
 // The needle tip in the base frame for one pose: error model, FK, drift.
 // `joint_errors` (one block per joint) and `drift` may be null.
 template <typename T>
@@ -241,8 +325,7 @@ Vec3<T> TipInBase(const Chain& chain, const T* const* rows,
     q[j] = ModelJointValue<T>(chain.rows[j].type, in.q[j], in.s[j], in.tau[j],
                               joint_errors ? joint_errors[j] : nullptr);
   }
-  const Mat4<T> m = BaseFromTip(chain, rows, q);
-  Vec3<T> p(m(0, 3), m(1, 3), m(2, 3));
+  Vec3<T> p = TipPosition(chain, rows, q);
   if (drift != nullptr) {
     for (int k = 0; k < 3; ++k) p[k] += drift[k] * in.t_h;
   }

@@ -215,4 +215,14 @@ Robot ReadUrdfChain(const std::string& path, const std::string& root_link,
   return ParseUrdfChain(ReadFile(path), path, root_link, tip_link);
 }
 
+Robot ReadRobot(const std::string& path, const std::string& root_link,
+                const std::string& tip_link) {
+  const std::string ext = ".urdf";
+  if (path.size() >= ext.size() &&
+      path.compare(path.size() - ext.size(), ext.size(), ext) == 0) {
+    return ReadUrdfChain(path, root_link, tip_link);
+  }
+  return ReadRobotYaml(path);
+}
+
 }  // namespace kincal

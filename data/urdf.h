@@ -20,6 +20,11 @@ Robot ParseUrdfChain(const std::string& xml, const std::string& file_label,
                      const std::string& root_link = "",
                      const std::string& tip_link = "");
 
+// Reads a robot from robot.yaml, or from a URDF file when the path ends in
+// ".urdf" (chain from `root_link` to `tip_link`, see ReadUrdfChain).
+Robot ReadRobot(const std::string& path, const std::string& root_link = "",
+                const std::string& tip_link = "");
+
 }  // namespace kincal
 
 #endif  // KINCAL_DATA_URDF_H_

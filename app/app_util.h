@@ -1,0 +1,35 @@
+#ifndef KINCAL_APP_APP_UTIL_H_
+#define KINCAL_APP_APP_UTIL_H_
+
+// Small helpers shared by the subcommands: reading inputs, writing outputs
+// atomically, JSON conversions. No algorithms here.
+
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "calib/fit.h"
+#include "calib/identifiability.h"
+#include "data/observations.h"
+#include "data/robot.h"
+
+namespace kincal::app {
+
+// Creates `dir` (and parents) if needed; InputError when it cannot.
+void MakeDirs(const std::string& dir);
+
+// JSON number, or null when not finite.
+nlohmann::json Number(double v);
+
+// {"n", "rms_mm", "mean_mm", "max_mm", "std_mm"}
+nlohmann::json StatsJson(const ErrorStats& s);
+
+// "mm", "deg", "1", "deg/mm", "mm/h": the interface unit of a parameter.
+std::string ParamUnit(const ParamInfo& p);
+
+// Per free parameter: name, value, sigma (interface units), nominal.
+nlohmann::json ParametersJson(const FitSummary& fit, const ModelState& nominal);
+
+}  // namespace kincal::app
+
+#endif  // KINCAL_APP_APP_UTIL_H_

@@ -1,0 +1,210 @@
+#include "calib/calibrate.h"
+
+#include <algorithm>
+#include <chrono>
+#include <map>
+#include <random>
+#include <set>
+
+#include "calib/paper_method.h"
+#include "data/error.h"
+
+namespace kincal {
+
+void SplitHoldout(const std::vector<Measurement>& ms, double fraction,
+                  uint64_t seed, std::vector<int>* train,
+                  std::vector<int>* heldout) {
+  train->clear();
+  heldout->clear();
+  std::map<int, std::vector<int>> groups;  // -1 = measured points
+  for (size_t i = 0; i < ms.size(); ++i) {
+    groups[ms[i].kind == Measurement::kMeasured ? -1 : ms[i].point].push_back(
+        static_cast<int>(i));
+  }
+  std::mt19937_64 rng(seed);
+  for (auto& kv : groups) {
+    std::vector<int>& idx = kv.second;
+    std::shuffle(idx.begin(), idx.end(), rng);
+    const int n = static_cast<int>(idx.size());
+    const int min_train = kv.first < 0 ? 10 : 3;
+    int hold = static_cast<int>(std::lround(fraction * n));
+    hold = std::max(0, std::min(hold, n - min_train));
+    for (int k = 0; k < n; ++k) (k < hold ? heldout : train)->push_back(idx[k]);
+  }
+  std::sort(train->begin(), train->end());
+  std::sort(heldout->begin(), heldout->end());
+}
+
+std::vector<double> CentroidDistances(const ModelState& state,
+                                      const std::vector<Measurement>& ms) {
+  std::map<int, std::vector<Eigen::Vector3d>> tips;
+  for (const Measurement& m : ms) {
+    if (m.kind == Measurement::kFixedPoint) {
+      tips[m.point].push_back(TipInBase(state.chain, m.input));
+    }
+  }
+  std::vector<double> out;
+  for (const auto& kv : tips) {
+    Eigen::Vector3d c = Eigen::Vector3d::Zero();
+    for (const auto& p : kv.second) c += p;
+    c /= static_cast<double>(kv.second.size());
+    for (const auto& p : kv.second) out.push_back((p - c).norm());
+  }
+  return out;
+}
+
+namespace {
+
+std::vector<Measurement> Pick(const std::vector<Measurement>& ms,
+                              const std::vector<int>& idx) {
+  std::vector<Measurement> out;
+  for (int i : idx) out.push_back(ms[i]);
+  return out;
+}
+
+std::vector<double> Norms(const ModelState& state,
+                          const std::vector<Measurement>& ms) {
+  std::vector<double> out;
+  for (const Measurement& m : ms) out.push_back(Residual(state, m).norm());
+  return out;
+}
+
+int DistinctPoses(const std::vector<Measurement>& ms) {
+  std::set<std::vector<double>> seen;
+  for (const Measurement& m : ms) seen.insert(m.input.q);
+  return static_cast<int>(seen.size());
+}
+
+}  // namespace
+
+CalibrateResult Calibrate(const Robot& nominal, const Observations& obs,
+                          const CalibrateOptions& options) {
+  const auto start = std::chrono::steady_clock::now();
+  Require(options.holdout_fraction >= 0 && options.holdout_fraction < 0.9,
+          "--holdout must be in [0, 0.9)");
+  CalibrateResult result;
+  result.method = options.method == CalibrateOptions::kPaper ? "paper"
+                                                             : "least_squares";
+  const Chain nominal_chain = Chain::FromRobot(nominal);
+  ModelState& state = result.state;
+  state.chain = nominal_chain;
+  std::vector<Measurement> all = MakeMeasurements(nominal_chain, obs, &state);
+  if (all.empty()) {
+    throw InputError(obs.source, 0, 0,
+                     "no row has a measured tip (x, y, z) or a fixed_point "
+                     "label: nothing to calibrate against");
+  }
+  const int distinct = DistinctPoses(all);
+  if (distinct < 2) {
+    throw InputError(obs.source, 0, 0,
+                     "all " + std::to_string(all.size()) +
+                         " usable rows have the same joint readings: one pose "
+                         "determines no robot parameter");
+  }
+  std::vector<PointDistance> distances;
+  for (const FixedDistance& d : options.distances) {
+    PointDistance pd;
+    pd.a = state.PointIndex(d.a);
+    pd.b = state.PointIndex(d.b);
+    if (pd.a < 0 || pd.b < 0) {
+      throw InputError("--fixed-distance " + d.a + "," + d.b +
+                       ": no fixed_point label '" + (pd.a < 0 ? d.a : d.b) +
+                       "' in " + obs.source);
+    }
+    pd.distance_mm = d.distance_mm;
+    pd.weight = 10.0;
+    distances.push_back(pd);
+  }
+
+  SplitHoldout(all, options.holdout_fraction, options.seed, &result.train_rows,
+               &result.heldout_rows);
+  const std::vector<Measurement> train = Pick(all, result.train_rows);
+  const std::vector<Measurement> held = Pick(all, result.heldout_rows);
+  InitializeFrameAndPoints(train, &state);
+
+  const bool any_measured =
+      std::any_of(train.begin(), train.end(), [](const Measurement& m) {
+        return m.kind == Measurement::kMeasured;
+      });
+  std::vector<ParamInfo> nuisance;  // frame and fixed points
+  if (any_measured) nuisance = FrameParams();
+  for (const ParamInfo& p : PointParams(state)) nuisance.push_back(p);
+
+  // Frame / points alone first: a good start for the full fit.
+  FitOptions frame_only;
+  frame_only.free = nuisance;
+  frame_only.compute_covariance = false;
+  frame_only.distances = distances;
+  Fit(train, frame_only, &state);
+
+  std::vector<ParamInfo> candidates = nuisance;
+  if (options.fit_geometry) {
+    for (const ParamInfo& p : GeometryParams(state.chain)) candidates.push_back(p);
+    for (const std::string& name : options.extra_params) {
+      candidates.push_back(FindParam(state, name));
+    }
+  }
+  result.identifiability = AnalyzeIdentifiability(
+      train, state, candidates, options.identifiability, distances);
+  int robot_params = 0;
+  for (const ParamInfo& p : result.identifiability.identifiable) {
+    if (p.kind != ParamKind::kFrame && p.kind != ParamKind::kPoint) ++robot_params;
+  }
+  if (options.fit_geometry && robot_params == 0) {
+    throw InputError(obs.source, 0, 0,
+                     "the data determine no robot parameter (" +
+                         std::to_string(distinct) +
+                         " distinct poses): use more poses that differ in "
+                         "every joint");
+  }
+  const int num_free = static_cast<int>(result.identifiability.identifiable.size());
+  const int num_residuals = 3 * static_cast<int>(train.size()) +
+                            static_cast<int>(distances.size());
+  if (num_residuals <= num_free) {
+    throw InputError(obs.source, 0, 0,
+                     "too few poses: " + std::to_string(train.size()) +
+                         " training poses give " + std::to_string(num_residuals) +
+                         " equations for " + std::to_string(num_free) +
+                         " identifiable parameters; need at least " +
+                         std::to_string(num_free / 3 + 1) +
+                         " distinct training poses (more for a useful fit)");
+  }
+
+  FitOptions fit;
+  fit.free = result.identifiability.identifiable;
+  fit.bounds_center = &nominal_chain;
+  fit.loss = options.loss;
+  fit.loss_scale_mm = options.loss_scale_mm;
+  fit.distances = distances;
+  if (options.method == CalibrateOptions::kPaper) {
+    PaperOptions paper;
+    paper.free = fit.free;
+    paper.bounds_center = &nominal_chain;
+    result.fit = FitPaperObjective(train, paper, &state);
+  } else {
+    result.fit = Fit(train, fit, &state);
+  }
+
+  result.train = ComputeErrorStats(Norms(state, train));
+  result.heldout = ComputeErrorStats(Norms(state, held));
+  for (size_t i = 0; i < distances.size(); ++i) {
+    const auto& a = state.points_in_base[distances[i].a];
+    const auto& b = state.points_in_base[distances[i].b];
+    const double d = std::sqrt((a[0] - b[0]) * (a[0] - b[0]) +
+                               (a[1] - b[1]) * (a[1] - b[1]) +
+                               (a[2] - b[2]) * (a[2] - b[2]));
+    result.distance_errors_mm.push_back(d - distances[i].distance_mm);
+  }
+  const std::vector<double> eps = CentroidDistances(state, train);
+  if (!eps.empty()) {
+    result.has_epsilon = true;
+    result.epsilon = ComputeErrorStats(eps);
+  }
+  result.calibrated = state.chain.ToRobot(nominal);
+  result.seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start)
+          .count();
+  return result;
+}
+
+}  // namespace kincal

@@ -1,0 +1,77 @@
+#ifndef KINCAL_CALIB_CALIBRATE_H_
+#define KINCAL_CALIB_CALIBRATE_H_
+
+// The calibration workflow behind `kincal calibrate`: split poses into
+// training and held-out (seeded), register the measuring frame, decide which
+// parameters the training data determine, fit them (bounded by the robot
+// file's +-delta), and report training and held-out error.
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "calib/fit.h"
+#include "calib/identifiability.h"
+#include "calib/model_state.h"
+#include "data/observations.h"
+#include "data/robot.h"
+
+namespace kincal {
+
+// A known distance between two fixed points (mm): the scale reference that
+// single-point data lacks (e.g. two sockets 50 mm apart).
+struct FixedDistance {
+  std::string a, b;
+  double distance_mm = 0.0;
+};
+
+struct CalibrateOptions {
+  enum Method { kLeastSquares, kPaper };
+  Method method = kLeastSquares;
+  // Fraction of poses held out of the fit to measure prediction error
+  // (per fixed-point group for single-point data). 0 = none.
+  double holdout_fraction = 0.2;
+  uint64_t seed = 1;
+  std::string loss = "none";  // none | huber | cauchy
+  double loss_scale_mm = 1.0;
+  IdentifiabilityOptions identifiability;
+  std::vector<FixedDistance> distances;
+  // Extra parameters to free besides the row geometry (e.g. "j2.beta").
+  std::vector<std::string> extra_params;
+  // Fit the geometry (false: only the frame / fixed points, as `evaluate`).
+  bool fit_geometry = true;
+};
+
+struct CalibrateResult {
+  Robot calibrated;  // nominal description with fitted values
+  ModelState state;
+  Identifiability identifiability;
+  FitSummary fit;
+  std::vector<int> train_rows, heldout_rows;  // indices in observations
+  ErrorStats train, heldout;                  // |residual| statistics, mm
+  // Single-point data: the seed's epsilon (mean distance to the group
+  // centroid), its max and std, on the training poses (Table 2's footer).
+  bool has_epsilon = false;
+  ErrorStats epsilon;
+  std::vector<double> distance_errors_mm;  // per FixedDistance
+  double seconds = 0.0;
+  std::string method;
+};
+
+CalibrateResult Calibrate(const Robot& nominal, const Observations& obs,
+                          const CalibrateOptions& options);
+
+// Splits measurement indices into train / held-out, seeded; fixed-point
+// groups are split per group so that each keeps at least 3 training poses.
+void SplitHoldout(const std::vector<Measurement>& measurements,
+                  double fraction, uint64_t seed, std::vector<int>* train,
+                  std::vector<int>* heldout);
+
+// The seed's epsilon for fixed-point measurements: for each group, distances
+// of the model tips to the group's centroid.
+std::vector<double> CentroidDistances(const ModelState& state,
+                                      const std::vector<Measurement>& ms);
+
+}  // namespace kincal
+
+#endif  // KINCAL_CALIB_CALIBRATE_H_

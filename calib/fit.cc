@@ -1,0 +1,427 @@
+#include "calib/fit.h"
+
+#include <ceres/ceres.h>
+
+#include <Eigen/Geometry>
+#include <chrono>
+#include <map>
+#include <memory>
+
+#include "data/error.h"
+
+namespace kincal {
+namespace {
+
+// Residual of one measurement.
+//   kMeasured:   r = meas_from_base * tip_in_base(q; rows, errors, drift) - p_in_meas
+//   kFixedPoint: r = tip_in_base(q; rows, errors, drift) - point_in_base
+// Parameter blocks, in order: the n+1 row geometry blocks (tool last), the n
+// joint error blocks, the drift block, then meas_from_base (6) or
+// point_in_base (3). The chain is copied for its structure (row kinds, axes);
+// its values are never read here.
+class TipResidual {
+ public:
+  static constexpr int kStride = 8;
+
+  TipResidual(const Chain& chain, const Measurement& m)
+      : chain_(chain), m_(m) {}
+
+  template <typename T>
+  bool operator()(T const* const* params, T* residual) const {
+    const int n = chain_.num_joints();
+    const T* const* rows = params;
+    const T* const* joint_errors = params + n + 1;
+    const T* drift = params[2 * n + 1];
+    const T* target = params[2 * n + 2];
+    const Vec3<T> tip_in_base =
+        TipInBase<T>(chain_, rows, joint_errors, drift, m_.input);
+    if (m_.kind == Measurement::kMeasured) {
+      const Vec3<T> p_in_meas = ApplyFrame(target, tip_in_base);
+      for (int k = 0; k < 3; ++k) residual[k] = p_in_meas[k] - m_.p_in_meas[k];
+    } else {
+      for (int k = 0; k < 3; ++k) residual[k] = tip_in_base[k] - target[k];
+    }
+    return true;
+  }
+
+  static ceres::CostFunction* Create(const Chain& chain, const Measurement& m) {
+    auto* cost =
+        new ceres::DynamicAutoDiffCostFunction<TipResidual, kStride>(
+            new TipResidual(chain, m));
+    for (int r = 0; r <= chain.num_joints(); ++r) {
+      cost->AddParameterBlock(kRowBlockSize);
+    }
+    for (int j = 0; j < chain.num_joints(); ++j) {
+      cost->AddParameterBlock(kJointErrorBlockSize);
+    }
+    cost->AddParameterBlock(kDriftBlockSize);
+    cost->AddParameterBlock(m.kind == Measurement::kMeasured ? kFrameBlockSize
+                                                             : 3);
+    cost->SetNumResiduals(3);
+    return cost;
+  }
+
+ private:
+  const Chain chain_;
+  const Measurement m_;
+};
+
+// A known distance between two fixed points:
+//   r = weight * (|point_a - point_b| - distance)
+struct DistanceResidual {
+  DistanceResidual(double distance_mm, double weight)
+      : distance_mm_(distance_mm), weight_(weight) {}
+  template <typename T>
+  bool operator()(const T* point_a, const T* point_b, T* residual) const {
+    using std::sqrt;
+    const T dx = point_a[0] - point_b[0], dy = point_a[1] - point_b[1],
+            dz = point_a[2] - point_b[2];
+    residual[0] = T(weight_) * (sqrt(dx * dx + dy * dy + dz * dz) - distance_mm_);
+    return true;
+  }
+  static ceres::CostFunction* Create(double distance_mm, double weight) {
+    return new ceres::AutoDiffCostFunction<DistanceResidual, 1, 3, 3>(
+        new DistanceResidual(distance_mm, weight));
+  }
+
+ private:
+  const double distance_mm_;
+  const double weight_;
+};
+
+// The parameter block pointers of one measurement, in TipResidual's order.
+std::vector<double*> BlocksOf(ModelState* s, const Measurement& m) {
+  std::vector<double*> blocks;
+  for (auto& row : s->chain.rows) blocks.push_back(row.p.data());
+  for (auto& e : s->chain.joint_errors) blocks.push_back(e.data());
+  blocks.push_back(s->chain.drift.data());
+  blocks.push_back(m.kind == Measurement::kMeasured
+                       ? s->meas_from_base.data()
+                       : s->points_in_base.at(m.point).data());
+  return blocks;
+}
+
+bool IsAngle(const Chain& chain, const ParamInfo& p) {
+  if (p.kind != ParamKind::kRow) return p.angle;
+  if (chain.convention == Convention::kUrdf) return p.index >= 3;
+  return p.index == 0 || p.index >= 3;
+}
+
+double Seconds(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start)
+      .count();
+}
+
+}  // namespace
+
+std::vector<Measurement> MakeMeasurements(const Chain& nominal,
+                                          const Observations& obs,
+                                          ModelState* state) {
+  const std::vector<PoseInput> inputs = MakePoseInputs(nominal, obs);
+  std::vector<Measurement> out;
+  for (size_t i = 0; i < obs.rows.size(); ++i) {
+    const Observation& o = obs.rows[i];
+    Measurement m;
+    m.row = static_cast<int>(i);
+    m.input = inputs[i];
+    if (o.has_point) {
+      m.kind = Measurement::kMeasured;
+      m.p_in_meas = o.p_in_meas;
+    } else if (!o.fixed_point.empty()) {
+      m.kind = Measurement::kFixedPoint;
+      m.point = state->PointIndex(o.fixed_point);
+      if (m.point < 0) {
+        state->point_labels.push_back(o.fixed_point);
+        state->points_in_base.push_back({0.0, 0.0, 0.0});
+        m.point = static_cast<int>(state->point_labels.size()) - 1;
+      }
+    } else {
+      continue;
+    }
+    out.push_back(m);
+  }
+  return out;
+}
+
+Eigen::Vector3d Residual(const ModelState& state, const Measurement& m) {
+  const Eigen::Vector3d tip = TipInBase(state.chain, m.input);
+  if (m.kind == Measurement::kMeasured) {
+    return ApplyFrame(state.meas_from_base.data(), Vec3<double>(tip)) -
+           m.p_in_meas;
+  }
+  const auto& p = state.points_in_base.at(m.point);
+  return tip - Eigen::Vector3d(p[0], p[1], p[2]);
+}
+
+FitSummary Fit(const std::vector<Measurement>& measurements,
+               const FitOptions& options, ModelState* state) {
+  const auto start = std::chrono::steady_clock::now();
+  KINCAL_CHECK(!measurements.empty(), "no measurements to fit");
+  FitSummary summary;
+  ceres::Problem problem;
+  for (const Measurement& m : measurements) {
+    ceres::LossFunction* loss = nullptr;
+    if (options.loss == "huber") {
+      loss = new ceres::HuberLoss(options.loss_scale_mm);
+    } else if (options.loss == "cauchy") {
+      loss = new ceres::CauchyLoss(options.loss_scale_mm);
+    } else {
+      KINCAL_CHECK(options.loss == "none", "unknown loss " << options.loss);
+    }
+    problem.AddResidualBlock(TipResidual::Create(state->chain, m), loss,
+                             BlocksOf(state, m));
+  }
+  for (const PointDistance& d : options.distances) {
+    problem.AddResidualBlock(DistanceResidual::Create(d.distance_mm, d.weight),
+                             nullptr, state->points_in_base.at(d.a).data(),
+                             state->points_in_base.at(d.b).data());
+  }
+
+  // Which entries of each block are free.
+  std::map<double*, std::vector<bool>> free_mask;
+  for (const ParamInfo& p : options.free) {
+    double* address = ParamAddress(state, p);
+    double* block = address - p.index;
+    if (!problem.HasParameterBlock(block)) continue;  // not in this data
+    auto& mask = free_mask[block];
+    mask.resize(problem.ParameterBlockSize(block), false);
+    mask[p.index] = true;
+    summary.params.push_back(p);
+  }
+  std::vector<double*> blocks;
+  problem.GetParameterBlocks(&blocks);
+  for (double* block : blocks) {
+    auto it = free_mask.find(block);
+    if (it == free_mask.end()) {
+      problem.SetParameterBlockConstant(block);
+      continue;
+    }
+    std::vector<int> constant;
+    for (size_t k = 0; k < it->second.size(); ++k) {
+      if (!it->second[k]) constant.push_back(static_cast<int>(k));
+    }
+    if (!constant.empty()) {
+      problem.SetManifold(block, new ceres::SubsetManifold(
+                                     static_cast<int>(it->second.size()),
+                                     constant));
+    }
+  }
+  if (options.bounds_center != nullptr) {
+    const Chain& c = *options.bounds_center;
+    for (const ParamInfo& p : summary.params) {
+      if (p.kind != ParamKind::kRow) continue;
+      double* address = ParamAddress(state, p);
+      const double center = c.rows.at(p.block).p.at(p.index);
+      const double bound =
+          IsAngle(c, p) ? c.bound_angle_rad : c.bound_length_mm;
+      problem.SetParameterLowerBound(address - p.index, p.index, center - bound);
+      problem.SetParameterUpperBound(address - p.index, p.index, center + bound);
+      // Start inside the box.
+      *address = std::min(std::max(*address, center - bound), center + bound);
+    }
+  }
+
+  auto rms = [&]() {
+    double sum = 0.0;
+    summary.residual_mm.clear();
+    for (const Measurement& m : measurements) {
+      const double e = Residual(*state, m).norm();
+      summary.residual_mm.push_back(e);
+      sum += e * e;
+    }
+    return std::sqrt(sum / measurements.size());
+  };
+  summary.initial_rms_mm = rms();
+
+  if (!summary.params.empty()) {
+    ceres::Solver::Options solver;
+    solver.linear_solver_type = ceres::DENSE_QR;
+    solver.trust_region_strategy_type = ceres::LEVENBERG_MARQUARDT;
+    solver.max_num_iterations = options.max_iterations;
+    solver.function_tolerance = options.function_tolerance;
+    solver.parameter_tolerance = options.parameter_tolerance;
+    solver.gradient_tolerance = 1e-14;
+    solver.num_threads = options.num_threads;
+    solver.logging_type = ceres::SILENT;
+    ceres::Solver::Summary ceres_summary;
+    ceres::Solve(solver, &problem, &ceres_summary);
+    summary.converged = ceres_summary.IsSolutionUsable() &&
+                        ceres_summary.termination_type == ceres::CONVERGENCE;
+    summary.termination = ceres_summary.message;
+    summary.iterations = static_cast<int>(ceres_summary.iterations.size());
+  } else {
+    summary.converged = true;
+    summary.termination = "nothing to fit";
+  }
+  summary.final_rms_mm = rms();
+
+  const int num_params = static_cast<int>(summary.params.size());
+  const int dof = 3 * static_cast<int>(measurements.size()) - num_params;
+  double sum_sq = 0.0;
+  for (double e : summary.residual_mm) sum_sq += e * e;
+  summary.sigma0_mm = dof > 0 ? std::sqrt(sum_sq / dof) : 0.0;
+
+  summary.values.resize(num_params);
+  summary.sigmas.assign(num_params, std::numeric_limits<double>::quiet_NaN());
+  for (int i = 0; i < num_params; ++i) {
+    summary.values[i] =
+        summary.params[i].ToInterface(ParamValue(*state, summary.params[i]));
+  }
+  if (options.compute_covariance && num_params > 0 && dof > 0) {
+    ceres::Covariance::Options cov_options;
+    cov_options.algorithm_type = ceres::DENSE_SVD;
+    cov_options.null_space_rank = -1;
+    cov_options.min_reciprocal_condition_number = 1e-14;
+    ceres::Covariance covariance(cov_options);
+    std::vector<double*> free_blocks;
+    for (const auto& kv : free_mask) free_blocks.push_back(kv.first);
+    std::vector<std::pair<const double*, const double*>> pairs;
+    for (size_t a = 0; a < free_blocks.size(); ++a) {
+      for (size_t b = a; b < free_blocks.size(); ++b) {
+        pairs.emplace_back(free_blocks[a], free_blocks[b]);
+      }
+    }
+    if (covariance.Compute(pairs, &problem)) {
+      summary.covariance.setZero(num_params, num_params);
+      const double scale = summary.sigma0_mm * summary.sigma0_mm;
+      for (int i = 0; i < num_params; ++i) {
+        const ParamInfo& pi = summary.params[i];
+        double* bi = ParamAddress(state, pi) - pi.index;
+        const int si = problem.ParameterBlockSize(bi);
+        for (int j = 0; j < num_params; ++j) {
+          const ParamInfo& pj = summary.params[j];
+          double* bj = ParamAddress(state, pj) - pj.index;
+          const int sj = problem.ParameterBlockSize(bj);
+          std::vector<double> block(si * sj);
+          const bool ok = covariance.GetCovarianceBlock(bi, bj, block.data());
+          if (ok) {
+            summary.covariance(i, j) = scale * block[pi.index * sj + pj.index];
+          }
+        }
+      }
+      for (int i = 0; i < num_params; ++i) {
+        const double var = summary.covariance(i, i);
+        const double sigma_internal = var >= 0 ? std::sqrt(var) : NAN;
+        summary.sigmas[i] = summary.params[i].angle
+                                ? summary.params[i].ToInterface(sigma_internal)
+                                : sigma_internal;
+      }
+    }
+  }
+  summary.seconds = Seconds(start);
+  return summary;
+}
+
+Eigen::MatrixXd ResidualJacobian(const std::vector<Measurement>& measurements,
+                                 const ModelState& state,
+                                 const std::vector<ParamInfo>& params,
+                                 const std::vector<PointDistance>& distances) {
+  ModelState s = state;  // BlocksOf needs mutable pointers; values unchanged
+  Eigen::MatrixXd jac = Eigen::MatrixXd::Zero(
+      3 * measurements.size() + distances.size(), params.size());
+  for (size_t i = 0; i < measurements.size(); ++i) {
+    const Measurement& m = measurements[i];
+    std::unique_ptr<ceres::CostFunction> cost(TipResidual::Create(s.chain, m));
+    const std::vector<double*> blocks = BlocksOf(&s, m);
+    const auto& sizes = cost->parameter_block_sizes();
+    std::vector<std::vector<double>> jac_blocks(blocks.size());
+    std::vector<double*> jac_ptrs(blocks.size());
+    for (size_t b = 0; b < blocks.size(); ++b) {
+      jac_blocks[b].assign(3 * sizes[b], 0.0);
+      jac_ptrs[b] = jac_blocks[b].data();
+    }
+    double residual[3];
+    cost->Evaluate(blocks.data(), residual, jac_ptrs.data());
+    for (size_t c = 0; c < params.size(); ++c) {
+      const double* address = ParamAddress(&s, params[c]);
+      for (size_t b = 0; b < blocks.size(); ++b) {
+        if (address >= blocks[b] && address < blocks[b] + sizes[b]) {
+          const int k = static_cast<int>(address - blocks[b]);
+          for (int r = 0; r < 3; ++r) {
+            jac(3 * i + r, c) = jac_blocks[b][r * sizes[b] + k];
+          }
+        }
+      }
+    }
+  }
+  for (size_t i = 0; i < distances.size(); ++i) {
+    const PointDistance& d = distances[i];
+    std::unique_ptr<ceres::CostFunction> cost(
+        DistanceResidual::Create(d.distance_mm, d.weight));
+    double* blocks[2] = {s.points_in_base.at(d.a).data(),
+                         s.points_in_base.at(d.b).data()};
+    double ja[3], jb[3], residual;
+    double* jac_ptrs[2] = {ja, jb};
+    cost->Evaluate(blocks, &residual, jac_ptrs);
+    const int row = static_cast<int>(3 * measurements.size() + i);
+    for (size_t c = 0; c < params.size(); ++c) {
+      if (params[c].kind != ParamKind::kPoint) continue;
+      if (params[c].block == d.a) jac(row, c) += ja[params[c].index];
+      if (params[c].block == d.b) jac(row, c) += jb[params[c].index];
+    }
+  }
+  return jac;
+}
+
+void InitializeFrameAndPoints(const std::vector<Measurement>& measurements,
+                              ModelState* state) {
+  // Fixed points: centroid of the model's tips of each group.
+  std::vector<Eigen::Vector3d> sums(state->points_in_base.size(),
+                                    Eigen::Vector3d::Zero());
+  std::vector<int> counts(state->points_in_base.size(), 0);
+  std::vector<Eigen::Vector3d> src, dst;
+  for (const Measurement& m : measurements) {
+    const Eigen::Vector3d tip = TipInBase(state->chain, m.input);
+    if (m.kind == Measurement::kFixedPoint) {
+      sums[m.point] += tip;
+      counts[m.point] += 1;
+    } else {
+      src.push_back(tip);
+      dst.push_back(m.p_in_meas);
+    }
+  }
+  for (size_t i = 0; i < sums.size(); ++i) {
+    if (counts[i] > 0) {
+      const Eigen::Vector3d c = sums[i] / counts[i];
+      state->points_in_base[i] = {c.x(), c.y(), c.z()};
+    }
+  }
+  if (src.empty()) return;
+  Eigen::Matrix3Xd a(3, src.size()), b(3, dst.size());
+  for (size_t i = 0; i < src.size(); ++i) {
+    a.col(i) = src[i];
+    b.col(i) = dst[i];
+  }
+  const Eigen::Matrix3Xd centered = a.colwise() - a.rowwise().mean();
+  const Eigen::JacobiSVD<Eigen::Matrix3Xd> svd(centered);
+  if (src.size() < 3 || svd.singularValues()(1) < 1e-6 * svd.singularValues()(0)) {
+    throw InputError(
+        "the measured tip points are fewer than 3 or all on one line: the "
+        "base-to-measuring-frame transform cannot be determined");
+  }
+  const Eigen::Matrix4d meas_from_base = Eigen::umeyama(a, b, false);
+  const Eigen::AngleAxisd aa(Eigen::Matrix3d(meas_from_base.block<3, 3>(0, 0)));
+  const Eigen::Vector3d w = aa.axis() * aa.angle();
+  state->meas_from_base = {w.x(), w.y(), w.z(), meas_from_base(0, 3),
+                           meas_from_base(1, 3), meas_from_base(2, 3)};
+}
+
+ErrorStats ComputeErrorStats(const std::vector<double>& e) {
+  ErrorStats s;
+  s.n = static_cast<int>(e.size());
+  if (e.empty()) return s;
+  double sum = 0, sum_sq = 0;
+  for (double v : e) {
+    sum += v;
+    sum_sq += v * v;
+    s.max_mm = std::max(s.max_mm, v);
+  }
+  s.mean_mm = sum / s.n;
+  s.rms_mm = std::sqrt(sum_sq / s.n);
+  double var = 0;
+  for (double v : e) var += (v - s.mean_mm) * (v - s.mean_mm);
+  s.std_mm = std::sqrt(var / s.n);
+  return s;
+}
+
+}  // namespace kincal

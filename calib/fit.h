@@ -1,0 +1,112 @@
+#ifndef KINCAL_CALIB_FIT_H_
+#define KINCAL_CALIB_FIT_H_
+
+// Least-squares fit of robot parameters, measuring frame and fixed points to
+// measured tip positions (Ceres Levenberg-Marquardt, autodiff through the
+// templated chain). Options, what is variable, and the Summary are kept apart
+// (as Ceres' Solver::Options / Summary).
+
+#include <Eigen/Core>
+#include <string>
+#include <vector>
+
+#include "calib/chain.h"
+#include "calib/model_state.h"
+#include "data/observations.h"
+
+namespace kincal {
+
+// One usable observation row.
+struct Measurement {
+  enum Kind { kMeasured, kFixedPoint };
+  int row = 0;  // index in Observations::rows
+  Kind kind = kMeasured;
+  PoseInput input;
+  Eigen::Vector3d p_in_meas = Eigen::Vector3d::Zero();  // kMeasured
+  int point = -1;  // kFixedPoint: index into ModelState::points_in_base
+};
+
+// Rows with x,y,z become kMeasured; rows with only a fixed_point label become
+// kFixedPoint (adding the label to state->point_labels); other rows are
+// skipped but still count for the approach directions. Pose inputs (s, tau)
+// use `nominal`'s geometry.
+std::vector<Measurement> MakeMeasurements(const Chain& nominal,
+                                          const Observations& obs,
+                                          ModelState* state);
+
+// The model's residual of one measurement (mm), 3 numbers:
+//   kMeasured:   meas_from_base * tip_in_base(q) - p_in_meas
+//   kFixedPoint: tip_in_base(q) - point_in_base
+Eigen::Vector3d Residual(const ModelState& state, const Measurement& m);
+
+// A known distance between two fixed points, as an extra residual
+// weight * (|point_a - point_b| - distance_mm).
+struct PointDistance {
+  int a = 0, b = 0;  // indices into ModelState::points_in_base
+  double distance_mm = 0.0;
+  double weight = 1.0;
+};
+
+struct FitOptions {
+  std::vector<PointDistance> distances;
+  // Parameters the fit may change; every other one is held at its value.
+  std::vector<ParamInfo> free;
+  // When set, free geometry parameters stay within +-bound (chain's
+  // bound_length_mm / bound_angle_rad) of this chain's values (the seed's
+  // |x - t0| <= delta).
+  const Chain* bounds_center = nullptr;
+  // Robust loss on the 3D residual: "none", "huber" or "cauchy", scale in mm.
+  std::string loss = "none";
+  double loss_scale_mm = 1.0;
+  int max_iterations = 200;
+  double function_tolerance = 1e-12;
+  double parameter_tolerance = 1e-12;
+  bool compute_covariance = true;
+  int num_threads = 1;
+};
+
+struct FitSummary {
+  bool converged = false;
+  std::string termination;  // Ceres' message
+  int iterations = 0;
+  double initial_rms_mm = 0.0;  // RMS of |residual| over measurements
+  double final_rms_mm = 0.0;
+  std::vector<double> residual_mm;  // |residual| per measurement
+  // Noise estimate per axis: sqrt(sum r^2 / (3 m - p)), mm.
+  double sigma0_mm = 0.0;
+  // Free parameters, their values and 1-sigma (interface units: mm, deg);
+  // sigma is NaN when the covariance could not be computed.
+  std::vector<ParamInfo> params;
+  std::vector<double> values;
+  std::vector<double> sigmas;
+  Eigen::MatrixXd covariance;  // internal units, order of `params`
+  double seconds = 0.0;
+};
+
+FitSummary Fit(const std::vector<Measurement>& measurements,
+               const FitOptions& options, ModelState* state);
+
+// Jacobian of all stacked residuals (3 per measurement, then one per
+// distance) with respect to `params` (internal units), evaluated at `state`,
+// by the same autodiff functors the fit uses.
+Eigen::MatrixXd ResidualJacobian(const std::vector<Measurement>& measurements,
+                                 const ModelState& state,
+                                 const std::vector<ParamInfo>& params,
+                                 const std::vector<PointDistance>& distances = {});
+
+// Registers the measuring frame only (robot held fixed): an Umeyama
+// (rigid, no scale) initial value from the model's tips, refined by Fit.
+// Needs >= 3 measured rows that are not collinear; throws InputError
+// otherwise. Fixed points, if any, are set to their groups' centroids first.
+void InitializeFrameAndPoints(const std::vector<Measurement>& measurements,
+                              ModelState* state);
+
+struct ErrorStats {
+  int n = 0;
+  double rms_mm = 0, mean_mm = 0, max_mm = 0, std_mm = 0;
+};
+ErrorStats ComputeErrorStats(const std::vector<double>& errors_mm);
+
+}  // namespace kincal
+
+#endif  // KINCAL_CALIB_FIT_H_

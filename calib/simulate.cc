@@ -1,0 +1,328 @@
+#include "calib/simulate.h"
+
+#include <ceres/jet.h>
+
+#include <Eigen/Geometry>
+#include <cmath>
+#include <random>
+#include <sstream>
+
+#include "calib/model_state.h"
+#include "data/csv.h"
+#include "data/error.h"
+
+namespace kincal {
+namespace {
+
+constexpr double kDegToRad = M_PI / 180.0;
+constexpr int kMaxJoints = 16;
+using Jet = ceres::Jet<double, kMaxJoints>;
+
+// Joint limits in internal units; defaults when the robot file has none.
+void Limits(const Robot& robot, const Chain& chain, std::vector<double>* lo,
+            std::vector<double>* hi) {
+  for (int j = 0; j < chain.num_joints(); ++j) {
+    const RobotRow& r = robot.joints[j];
+    double l = r.type == JointType::kPrismatic ? 0.0 : -170.0;
+    double h = r.type == JointType::kPrismatic ? 200.0 : 170.0;
+    if (r.HasLimits()) {
+      l = r.lower;
+      h = r.upper;
+    }
+    lo->push_back(chain.ReadingToInternal(j, l));
+    hi->push_back(chain.ReadingToInternal(j, h));
+  }
+}
+
+Vec3<Jet> TipJet(const Chain& chain, const PoseInput& in, const Jet* q_read) {
+  const int n = chain.num_joints();
+  std::vector<std::array<Jet, kRowBlockSize>> rows(chain.rows.size());
+  std::vector<const Jet*> row_ptrs;
+  for (size_t r = 0; r < chain.rows.size(); ++r) {
+    for (int k = 0; k < kRowBlockSize; ++k) rows[r][k] = Jet(chain.rows[r].p[k]);
+    row_ptrs.push_back(rows[r].data());
+  }
+  Jet q[kMaxJoints];
+  for (int j = 0; j < n; ++j) {
+    const JointErrorBlock& e = chain.joint_errors[j];
+    q[j] = (1.0 + e[kGain]) * q_read[j] - Jet(0.5 * in.s[j] * e[kBacklash]) +
+           Jet(e[kCompliance] * in.tau[j]);
+    if (chain.rows[j].type == JointType::kRevolute) {
+      q[j] += e[kCyclicCos] * cos(q_read[j]) + e[kCyclicSin] * sin(q_read[j]);
+    }
+  }
+  Vec3<Jet> p = TipPosition<Jet>(chain, row_ptrs.data(), q);
+  for (int k = 0; k < 3; ++k) p[k] += Jet(chain.drift[k] * in.t_h);
+  return p;
+}
+
+}  // namespace
+
+bool SolvePositionIk(const Chain& chain, const Eigen::Vector3d& target,
+                     const std::vector<double>& lower,
+                     const std::vector<double>& upper, PoseInput* in,
+                     double tolerance_mm) {
+  const int n = chain.num_joints();
+  KINCAL_CHECK(n <= kMaxJoints, "too many joints for IK: " << n);
+  double lambda = 1e-3;
+  auto eval = [&](const std::vector<double>& q, Eigen::Vector3d* r,
+                  Eigen::MatrixXd* jac) {
+    Jet qj[kMaxJoints];
+    for (int j = 0; j < n; ++j) qj[j] = Jet(q[j], j);
+    const Vec3<Jet> p = TipJet(chain, *in, qj);
+    jac->resize(3, n);
+    for (int k = 0; k < 3; ++k) {
+      (*r)[k] = p[k].a - target[k];
+      for (int j = 0; j < n; ++j) (*jac)(k, j) = p[k].v[j];
+    }
+  };
+  std::vector<double> q = in->q;
+  Eigen::Vector3d r;
+  Eigen::MatrixXd jac;
+  eval(q, &r, &jac);
+  for (int it = 0; it < 200 && r.norm() > tolerance_mm; ++it) {
+    // Scale prismatic and revolute columns alike (LM on J^T J + lambda I).
+    const Eigen::MatrixXd jtj = jac.transpose() * jac;
+    const Eigen::VectorXd g = jac.transpose() * r;
+    Eigen::MatrixXd a = jtj;
+    a.diagonal().array() += lambda * (1.0 + jtj.diagonal().array());
+    const Eigen::VectorXd step = a.ldlt().solve(-g);
+    std::vector<double> trial = q;
+    for (int j = 0; j < n; ++j) trial[j] += step[j];
+    Eigen::Vector3d r2;
+    Eigen::MatrixXd jac2;
+    eval(trial, &r2, &jac2);
+    if (r2.norm() < r.norm()) {
+      q = trial;
+      r = r2;
+      jac = jac2;
+      lambda = std::max(lambda * 0.3, 1e-12);
+    } else {
+      lambda *= 10.0;
+      if (lambda > 1e12) break;
+    }
+  }
+  if (r.norm() > tolerance_mm) return false;
+  for (int j = 0; j < n; ++j) {
+    if (!lower.empty() && (q[j] < lower[j] || q[j] > upper[j])) return false;
+  }
+  in->q = q;
+  return true;
+}
+
+Effect ParseEffect(const std::string& text, const Robot& robot) {
+  std::vector<std::string> parts;
+  std::stringstream ss(text);
+  for (std::string p; std::getline(ss, p, ':');) parts.push_back(p);
+  Effect e;
+  double value = 0;
+  const std::string usage =
+      "--effect '" + text +
+      "': expected cause:joint:magnitude (backlash, compliance, cyclic, gain, "
+      "axis_tilt) or drift:magnitude";
+  if (parts.size() == 2 && parts[0] == "drift" &&
+      ParseFiniteDouble(parts[1], &value)) {
+    e.cause = "drift";
+    e.magnitude = value;
+    return e;
+  }
+  if (parts.size() != 3 || !ParseFiniteDouble(parts[2], &value)) {
+    throw InputError(usage);
+  }
+  e.cause = parts[0];
+  e.joint = parts[1];
+  e.magnitude = value;
+  if (e.cause != "backlash" && e.cause != "compliance" && e.cause != "cyclic" &&
+      e.cause != "gain" && e.cause != "axis_tilt") {
+    throw InputError(usage);
+  }
+  const int j = robot.JointIndex(e.joint);
+  if (j < 0) throw InputError(usage + ": no joint named '" + e.joint + "'");
+  if (e.cause == "cyclic" && robot.joints[j].type != JointType::kRevolute) {
+    throw InputError(usage + ": cyclic applies to revolute joints");
+  }
+  if (e.cause == "axis_tilt") {
+    const Chain c = Chain::FromRobot(robot);
+    bool ok = false;
+    for (int r : ParallelAxisRows(c)) ok = ok || r == j - 1;
+    if (!ok) {
+      throw InputError(usage + ": axis_tilt needs joint '" + e.joint +
+                       "' to be nominally parallel to the joint before it");
+    }
+  }
+  return e;
+}
+
+SimulatedSession Simulate(const Robot& nominal, const SimulateOptions& opt) {
+  Require(opt.noise_mm >= 0, "noise must be >= 0");
+  std::mt19937_64 rng(opt.seed);
+  std::normal_distribution<double> normal(0.0, 1.0);
+  std::uniform_real_distribution<double> uniform(0.0, 1.0);
+
+  SimulatedSession out;
+  out.nominal = nominal;
+  out.effects = opt.effects;
+  const Chain nominal_chain = Chain::FromRobot(nominal);
+  Chain truth = nominal_chain;
+  truth.joint_errors.assign(truth.num_joints(), JointErrorBlock{});
+  truth.drift = {0, 0, 0};
+  for (const ParamInfo& p : GeometryParams(truth)) {
+    const double sigma =
+        (p.kind == ParamKind::kRow &&
+         (truth.convention == Convention::kUrdf ? p.index >= 3
+                                                : (p.index == 0 || p.index == 3)))
+            ? opt.sigma_angle_deg * kDegToRad
+            : opt.sigma_length_mm;
+    truth.rows[p.block].p[p.index] += sigma * normal(rng);
+  }
+  // Measuring frame: random rotation, origin at frame_distance.
+  Eigen::Vector3d axis(normal(rng), normal(rng), normal(rng));
+  axis.normalize();
+  const double angle = M_PI * (0.2 + 0.6 * uniform(rng));
+  Eigen::Vector3d dir(normal(rng), normal(rng), normal(rng));
+  dir = dir.normalized() * opt.frame_distance_mm;
+  out.meas_from_base = {axis.x() * angle, axis.y() * angle, axis.z() * angle,
+                        dir.x(), dir.y(), dir.z()};
+
+  std::vector<double> lo, hi;
+  Limits(nominal, nominal_chain, &lo, &hi);
+  const int n = nominal_chain.num_joints();
+  auto random_q = [&](double shrink) {
+    std::vector<double> q(n);
+    for (int j = 0; j < n; ++j) {
+      const double mid = 0.5 * (lo[j] + hi[j]), half = 0.5 * (hi[j] - lo[j]);
+      q[j] = mid + half * shrink * (2.0 * uniform(rng) - 1.0);
+    }
+    return q;
+  };
+
+  // Poses (readings, internal units) and, for fixed points, their targets.
+  std::vector<std::vector<double>> poses;
+  std::vector<int> point_of_pose;
+  std::vector<Eigen::Vector3d> point_targets;
+  if (opt.mode == SimulateOptions::kRandom) {
+    Require(opt.poses >= 1, "--poses must be >= 1");
+    for (int i = 0; i < opt.poses; ++i) {
+      poses.push_back(random_q(1.0));
+      point_of_pose.push_back(-1);
+    }
+  } else {
+    Require(opt.fixed_points >= 1 && opt.poses_per_point >= 1,
+            "--fixed-points and --poses-per-point must be >= 1");
+    PoseInput in;
+    in.s.assign(n, 0.0);
+    in.tau.assign(n, 0.0);
+    for (int k = 0; k < opt.fixed_points; ++k) {
+      in.q = random_q(0.6);
+      const Eigen::Vector3d point = TipInBase(truth, in);
+      point_targets.push_back(point);
+      int made = 0;
+      for (int attempt = 0; made < opt.poses_per_point && attempt < 200 * opt.poses_per_point;
+           ++attempt) {
+        in.q = random_q(1.0);
+        if (SolvePositionIk(truth, point, lo, hi, &in)) {
+          poses.push_back(in.q);
+          point_of_pose.push_back(k);
+          ++made;
+        }
+      }
+      if (made < opt.poses_per_point) {
+        throw InputError("could not find " + std::to_string(opt.poses_per_point) +
+                         " poses reaching fixed point " + std::to_string(k) +
+                         " within the joint limits (found " +
+                         std::to_string(made) + ")");
+      }
+    }
+  }
+
+  // Observations (readings in file units) in visit order.
+  Observations& obs = out.observations;
+  obs.source = "simulated";
+  obs.joint_names = nominal.JointNames();
+  for (size_t i = 0; i < poses.size(); ++i) {
+    Observation o;
+    o.pose = std::to_string(i);
+    for (int j = 0; j < n; ++j) {
+      o.q.push_back(nominal_chain.InternalToReading(j, poses[i][j]));
+    }
+    if (point_of_pose[i] >= 0) o.fixed_point = "p" + std::to_string(point_of_pose[i]);
+    if (opt.seconds_per_pose > 0) o.t_s = opt.seconds_per_pose * i;
+    obs.rows.push_back(o);
+  }
+
+  // Effects on the true chain.
+  std::vector<PoseInput> inputs = MakePoseInputs(nominal_chain, obs);
+  for (const Effect& e : opt.effects) {
+    std::ostringstream note;
+    if (e.cause == "drift") {
+      Eigen::Vector3d v(normal(rng), normal(rng), normal(rng));
+      v = v.normalized() * e.magnitude;
+      truth.drift = {v.x(), v.y(), v.z()};
+      note << "drift v = [" << v.x() << ", " << v.y() << ", " << v.z() << "] mm/h";
+      out.effect_notes.push_back(note.str());
+      continue;
+    }
+    const int j = nominal.JointIndex(e.joint);
+    const double unit =
+        nominal.joints[j].type == JointType::kRevolute ? kDegToRad : 1.0;
+    JointErrorBlock& err = truth.joint_errors[j];
+    if (e.cause == "backlash") {
+      err[kBacklash] = e.magnitude * unit;
+    } else if (e.cause == "gain") {
+      err[kGain] = e.magnitude;
+    } else if (e.cause == "cyclic") {
+      const double phase = 2 * M_PI * uniform(rng);
+      err[kCyclicCos] = e.magnitude * unit * std::cos(phase);
+      err[kCyclicSin] = e.magnitude * unit * std::sin(phase);
+      note << "phase " << phase / kDegToRad << " deg";
+    } else if (e.cause == "compliance") {
+      double max_tau = 0;
+      for (const auto& in : inputs) max_tau = std::max(max_tau, std::abs(in.tau[j]));
+      Require(max_tau > 1e-9, "compliance on joint '" + e.joint +
+                                  "': gravity has no torque about it in these poses");
+      err[kCompliance] = e.magnitude * unit / max_tau;
+      note << "per_torque " << err[kCompliance] / unit << " (max |tau| "
+           << max_tau << ")";
+    } else if (e.cause == "axis_tilt") {
+      truth.rows[j - 1].p[4] += e.magnitude * kDegToRad;
+      note << "beta on row " << truth.rows[j - 1].name;
+    }
+    out.effect_notes.push_back(note.str());
+  }
+
+  // Fixed points: re-solve readings so the true tip (with effects) is on the
+  // point plus placement noise; s and tau follow the readings.
+  if (opt.mode == SimulateOptions::kFixedPoint) {
+    for (int pass = 0; pass < 2; ++pass) {
+      for (size_t i = 0; i < poses.size(); ++i) {
+        Eigen::Vector3d target = point_targets[point_of_pose[i]];
+        if (pass == 1) {
+          for (int k = 0; k < 3; ++k) target[k] += opt.noise_mm * normal(rng);
+        }
+        PoseInput in = inputs[i];
+        if (SolvePositionIk(truth, target, {}, {}, &in)) {
+          for (int j = 0; j < n; ++j) {
+            obs.rows[i].q[j] = nominal_chain.InternalToReading(j, in.q[j]);
+          }
+        }
+      }
+      inputs = MakePoseInputs(nominal_chain, obs);
+    }
+  }
+
+  const bool measure =
+      opt.mode == SimulateOptions::kRandom || opt.measure_points;
+  if (measure) {
+    for (size_t i = 0; i < obs.rows.size(); ++i) {
+      const Eigen::Vector3d tip = TipInBase(truth, inputs[i]);
+      Eigen::Vector3d p = ApplyFrame(out.meas_from_base.data(), Vec3<double>(tip));
+      for (int k = 0; k < 3; ++k) p[k] += opt.noise_mm * normal(rng);
+      obs.rows[i].has_point = true;
+      obs.rows[i].p_in_meas = p;
+    }
+  }
+  out.truth = truth.ToRobot(nominal);
+  return out;
+}
+
+}  // namespace kincal

@@ -1,0 +1,77 @@
+#ifndef KINCAL_CALIB_SIMULATE_H_
+#define KINCAL_CALIB_SIMULATE_H_
+
+// Seeded synthetic sessions for any robot: the true robot is the nominal one
+// plus random geometric deviations and optional injected effects from the
+// spec's catalogue; poses are random within joint limits or single-point
+// groups (the tip held at a fixed point with varying needle orientation, by
+// inverse kinematics); measured tip points are given in an unknown measuring
+// frame with Gaussian noise.
+
+#include <array>
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "calib/chain.h"
+#include "data/observations.h"
+#include "data/robot.h"
+
+namespace kincal {
+
+// An injected effect, magnitude in the spec's units:
+//   backlash (deg|mm, full width), compliance (deg at the largest |torque| of
+//   the poses), cyclic (deg amplitude, random phase), gain (1), axis_tilt
+//   (deg, Hayati beta of the row before `joint`), drift (mm per hour, random
+//   direction).
+struct Effect {
+  std::string cause;
+  std::string joint;  // empty for drift
+  double magnitude = 0.0;
+};
+
+// Parses "cause:joint:magnitude" (or "drift:magnitude"); InputError if bad.
+Effect ParseEffect(const std::string& text, const Robot& robot);
+
+struct SimulateOptions {
+  enum Mode { kRandom, kFixedPoint };
+  Mode mode = kRandom;
+  int poses = 240;            // kRandom: number of poses
+  int fixed_points = 1;       // kFixedPoint: number of points
+  int poses_per_point = 30;   // kFixedPoint: poses per point
+  bool measure_points = true; // write x,y,z (kFixedPoint may omit them)
+  double noise_mm = 0.03;     // per axis, measured points / tip placement
+  double sigma_length_mm = 0.5;  // true deviations of geometric parameters
+  double sigma_angle_deg = 0.2;
+  double frame_distance_mm = 1000.0;  // measuring frame origin from the base
+  double seconds_per_pose = 20.0;     // time column t (0 = no t column)
+  std::vector<Effect> effects;
+  uint64_t seed = 1;
+};
+
+struct SimulatedSession {
+  Robot nominal;
+  Robot truth;  // true geometry; injected effects as extensions / beta
+  std::array<double, 6> meas_from_base{};  // true frame, [rad..., mm...]
+  Observations observations;
+  std::vector<Effect> effects;  // as injected (magnitudes in spec units)
+  // Per effect, the model parameters chosen (e.g. compliance per torque).
+  std::vector<std::string> effect_notes;
+};
+
+SimulatedSession Simulate(const Robot& nominal, const SimulateOptions& options);
+
+// Inverse kinematics for position only: joint values (internal units) that
+// put the tip of `chain` (with its error models, for pose input `in`) at
+// `target_in_base`, starting from `q_start`; Levenberg-Marquardt with
+// autodiff. Returns false when it does not converge below `tolerance_mm` or
+// leaves the limits (if given, internal units).
+bool SolvePositionIk(const Chain& chain, const Eigen::Vector3d& target_in_base,
+                     const std::vector<double>& lower,
+                     const std::vector<double>& upper, PoseInput* in,
+                     double tolerance_mm = 1e-9);
+
+}  // namespace kincal
+
+#endif  // KINCAL_CALIB_SIMULATE_H_
