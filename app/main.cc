@@ -32,6 +32,7 @@ int main(int argc, char** argv) {
   kincal::app::AddDiagnoseCommand(app, &run);
   kincal::app::AddCamcalCommand(app, &run);
   kincal::app::AddTrackCommand(app, &run);
+  kincal::app::AddImportCommand(app, &run);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
