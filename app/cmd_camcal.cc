@@ -1,17 +1,293 @@
+// kincal camcal: intrinsics (and stereo extrinsics) from images of a
+// chessboard or an AprilGrid; writes rig.yaml. A thin layer over
+// vision/calib_target.h (detection) and camcal/calibrate_cameras.h.
+
+#include <glob.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <memory>
+#include <opencv2/imgcodecs.hpp>
+#include <string>
+#include <vector>
+
 #include "app/command.h"
+#include "camcal/calibrate_cameras.h"
+#include "camcal/rig.h"
+#include "data/error.h"
+#include "vision/calib_target.h"
 
 namespace kincal::app {
+namespace {
 
-// Not built yet: registers the subcommand so usage is stable; exits 1.
+struct CamcalArgs {
+  std::string left, right, target, out;
+  int distortion = 5;
+  std::string loss = "huber";
+  double loss_scale_px = 3.0;
+  bool json = false;
+};
+
+// Files matching `pattern`, sorted by name; InputError when there are none.
+std::vector<std::string> Glob(const std::string& pattern, const char* option) {
+  glob_t g{};
+  const int rc = ::glob(pattern.c_str(), 0, nullptr, &g);
+  std::vector<std::string> files;
+  if (rc == 0) {
+    for (size_t i = 0; i < g.gl_pathc; ++i) files.emplace_back(g.gl_pathv[i]);
+  }
+  ::globfree(&g);
+  if (files.empty()) {
+    throw InputError(std::string(option) + " '" + pattern +
+                     "': no files match");
+  }
+  std::sort(files.begin(), files.end());
+  return files;
+}
+
+cv::Mat ReadGray(const std::string& path) {
+  cv::Mat img = cv::imread(path, cv::IMREAD_GRAYSCALE);
+  if (img.empty()) {
+    throw InputError(path +
+                     ": cannot read the image (missing, not an image, "
+                     "or an unsupported format)");
+  }
+  return img;
+}
+
+nlohmann::json Nullable(double v) {
+  return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr);
+}
+
+nlohmann::json PoseJson(const Rigid3& pose) {
+  std::vector<double> r;
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 3; ++j) r.push_back(pose.R(i, j));
+  }
+  return {{"R", r}, {"t", {pose.t.x(), pose.t.y(), pose.t.z()}}};
+}
+
+int RunCamcal(const CamcalArgs& args) {
+  // Everything that can be checked before reading images comes first.
+  const CalibTargetSpec spec = ParseCalibTargetSpec(args.target);
+  CalibrationOptions options;
+  options.num_distortion = args.distortion;
+  options.loss_scale_px = args.loss_scale_px;
+  if (args.loss == "huber") {
+    options.loss = CalibrationOptions::Loss::kHuber;
+  } else if (args.loss == "cauchy") {
+    options.loss = CalibrationOptions::Loss::kCauchy;
+  } else if (args.loss == "none") {
+    options.loss = CalibrationOptions::Loss::kTrivial;
+  } else {
+    throw InputError("--loss '" + args.loss +
+                     "': expected huber, cauchy or none");
+  }
+  options.Check();
+
+  std::vector<std::vector<std::string>> files;
+  files.push_back(Glob(args.left, "--left"));
+  if (!args.right.empty()) {
+    files.push_back(Glob(args.right, "--right"));
+    if (files[1].size() != files[0].size()) {
+      throw InputError("--left matches " + std::to_string(files[0].size()) +
+                       " images but --right matches " +
+                       std::to_string(files[1].size()) +
+                       "; stereo images are paired in name order");
+    }
+  }
+  const size_t nc = files.size();
+  const size_t nv = files[0].size();
+
+  CalibrationProblem problem;
+  for (size_t c = 0; c < nc; ++c) {
+    problem.cameras.push_back(
+        {c == 0 ? "left" : "right", 0, 0, 0, 0, 0, 0, {}});
+  }
+  CalibTargetDetector detector(spec);
+  std::vector<int> found(nc, 0);
+  for (size_t v = 0; v < nv; ++v) {
+    CalibrationView view;
+    view.label = files[0][v];
+    for (size_t c = 0; c < nc; ++c) {
+      const cv::Mat img = ReadGray(files[c][v]);
+      CameraIntrinsics& cam = problem.cameras[c];
+      if (cam.width == 0) {
+        cam.width = img.cols;
+        cam.height = img.rows;
+      } else if (img.cols != cam.width || img.rows != cam.height) {
+        throw InputError(
+            files[c][v] + ": image is " + std::to_string(img.cols) + "x" +
+            std::to_string(img.rows) + ", the camera's " + "other images are " +
+            std::to_string(cam.width) + "x" + std::to_string(cam.height));
+      }
+      view.observations.push_back(detector.Detect(img));
+      if (static_cast<int>(view.observations.back().pixels.size()) >=
+          options.min_points_per_view) {
+        ++found[c];
+      }
+    }
+    problem.views.push_back(std::move(view));
+  }
+  for (size_t c = 0; c < nc; ++c) {
+    if (found[c] < options.min_views) {
+      throw InputError(std::string(c == 0 ? "--left" : "--right") + " '" +
+                       (c == 0 ? args.left : args.right) + "': target " +
+                       spec.text + " found in " + std::to_string(found[c]) +
+                       " of " + std::to_string(nv) + " images; need at least " +
+                       std::to_string(options.min_views));
+    }
+  }
+
+  const CalibrationSummary sum = CalibrateCameras(problem, options);
+  WriteRigYaml(args.out, sum.rig);
+
+  if (args.json) {
+    nlohmann::json j;
+    j["rms_px"] = sum.rms_px;
+    j["baseline"] = sum.baseline;
+    j["baseline_sigma"] = Nullable(sum.baseline_sigma);
+    j["target"] = spec.text;
+    j["out"] = args.out;
+    j["views"] = nv;
+    j["termination"] = sum.termination;
+    j["converged"] = sum.converged;
+    j["iterations"] = sum.iterations;
+    j["residual_sigma_px"] = sum.residual_sigma_px;
+    j["seconds"] = sum.seconds;
+    if (!sum.covariance_note.empty())
+      j["covariance_note"] = sum.covariance_note;
+    nlohmann::json cams = nlohmann::json::array();
+    for (size_t c = 0; c < nc; ++c) {
+      const CameraCalibrationSummary& cs = sum.cameras[c];
+      const CameraIntrinsics& in = cs.intrinsics;
+      nlohmann::json cj = {
+          {"name", in.name},
+          {"width", in.width},
+          {"height", in.height},
+          {"fx", in.fx},
+          {"fy", in.fy},
+          {"cx", in.cx},
+          {"cy", in.cy},
+          {"distortion", in.distortion},
+          {"rms_px", cs.rms_px},
+          {"max_px", cs.max_px},
+          {"outliers", cs.outliers},
+          {"opencv_rms_px", cs.opencv_rms_px},
+          {"views_used", cs.num_views},
+          {"points", cs.num_points},
+          {"holdout_rms_px", Nullable(cs.holdout_rms_px)},
+          {"half_diff_rms_px", Nullable(cs.half_diff_rms_px)},
+          {"half_diff_max_px", Nullable(cs.half_diff_max_px)},
+          {"cam_from_rig", PoseJson(sum.rig.cameras[c].cam_from_rig)}};
+      if (!cs.sigma.empty()) {
+        cj["sigma"] = {
+            {"fx", cs.sigma[kFx]},
+            {"fy", cs.sigma[kFy]},
+            {"cx", cs.sigma[kCx]},
+            {"cy", cs.sigma[kCy]},
+            {"distortion", std::vector<double>(
+                               cs.sigma.begin() + kK1,
+                               cs.sigma.begin() + kK1 + in.distortion.size())}};
+      }
+      nlohmann::json per_view = nlohmann::json::array();
+      for (double r : cs.view_rms_px) per_view.push_back(Nullable(r));
+      cj["view_rms_px"] = per_view;
+      cams.push_back(cj);
+    }
+    j["cameras"] = cams;
+    if (nc == 2 && !sum.extrinsic_rotation_sigma_deg.empty()) {
+      j["extrinsics_sigma"] = {
+          {"rotation_deg", sum.extrinsic_rotation_sigma_deg},
+          {"translation", sum.extrinsic_translation_sigma}};
+    }
+    nlohmann::json images = nlohmann::json::array();
+    for (size_t v = 0; v < nv; ++v) {
+      nlohmann::json row;
+      for (size_t c = 0; c < nc; ++c) {
+        row[problem.cameras[c].name] = files[c][v];
+      }
+      images.push_back(row);
+    }
+    j["images"] = images;
+    PrintJson(j);
+    return 0;
+  }
+
+  std::printf("kincal camcal: %zu %s, target %s, %d distortion coefficients\n",
+              nv, nc == 2 ? "stereo pairs" : "images", spec.text.c_str(),
+              options.num_distortion);
+  std::printf("  Ceres: %s after %d iterations, %.2f s\n",
+              sum.termination.c_str(), sum.iterations, sum.seconds);
+  for (size_t c = 0; c < nc; ++c) {
+    const CameraCalibrationSummary& cs = sum.cameras[c];
+    const CameraIntrinsics& in = cs.intrinsics;
+    std::printf("  %s (%dx%d): fx %.3f fy %.3f cx %.3f cy %.3f",
+                in.name.c_str(), in.width, in.height, in.fx, in.fy, in.cx,
+                in.cy);
+    if (!cs.sigma.empty()) {
+      std::printf("  (sigma %.3f %.3f %.3f %.3f)", cs.sigma[kFx], cs.sigma[kFy],
+                  cs.sigma[kCx], cs.sigma[kCy]);
+    }
+    std::printf("\n    distortion:");
+    for (double d : in.distortion) std::printf(" %.6g", d);
+    std::printf(
+        "\n    %d views, %d points: RMS %.4f px (OpenCV %.4f), worst "
+        "%.3f px, %d outliers\n",
+        cs.num_views, cs.num_points, cs.rms_px, cs.opencv_rms_px, cs.max_px,
+        cs.outliers);
+    std::printf(
+        "    cross-validation: held-out RMS %.4f px, even/odd "
+        "projection difference RMS %.3f px (max %.3f)\n",
+        cs.holdout_rms_px, cs.half_diff_rms_px, cs.half_diff_max_px);
+    double worst = 0;
+    size_t worst_v = 0;
+    for (size_t v = 0; v < cs.view_rms_px.size(); ++v) {
+      if (std::isfinite(cs.view_rms_px[v]) && cs.view_rms_px[v] > worst) {
+        worst = cs.view_rms_px[v];
+        worst_v = v;
+      }
+    }
+    std::printf("    worst view: %s (RMS %.4f px)\n", files[c][worst_v].c_str(),
+                worst);
+  }
+  if (nc == 2) {
+    std::printf("  baseline %.4f +- %.4f (target units)\n", sum.baseline,
+                sum.baseline_sigma);
+  }
+  std::printf("  RMS %.4f px over all cameras; wrote %s\n", sum.rms_px,
+              args.out.c_str());
+  return 0;
+}
+
+}  // namespace
+
 void AddCamcalCommand(CLI::App& app, Runner* run) {
-  CLI::App* sub = app.add_subcommand("camcal", "(not implemented yet)");
-  sub->allow_extras();
-  sub->callback([run] {
-    *run = [] {
-      std::fprintf(stderr, "kincal camcal: not implemented yet\n");
-      return 1;
-    };
-  });
+  auto args = std::make_shared<CamcalArgs>();
+  CLI::App* sub = app.add_subcommand(
+      "camcal",
+      "Calibrate one camera or a stereo pair from images of a chessboard or "
+      "an AprilGrid; writes rig.yaml");
+  sub->add_option("--left", args->left,
+                  "images of the first (reference) camera, a quoted glob")
+      ->required();
+  sub->add_option("--right", args->right,
+                  "images of the second camera (paired with --left in name "
+                  "order); omit for one camera");
+  sub->add_option("--target", args->target,
+                  "chessboard:COLSxROWS:SQUARE (inner corners) or "
+                  "aprilgrid:COLSxROWS:TAG_SIZE:SPACING_RATIO; sizes in mm")
+      ->required();
+  sub->add_option("--out", args->out, "rig.yaml to write")->required();
+  sub->add_option("--distortion", args->distortion,
+                  "distortion coefficients: 0, 4, 5 (default) or 8");
+  sub->add_option("--loss", args->loss,
+                  "robust loss: huber (default), cauchy or none");
+  sub->add_option("--loss-scale", args->loss_scale_px,
+                  "robust loss scale, px (default 3)");
+  sub->add_flag("--json", args->json, "print one JSON object");
+  sub->callback([run, args] { *run = [args] { return RunCamcal(*args); }; });
 }
 
 }  // namespace kincal::app

@@ -1,0 +1,747 @@
+#include "camcal/calibrate_cameras.h"
+
+#include <ceres/ceres.h>
+#include <ceres/rotation.h>
+
+#include <chrono>
+#include <cmath>
+#include <memory>
+#include <opencv2/calib3d.hpp>
+#include <opencv2/core/eigen.hpp>
+#include <sstream>
+
+#include "data/error.h"
+
+namespace kincal {
+
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+// Reprojection error of a target point seen by the reference camera (whose
+// frame is the rig frame):
+//   residual = ProjectPoint(intrinsics, rig_from_target * p_in_target) - pixel
+// rig_from_target is a unit quaternion (Eigen order x, y, z, w) and a
+// translation in target units.
+class TargetReprojectionError {
+ public:
+  TargetReprojectionError(const Eigen::Vector3d& p_in_target,
+                          const Eigen::Vector2d& pixel)
+      : p_in_target_(p_in_target), pixel_(pixel) {}
+
+  template <typename T>
+  bool operator()(const T* intrinsics, const T* rig_from_target_q,
+                  const T* rig_from_target_t, T* residuals) const {
+    const Eigen::Map<const Eigen::Quaternion<T>> q(rig_from_target_q);
+    const Eigen::Map<const Eigen::Matrix<T, 3, 1>> t(rig_from_target_t);
+    const Eigen::Matrix<T, 3, 1> p_in_cam = q * p_in_target_.cast<T>() + t;
+    T pixel[2];
+    if (!ProjectPoint(intrinsics, p_in_cam.data(), pixel)) return false;
+    residuals[0] = pixel[0] - T(pixel_.x());
+    residuals[1] = pixel[1] - T(pixel_.y());
+    return true;
+  }
+
+  static ceres::CostFunction* Create(const Eigen::Vector3d& p_in_target,
+                                     const Eigen::Vector2d& pixel) {
+    return new ceres::AutoDiffCostFunction<TargetReprojectionError, 2,
+                                           kNumIntrinsics, 4, 3>(
+        new TargetReprojectionError(p_in_target, pixel));
+  }
+
+ private:
+  const Eigen::Vector3d p_in_target_;
+  const Eigen::Vector2d pixel_;
+};
+
+// Reprojection error of a target point seen by a non-reference camera:
+//   residual = ProjectPoint(intrinsics,
+//                 cam_from_rig * rig_from_target * p_in_target) - pixel
+class RigTargetReprojectionError {
+ public:
+  RigTargetReprojectionError(const Eigen::Vector3d& p_in_target,
+                             const Eigen::Vector2d& pixel)
+      : p_in_target_(p_in_target), pixel_(pixel) {}
+
+  template <typename T>
+  bool operator()(const T* intrinsics, const T* cam_from_rig_q,
+                  const T* cam_from_rig_t, const T* rig_from_target_q,
+                  const T* rig_from_target_t, T* residuals) const {
+    const Eigen::Map<const Eigen::Quaternion<T>> q_cr(cam_from_rig_q);
+    const Eigen::Map<const Eigen::Matrix<T, 3, 1>> t_cr(cam_from_rig_t);
+    const Eigen::Map<const Eigen::Quaternion<T>> q_rt(rig_from_target_q);
+    const Eigen::Map<const Eigen::Matrix<T, 3, 1>> t_rt(rig_from_target_t);
+    const Eigen::Matrix<T, 3, 1> p_in_rig =
+        q_rt * p_in_target_.cast<T>() + t_rt;
+    const Eigen::Matrix<T, 3, 1> p_in_cam = q_cr * p_in_rig + t_cr;
+    T pixel[2];
+    if (!ProjectPoint(intrinsics, p_in_cam.data(), pixel)) return false;
+    residuals[0] = pixel[0] - T(pixel_.x());
+    residuals[1] = pixel[1] - T(pixel_.y());
+    return true;
+  }
+
+  static ceres::CostFunction* Create(const Eigen::Vector3d& p_in_target,
+                                     const Eigen::Vector2d& pixel) {
+    return new ceres::AutoDiffCostFunction<RigTargetReprojectionError, 2,
+                                           kNumIntrinsics, 4, 3, 4, 3>(
+        new RigTargetReprojectionError(p_in_target, pixel));
+  }
+
+ private:
+  const Eigen::Vector3d p_in_target_;
+  const Eigen::Vector2d pixel_;
+};
+
+// A ray at infinity of one model, rotated, projected by another model:
+//   residual = ProjectPoint(intrinsics_b, R(rotation_aa) * ray_a) - pixel
+class RotatedRayError {
+ public:
+  RotatedRayError(const Eigen::Vector3d& ray_a, const Eigen::Vector2d& pixel,
+                  const std::array<double, kNumIntrinsics>& intrinsics_b)
+      : ray_a_(ray_a), pixel_(pixel), intrinsics_b_(intrinsics_b) {}
+
+  template <typename T>
+  bool operator()(const T* rotation_aa, T* residuals) const {
+    const T ray[3] = {T(ray_a_.x()), T(ray_a_.y()), T(ray_a_.z())};
+    T p_in_b[3];
+    ceres::AngleAxisRotatePoint(rotation_aa, ray, p_in_b);
+    T intrinsics[kNumIntrinsics];
+    for (int i = 0; i < kNumIntrinsics; ++i)
+      intrinsics[i] = T(intrinsics_b_[i]);
+    T pixel[2];
+    if (!ProjectPoint(intrinsics, p_in_b, pixel)) return false;
+    residuals[0] = pixel[0] - T(pixel_.x());
+    residuals[1] = pixel[1] - T(pixel_.y());
+    return true;
+  }
+
+  static ceres::CostFunction* Create(
+      const Eigen::Vector3d& ray_a, const Eigen::Vector2d& pixel,
+      const std::array<double, kNumIntrinsics>& intrinsics_b) {
+    return new ceres::AutoDiffCostFunction<RotatedRayError, 2, 3>(
+        new RotatedRayError(ray_a, pixel, intrinsics_b));
+  }
+
+ private:
+  const Eigen::Vector3d ray_a_;
+  const Eigen::Vector2d pixel_;
+  const std::array<double, kNumIntrinsics> intrinsics_b_;
+};
+
+// A pose as one Ceres quaternion block (x, y, z, w) and one translation block.
+struct PoseBlock {
+  std::array<double, 4> q{0, 0, 0, 1};
+  std::array<double, 3> t{0, 0, 0};
+
+  static PoseBlock From(const Rigid3& pose) {
+    PoseBlock b;
+    const Eigen::Quaterniond q(pose.R);
+    b.q = {q.x(), q.y(), q.z(), q.w()};
+    b.t = {pose.t.x(), pose.t.y(), pose.t.z()};
+    return b;
+  }
+  Rigid3 ToRigid3() const {
+    Rigid3 pose;
+    pose.R = Eigen::Quaterniond(q[3], q[0], q[1], q[2])
+                 .normalized()
+                 .toRotationMatrix();
+    pose.t = Eigen::Vector3d(t[0], t[1], t[2]);
+    return pose;
+  }
+};
+
+// Everything the refinement estimates.
+struct State {
+  std::vector<std::array<double, kNumIntrinsics>> intrinsics;  // per camera
+  std::vector<PoseBlock> cam_from_rig;     // per camera; [0] = identity
+  std::vector<PoseBlock> rig_from_target;  // per view
+  std::vector<bool> view_used;
+};
+
+bool UsableObservation(const TargetObservation& obs,
+                       const CalibrationOptions& options) {
+  return static_cast<int>(obs.pixels.size()) >= options.min_points_per_view;
+}
+
+std::unique_ptr<ceres::LossFunction> MakeLoss(
+    const CalibrationOptions& options) {
+  switch (options.loss) {
+    case CalibrationOptions::Loss::kHuber:
+      return std::make_unique<ceres::HuberLoss>(options.loss_scale_px);
+    case CalibrationOptions::Loss::kCauchy:
+      return std::make_unique<ceres::CauchyLoss>(options.loss_scale_px);
+    case CalibrationOptions::Loss::kTrivial:
+      break;
+  }
+  return nullptr;
+}
+
+Rigid3 FromRvecTvec(const cv::Vec3d& rvec, const cv::Vec3d& tvec) {
+  cv::Matx33d r;
+  cv::Rodrigues(rvec, r);
+  Rigid3 pose;
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 3; ++j) pose.R(i, j) = r(i, j);
+    pose.t(i) = tvec[i];
+  }
+  return pose;
+}
+
+cv::Mat DistortionMat(const CameraIntrinsics& cam) {
+  if (cam.distortion.empty()) return cv::Mat();
+  return cv::Mat(cam.distortion, true);
+}
+
+void ValidateProblem(const CalibrationProblem& problem,
+                     const CalibrationOptions& options) {
+  options.Check();
+  const size_t nc = problem.cameras.size();
+  Require(
+      nc == 1 || nc == 2,
+      "camera calibration: expected 1 or 2 cameras, got " + std::to_string(nc));
+  for (const CameraIntrinsics& cam : problem.cameras) {
+    Require(cam.width > 0 && cam.height > 0,
+            "camera calibration: camera '" + cam.name +
+                "' has no image size (" + std::to_string(cam.width) + "x" +
+                std::to_string(cam.height) + ")");
+  }
+  for (const CalibrationView& view : problem.views) {
+    KINCAL_CHECK(view.observations.size() == nc,
+                 "view " << view.label << " has " << view.observations.size()
+                         << " observations for " << nc << " cameras");
+    for (const TargetObservation& obs : view.observations) {
+      KINCAL_CHECK(obs.pixels.size() == obs.p_in_target.size(),
+                   "view " << view.label << ": " << obs.pixels.size()
+                           << " pixels for " << obs.p_in_target.size()
+                           << " target points");
+    }
+  }
+}
+
+// OpenCV initial values: cv::calibrateCamera per camera, the extrinsics as
+// the mean over the views both cameras see.
+State Initialize(const CalibrationProblem& problem,
+                 const CalibrationOptions& options,
+                 std::vector<double>* opencv_rms) {
+  const size_t nc = problem.cameras.size();
+  const size_t nv = problem.views.size();
+  State s;
+  s.intrinsics.resize(nc);
+  s.cam_from_rig.resize(nc);
+  s.rig_from_target.resize(nv);
+  s.view_used.assign(nv, false);
+  opencv_rms->assign(nc, kNaN);
+  // cam_from_target[c][v], valid where seen[c][v].
+  std::vector<std::vector<Rigid3>> cam_from_target(nc, std::vector<Rigid3>(nv));
+  std::vector<std::vector<bool>> seen(nc, std::vector<bool>(nv, false));
+
+  int flags = 0;
+  switch (options.num_distortion) {
+    case 0:
+      flags = cv::CALIB_FIX_K1 | cv::CALIB_FIX_K2 | cv::CALIB_FIX_K3 |
+              cv::CALIB_ZERO_TANGENT_DIST;
+      break;
+    case 4:
+      flags = cv::CALIB_FIX_K3;
+      break;
+    case 8:
+      flags = cv::CALIB_RATIONAL_MODEL;
+      break;
+    default:
+      break;
+  }
+  for (size_t c = 0; c < nc; ++c) {
+    const CameraIntrinsics& cam = problem.cameras[c];
+    std::vector<std::vector<cv::Point3f>> object_points;
+    std::vector<std::vector<cv::Point2f>> image_points;
+    std::vector<size_t> view_index;
+    for (size_t v = 0; v < nv; ++v) {
+      const TargetObservation& obs = problem.views[v].observations[c];
+      if (!UsableObservation(obs, options)) continue;
+      object_points.emplace_back();
+      image_points.emplace_back();
+      for (size_t i = 0; i < obs.pixels.size(); ++i) {
+        object_points.back().emplace_back(obs.p_in_target[i].x(),
+                                          obs.p_in_target[i].y(),
+                                          obs.p_in_target[i].z());
+        image_points.back().emplace_back(obs.pixels[i].x(), obs.pixels[i].y());
+      }
+      view_index.push_back(v);
+    }
+    if (static_cast<int>(view_index.size()) < options.min_views) {
+      throw InputError("camera '" + cam.name + "': the target was found in " +
+                       std::to_string(view_index.size()) +
+                       " views with at least " +
+                       std::to_string(options.min_points_per_view) +
+                       " points; calibration needs at least " +
+                       std::to_string(options.min_views));
+    }
+    cv::Mat K, dist;
+    std::vector<cv::Mat> rvecs, tvecs;
+    (*opencv_rms)[c] = cv::calibrateCamera(
+        object_points, image_points, cv::Size(cam.width, cam.height), K, dist,
+        rvecs, tvecs, flags,
+        cv::TermCriteria(cv::TermCriteria::COUNT + cv::TermCriteria::EPS, 100,
+                         1e-12));
+    std::array<double, kNumIntrinsics>& a = s.intrinsics[c];
+    a.fill(0.0);
+    a[kFx] = K.at<double>(0, 0);
+    a[kFy] = K.at<double>(1, 1);
+    a[kCx] = K.at<double>(0, 2);
+    a[kCy] = K.at<double>(1, 2);
+    for (int i = 0;
+         i < options.num_distortion && i < static_cast<int>(dist.total());
+         ++i) {
+      a[kK1 + i] = dist.at<double>(i);
+    }
+    for (size_t k = 0; k < view_index.size(); ++k) {
+      cam_from_target[c][view_index[k]] =
+          FromRvecTvec(cv::Vec3d(rvecs[k]), cv::Vec3d(tvecs[k]));
+      seen[c][view_index[k]] = true;
+    }
+  }
+
+  if (nc == 2) {
+    // cam1_from_rig = cam1_from_target * (cam0_from_target)^-1, averaged.
+    Eigen::Vector4d q_sum = Eigen::Vector4d::Zero();
+    Eigen::Vector3d t_sum = Eigen::Vector3d::Zero();
+    Eigen::Quaterniond q_ref = Eigen::Quaterniond::Identity();
+    int n = 0;
+    for (size_t v = 0; v < nv; ++v) {
+      if (!seen[0][v] || !seen[1][v]) continue;
+      const Rigid3 cam1_from_cam0 =
+          cam_from_target[1][v] * cam_from_target[0][v].Inverse();
+      Eigen::Quaterniond q(cam1_from_cam0.R);
+      if (n == 0) q_ref = q;
+      if (q.coeffs().dot(q_ref.coeffs()) < 0) q.coeffs() *= -1;
+      q_sum += q.coeffs();
+      t_sum += cam1_from_cam0.t;
+      ++n;
+    }
+    if (n == 0) {
+      throw InputError("cameras '" + problem.cameras[0].name + "' and '" +
+                       problem.cameras[1].name +
+                       "' never saw the target in the same view; stereo "
+                       "calibration needs views seen by both");
+    }
+    Rigid3 cam1_from_rig;
+    cam1_from_rig.R =
+        Eigen::Quaterniond(q_sum / n).normalized().toRotationMatrix();
+    cam1_from_rig.t = t_sum / n;
+    s.cam_from_rig[1] = PoseBlock::From(cam1_from_rig);
+  }
+  for (size_t v = 0; v < nv; ++v) {
+    if (seen[0][v]) {
+      s.rig_from_target[v] = PoseBlock::From(cam_from_target[0][v]);
+      s.view_used[v] = true;
+    } else if (nc == 2 && seen[1][v]) {
+      s.rig_from_target[v] = PoseBlock::From(
+          s.cam_from_rig[1].ToRigid3().Inverse() * cam_from_target[1][v]);
+      s.view_used[v] = true;
+    }
+  }
+  return s;
+}
+
+// Adds every usable observation of the used views to `problem`. Camera
+// blocks are held constant unless `refine_cameras`.
+int BuildProblem(const std::vector<CalibrationView>& views,
+                 const CalibrationOptions& options, bool refine_cameras,
+                 State* s, ceres::Problem* problem) {
+  const size_t nc = s->intrinsics.size();
+  int num_points = 0;
+  for (size_t v = 0; v < views.size(); ++v) {
+    if (!s->view_used[v]) continue;
+    PoseBlock& pose = s->rig_from_target[v];
+    for (size_t c = 0; c < nc; ++c) {
+      const TargetObservation& obs = views[v].observations[c];
+      if (!UsableObservation(obs, options)) continue;
+      for (size_t i = 0; i < obs.pixels.size(); ++i) {
+        if (c == 0) {
+          problem->AddResidualBlock(TargetReprojectionError::Create(
+                                        obs.p_in_target[i], obs.pixels[i]),
+                                    MakeLoss(options).release(),
+                                    s->intrinsics[c].data(), pose.q.data(),
+                                    pose.t.data());
+        } else {
+          problem->AddResidualBlock(
+              RigTargetReprojectionError::Create(obs.p_in_target[i],
+                                                 obs.pixels[i]),
+              MakeLoss(options).release(), s->intrinsics[c].data(),
+              s->cam_from_rig[c].q.data(), s->cam_from_rig[c].t.data(),
+              pose.q.data(), pose.t.data());
+        }
+        ++num_points;
+      }
+    }
+    problem->SetManifold(pose.q.data(), new ceres::EigenQuaternionManifold);
+  }
+  for (size_t c = 0; c < nc; ++c) {
+    double* intr = s->intrinsics[c].data();
+    if (!problem->HasParameterBlock(intr)) continue;
+    if (!refine_cameras) {
+      problem->SetParameterBlockConstant(intr);
+    } else {
+      // Coefficients beyond the model are fixed at 0.
+      std::vector<int> fixed;
+      for (int i = kK1 + options.num_distortion; i < kNumIntrinsics; ++i) {
+        fixed.push_back(i);
+      }
+      if (!fixed.empty()) {
+        problem->SetManifold(intr,
+                             new ceres::SubsetManifold(kNumIntrinsics, fixed));
+      }
+    }
+    if (c > 0) {
+      problem->SetManifold(s->cam_from_rig[c].q.data(),
+                           new ceres::EigenQuaternionManifold);
+      if (!refine_cameras) {
+        problem->SetParameterBlockConstant(s->cam_from_rig[c].q.data());
+        problem->SetParameterBlockConstant(s->cam_from_rig[c].t.data());
+      }
+    }
+  }
+  return num_points;
+}
+
+ceres::Solver::Options SolverOptions(const CalibrationOptions& options) {
+  ceres::Solver::Options solver;
+  solver.linear_solver_type = ceres::DENSE_SCHUR;
+  solver.max_num_iterations = options.max_iterations;
+  solver.function_tolerance = 1e-12;
+  solver.gradient_tolerance = 1e-12;
+  solver.parameter_tolerance = 1e-12;
+  solver.num_threads = 1;  // deterministic, and the machine is shared
+  solver.logging_type = ceres::SILENT;
+  return solver;
+}
+
+// Point residuals (pixel error norms) per camera and view.
+struct Residuals {
+  std::vector<std::vector<std::vector<double>>> norms;  // [c][v][point]
+};
+
+Residuals ComputeResiduals(const std::vector<CalibrationView>& views,
+                           const CalibrationOptions& options, const State& s) {
+  const size_t nc = s.intrinsics.size();
+  Residuals r;
+  r.norms.assign(nc, std::vector<std::vector<double>>(views.size()));
+  for (size_t v = 0; v < views.size(); ++v) {
+    if (!s.view_used[v]) continue;
+    const Rigid3 rig_from_target = s.rig_from_target[v].ToRigid3();
+    for (size_t c = 0; c < nc; ++c) {
+      const TargetObservation& obs = views[v].observations[c];
+      if (!UsableObservation(obs, options)) continue;
+      const Rigid3 cam_from_target =
+          s.cam_from_rig[c].ToRigid3() * rig_from_target;
+      for (size_t i = 0; i < obs.pixels.size(); ++i) {
+        const Eigen::Vector3d p_in_cam = cam_from_target * obs.p_in_target[i];
+        Eigen::Vector2d px;
+        double err = kNaN;
+        if (ProjectPoint(s.intrinsics[c].data(), p_in_cam.data(), px.data())) {
+          err = (px - obs.pixels[i]).norm();
+        }
+        r.norms[c][v].push_back(err);
+      }
+    }
+  }
+  return r;
+}
+
+double Rms(const std::vector<double>& values) {
+  if (values.empty()) return kNaN;
+  double ss = 0;
+  for (double x : values) ss += x * x;
+  return std::sqrt(ss / values.size());
+}
+
+// Fits only the view poses of `views` with the cameras of `rig` fixed;
+// returns per camera the sum of squared point errors and the count.
+void HeldOutSums(const Rig& rig, const std::vector<CalibrationView>& views,
+                 const CalibrationOptions& options, std::vector<double>* ss,
+                 std::vector<int>* count) {
+  const size_t nc = rig.cameras.size();
+  ss->assign(nc, 0.0);
+  count->assign(nc, 0);
+  for (const CalibrationView& view : views) {
+    // Initial pose: PnP in the first camera that saw the target.
+    State s;
+    s.view_used = {false};
+    s.rig_from_target.resize(1);
+    for (size_t c = 0; c < nc; ++c) {
+      s.intrinsics.push_back(rig.cameras[c].intrinsics.ToArray());
+      s.cam_from_rig.push_back(PoseBlock::From(rig.cameras[c].cam_from_rig));
+    }
+    for (size_t c = 0; c < nc && !s.view_used[0]; ++c) {
+      const TargetObservation& obs = view.observations[c];
+      if (!UsableObservation(obs, options)) continue;
+      std::vector<cv::Point3d> obj;
+      std::vector<cv::Point2d> img;
+      for (size_t i = 0; i < obs.pixels.size(); ++i) {
+        obj.emplace_back(obs.p_in_target[i].x(), obs.p_in_target[i].y(),
+                         obs.p_in_target[i].z());
+        img.emplace_back(obs.pixels[i].x(), obs.pixels[i].y());
+      }
+      cv::Mat K;
+      cv::eigen2cv(rig.cameras[c].intrinsics.K(), K);
+      cv::Vec3d rvec, tvec;
+      if (!cv::solvePnP(obj, img, K, DistortionMat(rig.cameras[c].intrinsics),
+                        rvec, tvec)) {
+        continue;
+      }
+      const Rigid3 cam_from_target = FromRvecTvec(rvec, tvec);
+      s.rig_from_target[0] = PoseBlock::From(
+          rig.cameras[c].cam_from_rig.Inverse() * cam_from_target);
+      s.view_used[0] = true;
+    }
+    if (!s.view_used[0]) continue;
+    const std::vector<CalibrationView> one = {view};
+    ceres::Problem problem;
+    BuildProblem(one, options, /*refine_cameras=*/false, &s, &problem);
+    ceres::Solver::Summary summary;
+    ceres::Solve(SolverOptions(options), &problem, &summary);
+    const Residuals r = ComputeResiduals(one, options, s);
+    for (size_t c = 0; c < nc; ++c) {
+      for (double e : r.norms[c][0]) {
+        if (std::isnan(e)) continue;
+        (*ss)[c] += e * e;
+        ++(*count)[c];
+      }
+    }
+  }
+}
+
+std::string TerminationName(ceres::TerminationType t) {
+  return ceres::TerminationTypeToString(t);
+}
+
+}  // namespace
+
+void CalibrationOptions::Check() const {
+  Require(num_distortion == 0 || num_distortion == 4 || num_distortion == 5 ||
+              num_distortion == 8,
+          "calibration: num_distortion must be 0, 4, 5 or 8, got " +
+              std::to_string(num_distortion));
+  Require(loss_scale_px > 0, "calibration: loss_scale_px must be > 0");
+  Require(min_points_per_view >= 4,
+          "calibration: min_points_per_view must be >= 4");
+  Require(min_views >= 2, "calibration: min_views must be >= 2");
+  Require(max_iterations > 0, "calibration: max_iterations must be > 0");
+}
+
+std::vector<double> HeldOutRmsPx(const Rig& rig,
+                                 const std::vector<CalibrationView>& views,
+                                 const CalibrationOptions& options) {
+  std::vector<double> ss;
+  std::vector<int> count;
+  HeldOutSums(rig, views, options, &ss, &count);
+  std::vector<double> rms(ss.size(), kNaN);
+  for (size_t c = 0; c < ss.size(); ++c) {
+    if (count[c] > 0) rms[c] = std::sqrt(ss[c] / count[c]);
+  }
+  return rms;
+}
+
+std::pair<double, double> ProjectionDifferencePx(const CameraIntrinsics& a,
+                                                 const CameraIntrinsics& b) {
+  const int nx = 32, ny = 24;
+  std::vector<Eigen::Vector3d> rays;
+  std::vector<Eigen::Vector2d> pixels;
+  for (int j = 0; j < ny; ++j) {
+    for (int i = 0; i < nx; ++i) {
+      const Eigen::Vector2d px((a.width - 1) * (i + 0.5) / nx,
+                               (a.height - 1) * (j + 0.5) / ny);
+      rays.push_back(Unproject(a, px));
+      pixels.push_back(px);
+    }
+  }
+  const std::array<double, kNumIntrinsics> intr_b = b.ToArray();
+  double rotation_aa[3] = {0, 0, 0};
+  ceres::Problem problem;
+  for (size_t k = 0; k < rays.size(); ++k) {
+    problem.AddResidualBlock(
+        RotatedRayError::Create(rays[k], pixels[k], intr_b), nullptr,
+        rotation_aa);
+  }
+  ceres::Solver::Options options;
+  options.linear_solver_type = ceres::DENSE_QR;
+  options.logging_type = ceres::SILENT;
+  ceres::Solver::Summary summary;
+  ceres::Solve(options, &problem, &summary);
+  double ss = 0, max = 0;
+  int n = 0;
+  for (size_t k = 0; k < rays.size(); ++k) {
+    Eigen::Vector3d p_in_b;
+    ceres::AngleAxisRotatePoint(rotation_aa, rays[k].data(), p_in_b.data());
+    const Eigen::Vector2d px = Project(b, p_in_b);
+    if (!px.allFinite()) continue;
+    const double e = (px - pixels[k]).norm();
+    ss += e * e;
+    max = std::max(max, e);
+    ++n;
+  }
+  return {n ? std::sqrt(ss / n) : kNaN, n ? max : kNaN};
+}
+
+CalibrationSummary CalibrateCameras(const CalibrationProblem& input,
+                                    const CalibrationOptions& options) {
+  const auto start = std::chrono::steady_clock::now();
+  ValidateProblem(input, options);
+  const size_t nc = input.cameras.size();
+  const size_t nv = input.views.size();
+
+  CalibrationSummary out;
+  std::vector<double> opencv_rms;
+  State s = Initialize(input, options, &opencv_rms);
+
+  ceres::Problem problem;
+  const int num_points = BuildProblem(input.views, options,
+                                      /*refine_cameras=*/true, &s, &problem);
+  ceres::Solver::Summary solver_summary;
+  ceres::Solve(SolverOptions(options), &problem, &solver_summary);
+  out.termination = TerminationName(solver_summary.termination_type);
+  out.converged = solver_summary.termination_type == ceres::CONVERGENCE;
+  out.iterations = static_cast<int>(solver_summary.iterations.size()) - 1;
+  out.initial_cost = solver_summary.initial_cost;
+  out.final_cost = solver_summary.final_cost;
+
+  // Rig and per-camera summaries.
+  const Residuals res = ComputeResiduals(input.views, options, s);
+  double ss_all = 0;
+  int n_all = 0;
+  for (size_t c = 0; c < nc; ++c) {
+    Camera cam;
+    cam.intrinsics = CameraIntrinsics::FromArray(s.intrinsics[c].data(),
+                                                 options.num_distortion);
+    cam.intrinsics.name = input.cameras[c].name;
+    cam.intrinsics.width = input.cameras[c].width;
+    cam.intrinsics.height = input.cameras[c].height;
+    cam.cam_from_rig = c == 0 ? Rigid3() : s.cam_from_rig[c].ToRigid3();
+    out.rig.cameras.push_back(cam);
+
+    CameraCalibrationSummary cs;
+    cs.intrinsics = cam.intrinsics;
+    cs.opencv_rms_px = opencv_rms[c];
+    std::vector<double> all;
+    for (size_t v = 0; v < nv; ++v) {
+      const std::vector<double>& e = res.norms[c][v];
+      cs.view_rms_px.push_back(Rms(e));
+      if (!e.empty()) ++cs.num_views;
+      all.insert(all.end(), e.begin(), e.end());
+    }
+    cs.num_points = static_cast<int>(all.size());
+    cs.rms_px = Rms(all);
+    for (double e : all) {
+      cs.max_px = std::max(cs.max_px, e);
+      ss_all += e * e;
+      ++n_all;
+    }
+    for (double e : all) {
+      if (e > options.outlier_factor * cs.rms_px) ++cs.outliers;
+    }
+    out.cameras.push_back(cs);
+  }
+  out.rms_px = n_all ? std::sqrt(ss_all / n_all) : kNaN;
+  out.baseline = out.rig.BaselineMm();
+  out.view_used = s.view_used;
+  for (size_t v = 0; v < nv; ++v) {
+    out.rig_from_target.push_back(s.rig_from_target[v].ToRigid3());
+  }
+
+  // Residual variance per coordinate: sum r^2 / (m - n).
+  int num_free = 0;
+  for (size_t v = 0; v < nv; ++v) num_free += s.view_used[v] ? 6 : 0;
+  num_free += static_cast<int>(nc) * (4 + options.num_distortion);
+  num_free += static_cast<int>(nc - 1) * 6;
+  const int dof = 2 * num_points - num_free;
+  const double variance = dof > 0 ? ss_all / dof : kNaN;
+  out.residual_sigma_px = std::sqrt(variance);
+
+  if (options.compute_covariance && dof > 0) {
+    ceres::Covariance::Options copt;
+    copt.algorithm_type = ceres::DENSE_SVD;
+    copt.num_threads = 1;
+    ceres::Covariance covariance(copt);
+    std::vector<std::pair<const double*, const double*>> blocks;
+    for (size_t c = 0; c < nc; ++c) {
+      blocks.emplace_back(s.intrinsics[c].data(), s.intrinsics[c].data());
+    }
+    if (nc == 2) {
+      blocks.emplace_back(s.cam_from_rig[1].q.data(),
+                          s.cam_from_rig[1].q.data());
+      blocks.emplace_back(s.cam_from_rig[1].t.data(),
+                          s.cam_from_rig[1].t.data());
+    }
+    if (covariance.Compute(blocks, &problem)) {
+      for (size_t c = 0; c < nc; ++c) {
+        Eigen::Matrix<double, kNumIntrinsics, kNumIntrinsics, Eigen::RowMajor>
+            cov;
+        covariance.GetCovarianceBlock(s.intrinsics[c].data(),
+                                      s.intrinsics[c].data(), cov.data());
+        for (int i = 0; i < kNumIntrinsics; ++i) {
+          out.cameras[c].sigma.push_back(
+              std::sqrt(std::max(0.0, cov(i, i) * variance)));
+        }
+      }
+      if (nc == 2) {
+        Eigen::Matrix<double, 3, 3, Eigen::RowMajor> cov_r, cov_t;
+        covariance.GetCovarianceBlockInTangentSpace(s.cam_from_rig[1].q.data(),
+                                                    s.cam_from_rig[1].q.data(),
+                                                    cov_r.data());
+        covariance.GetCovarianceBlock(s.cam_from_rig[1].t.data(),
+                                      s.cam_from_rig[1].t.data(), cov_t.data());
+        // EigenQuaternionManifold's tangent is half the rotation vector.
+        for (int i = 0; i < 3; ++i) {
+          out.extrinsic_rotation_sigma_deg.push_back(
+              2.0 * std::sqrt(std::max(0.0, cov_r(i, i) * variance)) * 180.0 /
+              M_PI);
+          out.extrinsic_translation_sigma.push_back(
+              std::sqrt(std::max(0.0, cov_t(i, i) * variance)));
+        }
+        // baseline = |t| (camera centre distance = |R^T t| = |t|).
+        const Eigen::Vector3d t(s.cam_from_rig[1].t.data());
+        const Eigen::Vector3d u = t.normalized();
+        out.baseline_sigma = std::sqrt(u.dot(cov_t * u) * variance);
+      }
+    } else {
+      out.covariance_note =
+          "covariance not available: the Jacobian is rank deficient (the "
+          "views do not determine every parameter)";
+    }
+  }
+
+  if (options.cross_validate) {
+    // Even and odd views.
+    CalibrationProblem half[2];
+    for (int h = 0; h < 2; ++h) half[h].cameras = input.cameras;
+    for (size_t v = 0; v < nv; ++v) half[v % 2].views.push_back(input.views[v]);
+    CalibrationOptions sub = options;
+    sub.cross_validate = false;
+    sub.compute_covariance = false;
+    try {
+      const CalibrationSummary a = CalibrateCameras(half[0], sub);
+      const CalibrationSummary b = CalibrateCameras(half[1], sub);
+      const std::vector<double> a_on_b =
+          HeldOutRmsPx(a.rig, half[1].views, sub);
+      const std::vector<double> b_on_a =
+          HeldOutRmsPx(b.rig, half[0].views, sub);
+      for (size_t c = 0; c < nc; ++c) {
+        out.cameras[c].holdout_rms_px =
+            std::sqrt(0.5 * (a_on_b[c] * a_on_b[c] + b_on_a[c] * b_on_a[c]));
+        const auto diff = ProjectionDifferencePx(a.rig.cameras[c].intrinsics,
+                                                 b.rig.cameras[c].intrinsics);
+        out.cameras[c].half_diff_rms_px = diff.first;
+        out.cameras[c].half_diff_max_px = diff.second;
+      }
+    } catch (const InputError&) {
+      // Too few views in a half: cross-validation figures stay NaN.
+    }
+  }
+  out.seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start)
+          .count();
+  return out;
+}
+
+}  // namespace kincal

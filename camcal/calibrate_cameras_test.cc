@@ -1,0 +1,367 @@
+#include "camcal/calibrate_cameras.h"
+
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <opencv2/calib3d.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+#include <random>
+#include <sstream>
+
+#include "data/error.h"
+#include "tests/testing/paths.h"
+
+namespace kincal {
+namespace {
+
+// ---------------------------------------------------------------- synthetic
+
+std::vector<Eigen::Vector3d> Board(int cols, int rows, double square) {
+  std::vector<Eigen::Vector3d> pts;
+  for (int j = 0; j < rows; ++j) {
+    for (int i = 0; i < cols; ++i) pts.emplace_back(i * square, j * square, 0);
+  }
+  return pts;
+}
+
+struct Synthetic {
+  CalibrationProblem problem;
+  Rig truth;
+};
+
+// A stereo rig (baseline 120 mm) looking at a 10x7 board (30 mm squares) from
+// random poses, pixel noise sigma `noise_px`, seeded.
+Synthetic MakeSynthetic(int num_cameras, int num_views, double noise_px,
+                        uint64_t seed) {
+  Synthetic s;
+  for (int c = 0; c < num_cameras; ++c) {
+    Camera cam;
+    cam.intrinsics = {c == 0 ? "left" : "right",
+                      1280,
+                      1024,
+                      1800.0 + 10 * c,
+                      1795.0 + 10 * c,
+                      641.0 - 5 * c,
+                      509.0 + 3 * c,
+                      {-0.12, 0.09, 0.0007, -0.0004, 0.0}};
+    if (c == 1) {
+      cam.cam_from_rig.R =
+          Eigen::AngleAxisd(-0.08, Eigen::Vector3d::UnitY()).toRotationMatrix();
+      cam.cam_from_rig.t = Eigen::Vector3d(-120, 0.8, 1.5);
+    }
+    s.truth.cameras.push_back(cam);
+    s.problem.cameras.push_back(cam.intrinsics);
+  }
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> angle(-0.5, 0.5);
+  std::uniform_real_distribution<double> shift(-80, 80);
+  std::uniform_real_distribution<double> depth(600, 1100);
+  std::normal_distribution<double> noise(0.0, noise_px);
+  const std::vector<Eigen::Vector3d> board = Board(10, 7, 30.0);
+  while (static_cast<int>(s.problem.views.size()) < num_views) {
+    Rigid3 rig_from_target;
+    rig_from_target.R =
+        (Eigen::AngleAxisd(angle(rng), Eigen::Vector3d::UnitX()) *
+         Eigen::AngleAxisd(angle(rng), Eigen::Vector3d::UnitY()) *
+         Eigen::AngleAxisd(angle(rng) * 0.5, Eigen::Vector3d::UnitZ()))
+            .toRotationMatrix();
+    // Board centre at (shift, shift, depth) in the middle of the two cameras.
+    const Eigen::Vector3d centre(135, 90, 0);
+    rig_from_target.t =
+        Eigen::Vector3d(60 + shift(rng), shift(rng), depth(rng)) -
+        rig_from_target.R * centre;
+    CalibrationView view;
+    view.label = "view" + std::to_string(s.problem.views.size());
+    bool all_inside = true;
+    for (const Camera& cam : s.truth.cameras) {
+      TargetObservation obs;
+      for (const Eigen::Vector3d& p : board) {
+        const Eigen::Vector2d px =
+            Project(cam.intrinsics, cam.cam_from_rig * (rig_from_target * p));
+        all_inside = all_inside && px.x() > 0 && px.y() > 0 &&
+                     px.x() < cam.intrinsics.width - 1 &&
+                     px.y() < cam.intrinsics.height - 1;
+        obs.p_in_target.push_back(p);
+        obs.pixels.push_back(px + Eigen::Vector2d(noise(rng), noise(rng)));
+      }
+      view.observations.push_back(obs);
+    }
+    if (all_inside) s.problem.views.push_back(view);
+  }
+  return s;
+}
+
+TEST(CalibrateCameras, SyntheticStereoRecoversRigWithinSigma) {
+  const double noise_px = 0.3;
+  const Synthetic syn = MakeSynthetic(2, 16, noise_px, 7);
+  const CalibrationSummary sum = CalibrateCameras(syn.problem);
+  EXPECT_TRUE(sum.converged) << sum.termination;
+  ASSERT_EQ(sum.cameras.size(), 2u);
+  // Residual per coordinate ~ the noise.
+  EXPECT_NEAR(sum.residual_sigma_px, noise_px, 0.05);
+  for (int c = 0; c < 2; ++c) {
+    const CameraCalibrationSummary& cs = sum.cameras[c];
+    const auto est = cs.intrinsics.ToArray();
+    const auto truth = syn.truth.cameras[c].intrinsics.ToArray();
+    ASSERT_EQ(cs.sigma.size(), static_cast<size_t>(kNumIntrinsics));
+    for (int i = 0; i < kK1 + 5; ++i) {
+      EXPECT_GT(cs.sigma[i], 0) << "camera " << c << " parameter " << i;
+      EXPECT_LT(std::abs(est[i] - truth[i]), 4 * cs.sigma[i])
+          << "camera " << c << " parameter " << i << ": " << est[i] << " vs "
+          << truth[i] << " sigma " << cs.sigma[i];
+    }
+    EXPECT_EQ(cs.sigma[kK4], 0.0);  // not in the model
+    EXPECT_EQ(cs.num_views, 16);
+    EXPECT_EQ(cs.num_points, 16 * 70);
+    // Held-out reprojection: noise plus a little for the fitted pose.
+    EXPECT_GT(cs.holdout_rms_px, 0.9 * noise_px * std::sqrt(2.0) * 0.9);
+    EXPECT_LT(cs.holdout_rms_px, 1.3 * noise_px * std::sqrt(2.0));
+    EXPECT_LT(cs.half_diff_rms_px, 3.0);
+    EXPECT_EQ(cs.outliers, 0);
+  }
+  const Rigid3& est = sum.rig.cameras[1].cam_from_rig;
+  const Rigid3& truth = syn.truth.cameras[1].cam_from_rig;
+  EXPECT_LT(std::abs(sum.baseline - syn.truth.BaselineMm()),
+            4 * sum.baseline_sigma);
+  EXPECT_GT(sum.baseline_sigma, 0);
+  for (int i = 0; i < 3; ++i) {
+    EXPECT_LT(std::abs(est.t[i] - truth.t[i]),
+              4 * sum.extrinsic_translation_sigma[i]);
+  }
+  const double angle_deg =
+      Eigen::AngleAxisd(est.R * truth.R.transpose()).angle() * 180 / M_PI;
+  EXPECT_LT(angle_deg, 4 * sum.extrinsic_rotation_sigma_deg[0] +
+                           4 * sum.extrinsic_rotation_sigma_deg[1] +
+                           4 * sum.extrinsic_rotation_sigma_deg[2]);
+}
+
+TEST(CalibrateCameras, RobustLossResistsOutliers) {
+  Synthetic syn = MakeSynthetic(1, 10, 0.2, 11);
+  // Corrupt 1% of the corners by 30 px.
+  std::mt19937_64 rng(3);
+  int corrupted = 0;
+  for (CalibrationView& v : syn.problem.views) {
+    for (Eigen::Vector2d& px : v.observations[0].pixels) {
+      if (rng() % 100 == 0) {
+        px += Eigen::Vector2d(30, -20);
+        ++corrupted;
+      }
+    }
+  }
+  ASSERT_GT(corrupted, 2);
+  CalibrationOptions options;
+  options.cross_validate = false;
+  const CalibrationSummary robust = CalibrateCameras(syn.problem, options);
+  options.loss = CalibrationOptions::Loss::kTrivial;
+  const CalibrationSummary plain = CalibrateCameras(syn.problem, options);
+  const double truth_fx = syn.truth.cameras[0].intrinsics.fx;
+  EXPECT_LT(std::abs(robust.rig.cameras[0].intrinsics.fx - truth_fx),
+            std::abs(plain.rig.cameras[0].intrinsics.fx - truth_fx));
+  options.loss = CalibrationOptions::Loss::kCauchy;
+  options.loss_scale_px = 1.0;
+  const CalibrationSummary cauchy = CalibrateCameras(syn.problem, options);
+  std::printf(
+      "fx error: Huber 3 px %.3f, Cauchy 1 px %.3f, least squares %.3f\n",
+      robust.rig.cameras[0].intrinsics.fx - truth_fx,
+      cauchy.rig.cameras[0].intrinsics.fx - truth_fx,
+      plain.rig.cameras[0].intrinsics.fx - truth_fx);
+  // Both robust fits stay within 4 sigma of the truth; least squares does not.
+  EXPECT_LT(std::abs(robust.rig.cameras[0].intrinsics.fx - truth_fx),
+            4 * robust.cameras[0].sigma[kFx]);
+  EXPECT_LT(std::abs(cauchy.rig.cameras[0].intrinsics.fx - truth_fx),
+            4 * cauchy.cameras[0].sigma[kFx]);
+  EXPECT_GT(std::abs(plain.rig.cameras[0].intrinsics.fx - truth_fx),
+            10 * std::abs(robust.rig.cameras[0].intrinsics.fx - truth_fx));
+  EXPECT_GE(robust.cameras[0].outliers, corrupted);
+}
+
+TEST(CalibrateCameras, TooFewViewsIsInputError) {
+  const Synthetic syn = MakeSynthetic(2, 2, 0.1, 5);
+  EXPECT_THROW(CalibrateCameras(syn.problem), InputError);
+  Synthetic one = MakeSynthetic(1, 6, 0.1, 5);
+  one.problem.cameras.clear();
+  EXPECT_THROW(CalibrateCameras(one.problem), InputError);
+  CalibrationOptions bad;
+  bad.num_distortion = 3;
+  EXPECT_THROW(CalibrateCameras(MakeSynthetic(1, 6, 0.1, 5).problem, bad),
+               InputError);
+}
+
+TEST(ProjectionDifference, ZeroForSameModelAndRotationRemoved) {
+  CameraIntrinsics a{"a", 640, 480, 800, 800, 320, 240, {-0.2, 0.1, 0, 0, 0}};
+  EXPECT_LT(ProjectionDifferencePx(a, a).first, 1e-9);
+  // A principal point shift of 2 px is (mostly) a rotation.
+  CameraIntrinsics b = a;
+  b.cx += 2;
+  EXPECT_LT(ProjectionDifferencePx(a, b).first, 0.2);
+  b = a;
+  b.fx *= 1.01;  // 1% focal: up to ~3 px at the edge, not a rotation
+  EXPECT_GT(ProjectionDifferencePx(a, b).second, 2.0);
+}
+
+// ---------------------------------------------------------------- real data
+
+// Bouguet reference intrinsics on OpenCV's calib1 data: 7 views x 35 corners.
+TEST(CalibrateCamerasRealData, calib1MatchesBouguetReferenceWithinSigma) {
+  KINCAL_REQUIRE_SHARED_DATA("opencv-extra-calib1");
+  const std::string dir = testing::SharedDataDir() + "/opencv-extra-calib1";
+  std::ifstream in(dir + "/calib1_image_points.txt");
+  ASSERT_TRUE(in) << dir;
+  CalibrationProblem problem;
+  problem.cameras.push_back({"calib1", 640, 480, 0, 0, 0, 0, {}});
+  std::string line;
+  const std::vector<Eigen::Vector3d> board = Board(7, 5, 2.54);
+  while (std::getline(in, line)) {
+    if (line.empty()) continue;
+    if (line[0] == '#') {
+      problem.views.push_back({line, {TargetObservation()}});
+      continue;
+    }
+    std::istringstream ls(line);
+    double u, v;
+    ASSERT_TRUE(ls >> u >> v) << line;
+    TargetObservation& obs = problem.views.back().observations[0];
+    obs.p_in_target.push_back(board[obs.pixels.size()]);
+    obs.pixels.emplace_back(u, v);
+  }
+  ASSERT_EQ(problem.views.size(), 7u);
+  for (const auto& v : problem.views) {
+    ASSERT_EQ(v.observations[0].pixels.size(), 35u);
+  }
+  // Bouguet's model: k1 k2 p1 p2 (k3 = 0), least squares.
+  CalibrationOptions options;
+  options.num_distortion = 4;
+  const CalibrationSummary sum = CalibrateCameras(problem, options);
+  ASSERT_TRUE(sum.converged) << sum.termination;
+  const CameraIntrinsics& c = sum.rig.cameras[0].intrinsics;
+  // calib1_reference.txt: fc, cc, kc and std_intrinsics.
+  const double ref[8] = {809.94790, 806.55964, 361.99611, 214.39514,
+                         -0.12821,  -0.39441,  -0.00435,  -0.00732};
+  const double ref_sigma[8] = {9.483582371446595,    8.827729903480298,
+                               8.536273813519113,    13.27634001543498,
+                               0.03972140807068844,  0.5217584855616905,
+                               0.003163017623740528, 0.002420488943287363};
+  const double est[8] = {c.fx,
+                         c.fy,
+                         c.cx,
+                         c.cy,
+                         c.distortion[0],
+                         c.distortion[1],
+                         c.distortion[2],
+                         c.distortion[3]};
+  const char* names[8] = {"fx", "fy", "cx", "cy", "k1", "k2", "p1", "p2"};
+  for (int i = 0; i < 8; ++i) {
+    EXPECT_LT(std::abs(est[i] - ref[i]), ref_sigma[i])
+        << names[i] << ": " << est[i] << " vs reference " << ref[i]
+        << " (sigma " << ref_sigma[i] << ")";
+    // Our sigma agrees with the reference sigma within a factor 2.
+    EXPECT_GT(sum.cameras[0].sigma[i], 0.5 * ref_sigma[i]) << names[i];
+    EXPECT_LT(sum.cameras[0].sigma[i], 2.0 * ref_sigma[i]) << names[i];
+  }
+  // Bouguet's err = [0.10179 0.09492] (std of x and y): norm RMS 0.139 px.
+  EXPECT_LT(sum.rms_px, 0.145);
+  std::printf(
+      "calib1: fx %.5f fy %.5f cx %.5f cy %.5f k %.5f %.5f %.5f %.5f "
+      "rms %.4f px, sigma fx %.3f\n",
+      est[0], est[1], est[2], est[3], est[4], est[5], est[6], est[7],
+      sum.rms_px, sum.cameras[0].sigma[0]);
+}
+
+TargetObservation DetectChessboard(const std::string& path, cv::Size size) {
+  const cv::Mat img = cv::imread(path, cv::IMREAD_GRAYSCALE);
+  EXPECT_FALSE(img.empty()) << path;
+  std::vector<cv::Point2f> corners;
+  TargetObservation obs;
+  if (!cv::findChessboardCorners(
+          img, size, corners,
+          cv::CALIB_CB_ADAPTIVE_THRESH | cv::CALIB_CB_NORMALIZE_IMAGE)) {
+    return obs;
+  }
+  cv::cornerSubPix(
+      img, corners, cv::Size(11, 11), cv::Size(-1, -1),
+      cv::TermCriteria(cv::TermCriteria::COUNT + cv::TermCriteria::EPS, 30,
+                       0.01));
+  const std::vector<Eigen::Vector3d> board =
+      Board(size.width, size.height, 1.0);
+  for (size_t i = 0; i < corners.size(); ++i) {
+    obs.p_in_target.push_back(board[i]);
+    obs.pixels.emplace_back(corners[i].x, corners[i].y);
+  }
+  return obs;
+}
+
+// OpenCV's stereo sample data: 13 pairs, 9x6 board, square = 1. OpenCV's
+// stereo_calib reaches RMS 0.445 px; the baseline is about 3.34 squares.
+TEST(CalibrateCamerasRealData, StereoLeftRightReachesOpenCvRms) {
+  KINCAL_REQUIRE_SHARED_DATA("opencv-stereo-left-right");
+  const std::string dir =
+      testing::SharedDataDir() + "/opencv-stereo-left-right";
+  CalibrationProblem problem;
+  problem.cameras.push_back({"left", 640, 480, 0, 0, 0, 0, {}});
+  problem.cameras.push_back({"right", 640, 480, 0, 0, 0, 0, {}});
+  for (const char* id : {"01", "02", "03", "04", "05", "06", "07", "08", "09",
+                         "11", "12", "13", "14"}) {
+    CalibrationView view;
+    view.label = id;
+    for (const char* side : {"left", "right"}) {
+      view.observations.push_back(
+          DetectChessboard(dir + "/" + side + id + ".jpg", cv::Size(9, 6)));
+    }
+    problem.views.push_back(view);
+  }
+  const CalibrationSummary sum = CalibrateCameras(problem);
+  EXPECT_TRUE(sum.converged) << sum.termination;
+  EXPECT_LE(sum.rms_px, 0.445);
+  // OpenCV's samples/cpp/stereo_calib.cpp on the same corners, same flags.
+  std::vector<std::vector<cv::Point3f>> obj;
+  std::vector<std::vector<cv::Point2f>> img[2];
+  for (const CalibrationView& v : problem.views) {
+    if (v.observations[0].empty() || v.observations[1].empty()) continue;
+    obj.emplace_back();
+    for (const Eigen::Vector3d& p : v.observations[0].p_in_target) {
+      obj.back().emplace_back(p.x(), p.y(), p.z());
+    }
+    for (int c = 0; c < 2; ++c) {
+      img[c].emplace_back();
+      for (const Eigen::Vector2d& px : v.observations[c].pixels) {
+        img[c].back().emplace_back(px.x(), px.y());
+      }
+    }
+  }
+  cv::Mat K[2] = {cv::initCameraMatrix2D(obj, img[0], cv::Size(640, 480), 0),
+                  cv::initCameraMatrix2D(obj, img[1], cv::Size(640, 480), 0)};
+  cv::Mat D[2], R, T, E, F;
+  const double opencv_rms = cv::stereoCalibrate(
+      obj, img[0], img[1], K[0], D[0], K[1], D[1], cv::Size(640, 480), R, T, E,
+      F,
+      cv::CALIB_FIX_ASPECT_RATIO | cv::CALIB_ZERO_TANGENT_DIST |
+          cv::CALIB_USE_INTRINSIC_GUESS | cv::CALIB_SAME_FOCAL_LENGTH |
+          cv::CALIB_RATIONAL_MODEL | cv::CALIB_FIX_K3 | cv::CALIB_FIX_K4 |
+          cv::CALIB_FIX_K5,
+      cv::TermCriteria(cv::TermCriteria::COUNT + cv::TermCriteria::EPS, 100,
+                       1e-5));
+  EXPECT_LE(sum.rms_px, opencv_rms);
+  EXPECT_NEAR(cv::norm(T), sum.baseline, 0.02);
+  EXPECT_NEAR(sum.baseline, 3.34, 0.05);
+  EXPECT_GT(sum.baseline_sigma, 0);
+  EXPECT_LT(sum.baseline_sigma, 0.05);
+  for (const CameraCalibrationSummary& cs : sum.cameras) {
+    EXPECT_GT(cs.holdout_rms_px, cs.rms_px);  // held-out is harder
+    EXPECT_LT(cs.holdout_rms_px, 1.0);
+  }
+  std::printf(
+      "stereo: OpenCV stereo_calib %.4f px, baseline %.4f; kincal rms %.4f px "
+      "(left %.4f, right %.4f; OpenCV init %.4f, %.4f), "
+      "baseline %.4f +- %.4f, holdout %.4f / %.4f px, half diff %.3f / %.3f "
+      "px, %d iterations, %.3f s\n",
+      opencv_rms, cv::norm(T), sum.rms_px, sum.cameras[0].rms_px,
+      sum.cameras[1].rms_px, sum.cameras[0].opencv_rms_px,
+      sum.cameras[1].opencv_rms_px, sum.baseline, sum.baseline_sigma,
+      sum.cameras[0].holdout_rms_px, sum.cameras[1].holdout_rms_px,
+      sum.cameras[0].half_diff_rms_px, sum.cameras[1].half_diff_rms_px,
+      sum.iterations, sum.seconds);
+}
+
+}  // namespace
+}  // namespace kincal

@@ -1,0 +1,120 @@
+// End-to-end: `kincal camcal` on OpenCV's stereo images, and its bad-input
+// exits (code 2, nothing written).
+
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include <array>
+#include <cstdio>
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "camcal/rig.h"
+#include "tests/testing/paths.h"
+
+namespace kincal {
+namespace {
+
+struct RunResult {
+  int code = -1;
+  std::string out;
+};
+
+RunResult RunKincal(const std::string& args) {
+  const std::string cmd = testing::KincalBinary() + " " + args + " 2>/dev/null";
+  RunResult r;
+  FILE* pipe = ::popen(cmd.c_str(), "r");
+  if (!pipe) return r;
+  std::array<char, 4096> buf;
+  size_t n;
+  while ((n = std::fread(buf.data(), 1, buf.size(), pipe)) > 0) {
+    r.out.append(buf.data(), n);
+  }
+  const int status = ::pclose(pipe);
+  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return r;
+}
+
+std::string StereoDir() {
+  return testing::SharedDataDir() + "/opencv-stereo-left-right";
+}
+
+TEST(CamcalCli, StereoChessboardJsonAndRig) {
+  KINCAL_REQUIRE_SHARED_DATA("opencv-stereo-left-right");
+  const std::string out = testing::MakeTempDir("camcal") + "/rig.yaml";
+  const RunResult r = RunKincal(
+      "camcal --left '" + StereoDir() + "/left*.jpg' --right '" + StereoDir() +
+      "/right*.jpg' --target chessboard:9x6:1 --out " + out + " --json");
+  ASSERT_EQ(r.code, 0) << r.out;
+  const nlohmann::json j = nlohmann::json::parse(r.out);
+  EXPECT_LE(j.at("rms_px").get<double>(), 0.445);
+  EXPECT_NEAR(j.at("baseline").get<double>(), 3.34, 0.05);
+  ASSERT_EQ(j.at("cameras").size(), 2u);
+  for (const auto& c : j.at("cameras")) {
+    for (const char* key : {"fx", "fy", "cx", "cy", "rms_px"}) {
+      EXPECT_TRUE(c.at(key).is_number()) << key;
+    }
+    EXPECT_EQ(c.at("distortion").size(), 5u);
+    EXPECT_EQ(c.at("view_rms_px").size(), 13u);
+    EXPECT_TRUE(c.at("holdout_rms_px").is_number());
+    EXPECT_TRUE(c.at("sigma").at("fx").is_number());
+    EXPECT_NEAR(c.at("fx").get<double>(), 537, 10);
+  }
+  EXPECT_NE(j.at("command").get<std::string>().find("camcal"),
+            std::string::npos);
+  // The rig file reads back and agrees with the JSON.
+  const Rig rig = ReadRigYaml(out);
+  ASSERT_EQ(rig.cameras.size(), 2u);
+  EXPECT_DOUBLE_EQ(rig.cameras[1].intrinsics.fx,
+                   j["cameras"][1]["fx"].get<double>());
+  EXPECT_NEAR(rig.BaselineMm(), j["baseline"].get<double>(), 1e-9);
+}
+
+TEST(CamcalCli, BadInputExitsTwoAndWritesNothing) {
+  const std::string dir = testing::MakeTempDir("camcal_bad");
+  const std::string out = dir + "/rig.yaml";
+  const std::string left = "'" + StereoDir() + "/left*.jpg'";
+  // Bad target spec (checked before any image is read).
+  EXPECT_EQ(RunKincal("camcal --left " + left +
+                      " --target chessboard:9x6 --out " + out)
+                .code,
+            2);
+  EXPECT_EQ(RunKincal("camcal --left " + left +
+                      " --target squares:9x6:1 --out " + out)
+                .code,
+            2);
+  // A glob with no images.
+  EXPECT_EQ(RunKincal("camcal --left '" + dir +
+                      "/none*.png' --target chessboard:9x6:1 --out " + out)
+                .code,
+            2);
+  // Unreadable images.
+  {
+    FILE* f = std::fopen((dir + "/img0.png").c_str(), "w");
+    ASSERT_NE(f, nullptr);
+    std::fputs("not a png", f);
+    std::fclose(f);
+  }
+  EXPECT_EQ(RunKincal("camcal --left '" + dir +
+                      "/img*.png' --target chessboard:9x6:1 --out " + out)
+                .code,
+            2);
+  // Missing required option.
+  EXPECT_EQ(RunKincal("camcal --left " + left + " --out " + out).code, 2);
+  if (testing::Exists(StereoDir())) {
+    // Target not found (wrong size): too few views.
+    EXPECT_EQ(RunKincal("camcal --left " + left +
+                        " --target chessboard:7x7:1 --out " + out)
+                  .code,
+              2);
+    // Unequal left/right counts.
+    EXPECT_EQ(RunKincal("camcal --left " + left + " --right '" + StereoDir() +
+                        "/right0*.jpg' --target chessboard:9x6:1 --out " + out)
+                  .code,
+              2);
+  }
+  EXPECT_FALSE(testing::Exists(out));
+}
+
+}  // namespace
+}  // namespace kincal
