@@ -171,18 +171,47 @@ CalibrateResult Calibrate(const Robot& nominal, const Observations& obs,
   }
 
   FitOptions fit;
-  fit.free = result.identifiability.identifiable;
   fit.bounds_center = &nominal_chain;
   fit.loss = options.loss;
   fit.loss_scale_mm = options.loss_scale_mm;
   fit.distances = distances;
-  if (options.method == CalibrateOptions::kPaper) {
-    PaperOptions paper;
-    paper.free = fit.free;
-    paper.bounds_center = &nominal_chain;
-    result.fit = FitPaperObjective(train, paper, &state);
-  } else {
-    result.fit = Fit(train, fit, &state);
+  auto run_fit = [&](const std::vector<ParamInfo>& free) {
+    fit.free = free;
+    if (options.method == CalibrateOptions::kPaper) {
+      PaperOptions paper;
+      for (const ParamInfo& p : free) {
+        if (p.kind != ParamKind::kFrame && p.kind != ParamKind::kPoint) {
+          paper.free.push_back(p);
+        }
+      }
+      paper.bounds_center = &nominal_chain;
+      paper.distances = distances;
+      return FitPaperObjective(train, paper, &state);
+    }
+    return Fit(train, fit, &state);
+  };
+  result.fit = run_fit(result.identifiability.identifiable);
+
+  // Second look at the solution, with the noise level the fit found: drop
+  // parameters the data cannot pin down within a tenth of their admissible
+  // range, reset them to nominal and refit.
+  if (options.fit_geometry && result.fit.sigma0_mm > 0) {
+    IdentifiabilityOptions second = options.identifiability;
+    second.noise_sigma_mm = result.fit.sigma0_mm;
+    Identifiability at_solution = AnalyzeIdentifiability(
+        train, state, candidates, second, distances);
+    if (at_solution.identifiable.size() <
+        result.identifiability.identifiable.size()) {
+      for (const ParamInfo& p : at_solution.unidentifiable) {
+        if (p.kind == ParamKind::kRow) {
+          *ParamAddress(&state, p) = nominal_chain.rows[p.block].p[p.index];
+        }
+      }
+      result.identifiability = at_solution;
+      result.fit = run_fit(result.identifiability.identifiable);
+    } else {
+      result.identifiability = at_solution;
+    }
   }
 
   result.train = ComputeErrorStats(Norms(state, train));

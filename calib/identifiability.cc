@@ -42,7 +42,21 @@ Identifiability AnalyzeIdentifiability(
       rest -= basis * (basis.transpose() * rest);
     }
     const double sine = norm > 0 ? rest.norm() : 0.0;
-    if (sine > options.tolerance) {
+    // Predicted sigma given the accepted parameters (internal units).
+    const double sigma = options.noise_sigma_mm > 0 && sine > 0
+                             ? options.noise_sigma_mm / (sine * norm)
+                             : NAN;
+    bool determined = sine > options.tolerance;
+    if (determined && options.noise_sigma_mm > 0 &&
+        candidates[c].kind == ParamKind::kRow) {
+      const bool angle = candidates[c].angle;
+      const double bound = angle ? state.chain.bound_angle_rad
+                                 : state.chain.bound_length_mm;
+      determined = sigma < options.max_sigma_fraction * bound;
+    }
+    if (determined) {
+      out.conditional_sigma.push_back(candidates[c].angle ? sigma * 180 / M_PI
+                                                          : sigma);
       basis.conservativeResize(m, basis.cols() + 1);
       basis.col(basis.cols() - 1) = rest / rest.norm();
       accepted.push_back(c);

@@ -28,12 +28,25 @@ struct IdentifiabilityOptions {
   // Columns with sin(angle) below this are "weak": estimated, but with a
   // large sigma; listed in `weak`.
   double weak_tolerance = 1e-2;
+  // Statistical criterion, used when noise_sigma_mm > 0 (at a solution): a
+  // row parameter is determined only if its predicted 1-sigma given the
+  // parameters accepted before it, noise_sigma_mm / |part of its column
+  // outside their span|, is below max_sigma_fraction of its admissible
+  // deviation (the robot's bounds: length or angle). This catches
+  // redundancies that are exact only where the model fits (e.g. a rigid
+  // rotation of the whole arm with single-point data), which the sine test
+  // misses away from the solution.
+  double noise_sigma_mm = 0.0;
+  double max_sigma_fraction = 0.1;
 };
 
 struct Identifiability {
   std::vector<ParamInfo> identifiable;    // in priority order
   std::vector<ParamInfo> unidentifiable;  // held at nominal
   std::vector<std::string> weak;          // identifiable but poorly
+  // Predicted 1-sigma (interface units) of each identifiable parameter given
+  // the ones before it; NaN without a noise level.
+  std::vector<double> conditional_sigma;
   // For each unidentifiable parameter: "j2.d = +1.000 frame.z - 1.000 j1.d"
   // (linearised effect on the residuals; up to 4 largest terms).
   std::vector<std::string> relations;

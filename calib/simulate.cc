@@ -3,6 +3,7 @@
 #include <ceres/jet.h>
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <cmath>
 #include <random>
 #include <sstream>
@@ -167,6 +168,12 @@ SimulatedSession Simulate(const Robot& nominal, const SimulateOptions& opt) {
   truth.joint_errors.assign(truth.num_joints(), JointErrorBlock{});
   truth.drift = {0, 0, 0};
   for (const ParamInfo& p : GeometryParams(truth)) {
+    if (!opt.perturbed.empty() &&
+        std::find(opt.perturbed.begin(), opt.perturbed.end(), p.name) ==
+            opt.perturbed.end()) {
+      normal(rng);  // keep the random stream independent of the selection
+      continue;
+    }
     const double sigma =
         (p.kind == ParamKind::kRow &&
          (truth.convention == Convention::kUrdf ? p.index >= 3

@@ -48,6 +48,9 @@ struct SimulateOptions {
   double seconds_per_pose = 20.0;     // time column t (0 = no t column)
   std::vector<Effect> effects;
   uint64_t seed = 1;
+  // When not empty, only these geometric parameters (names as j3.a) deviate
+  // from nominal; e.g. to compare estimates with truth parameter by parameter.
+  std::vector<std::string> perturbed;
 };
 
 struct SimulatedSession {
