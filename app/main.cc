@@ -33,6 +33,7 @@ int main(int argc, char** argv) {
   kincal::app::AddCamcalCommand(app, &run);
   kincal::app::AddTrackCommand(app, &run);
   kincal::app::AddImportCommand(app, &run);
+  kincal::app::AddCaptureCommand(app, &run);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
