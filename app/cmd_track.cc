@@ -1,17 +1,221 @@
+// kincal track: the needle tip in the rig frame for every stereo frame pair,
+// from the AprilTags of the tool target (../shared/spec/formats.md).
+
+#include <glob.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <memory>
+#include <opencv2/imgcodecs.hpp>
+#include <sstream>
+#include <thread>
+
 #include "app/command.h"
+#include "camcal/rig.h"
+#include "data/atomic_file.h"
+#include "data/csv.h"
+#include "data/error.h"
+#include "data/provenance.h"
+#include "data/yaml_util.h"
+#include "vision/target.h"
+#include "vision/tool_pose.h"
+#include "vision/tracker.h"
 
 namespace kincal::app {
+namespace {
 
-// Not built yet: registers the subcommand so usage is stable; exits 1.
-void AddTrackCommand(CLI::App& app, Runner* run) {
-  CLI::App* sub = app.add_subcommand("track", "(not implemented yet)");
-  sub->allow_extras();
-  sub->callback([run] {
-    *run = [] {
-      std::fprintf(stderr, "kincal track: not implemented yet\n");
-      return 1;
+struct TrackArgs {
+  std::string rig, target, left, right, out;
+  bool json = false;
+  bool no_tracking = false;
+  double decimate = 2.0;
+  bool quiet = false;
+};
+
+// Files matching `pattern`, sorted by name; InputError when none.
+std::vector<std::string> Glob(const std::string& pattern,
+                              const std::string& option) {
+  glob_t g{};
+  const int rc = ::glob(pattern.c_str(), 0, nullptr, &g);
+  std::vector<std::string> files;
+  if (rc == 0) {
+    for (size_t i = 0; i < g.gl_pathc; ++i) files.push_back(g.gl_pathv[i]);
+  }
+  ::globfree(&g);
+  if (files.empty()) {
+    throw InputError(option + " '" + pattern + "': no file matches");
+  }
+  std::sort(files.begin(), files.end());
+  return files;
+}
+
+cv::Mat ReadGray(const std::string& path, const CameraIntrinsics& cam) {
+  const cv::Mat im = cv::imread(path, cv::IMREAD_GRAYSCALE);
+  if (im.empty()) throw InputError(path + ": cannot read the image");
+  if (im.cols != cam.width || im.rows != cam.height) {
+    std::ostringstream os;
+    os << path << ": image is " << im.cols << "x" << im.rows << " but camera '"
+       << cam.name << "' in the rig is " << cam.width << "x" << cam.height;
+    throw InputError(os.str());
+  }
+  return im;
+}
+
+std::string PosesPath(const std::string& out) {
+  const std::string ext = ".csv";
+  if (out.size() > ext.size() &&
+      out.compare(out.size() - ext.size(), ext.size(), ext) == 0) {
+    return out.substr(0, out.size() - ext.size()) + ".poses.csv";
+  }
+  return out + ".poses.csv";
+}
+
+int RunTrack(const TrackArgs& args) {
+  const auto start = std::chrono::steady_clock::now();
+  const Rig rig = ReadRigYaml(args.rig);
+  const Target target = ReadTargetYaml(args.target);
+  if (rig.cameras.size() < 2) {
+    throw InputError(args.rig + ": track needs a stereo rig (2 cameras), got " +
+                     std::to_string(rig.cameras.size()));
+  }
+  const std::vector<std::string> left = Glob(args.left, "--left");
+  const std::vector<std::string> right = Glob(args.right, "--right");
+  if (left.size() != right.size()) {
+    throw InputError("--left matches " + std::to_string(left.size()) +
+                     " images but --right matches " +
+                     std::to_string(right.size()) + "; frames pair in order");
+  }
+  TrackerOptions topt;
+  topt.detector.family = target.family;
+  topt.detector.quad_decimate = args.decimate;
+  topt.enabled = !args.no_tracking;
+  topt.Check();
+  std::vector<std::unique_ptr<TagTracker>> trackers;
+  for (int c = 0; c < 2; ++c)
+    trackers.push_back(std::make_unique<TagTracker>(topt));
+
+  const size_t n = left.size();
+  std::ostringstream points, poses;
+  const std::string header =
+      "# written by " + ToolVersion() + ": " + CommandLine() + "\n";
+  points << header << "frame,x,y,z,reproj_px,tags\n";
+  poses << header << "# rig_from_tool: R row-major, t in mm; tip in rig, mm\n"
+        << "frame,found,r00,r01,r02,r10,r11,r12,r20,r21,r22,tx,ty,tz,"
+           "reproj_px,tags,left_image,right_image\n";
+  int found = 0;
+  std::vector<double> rms_values;
+  auto last_progress = start;
+  for (size_t f = 0; f < n; ++f) {
+    std::vector<std::vector<TagDetection>> dets(2);
+    const std::string* files[2] = {&left[f], &right[f]};
+    // One thread per camera; errors are carried back, not thrown in threads.
+    std::string error[2];
+    auto work = [&](int c) {
+      try {
+        const cv::Mat im = ReadGray(*files[c], rig.cameras[c].intrinsics);
+        dets[c] = trackers[c]->Track(im);
+      } catch (const std::exception& e) {
+        error[c] = e.what();
+      }
     };
-  });
+    std::thread t1(work, 1);
+    work(0);
+    t1.join();
+    for (int c = 0; c < 2; ++c) {
+      if (!error[c].empty()) throw InputError(error[c]);
+    }
+    const ToolPoseResult r = EstimateToolPose(rig, target, dets);
+    points << f;
+    poses << f << "," << (r.found ? 1 : 0);
+    if (r.found) {
+      ++found;
+      rms_values.push_back(r.rms_px);
+      for (int i = 0; i < 3; ++i)
+        points << "," << FormatDouble(r.tip_in_rig(i));
+      points << "," << FormatDouble(r.rms_px) << "," << r.tags_used << "\n";
+      for (int i = 0; i < 9; ++i) {
+        poses << "," << FormatDouble(r.rig_from_tool.R(i / 3, i % 3));
+      }
+      for (int i = 0; i < 3; ++i) {
+        poses << "," << FormatDouble(r.rig_from_tool.t(i));
+      }
+      poses << "," << FormatDouble(r.rms_px) << "," << r.tags_used;
+    } else {
+      points << ",,,,,0\n";
+      poses << ",,,,,,,,,,,,,,0";
+    }
+    poses << "," << CsvQuote(left[f]) << "," << CsvQuote(right[f]) << "\n";
+    const auto now = std::chrono::steady_clock::now();
+    if (!args.quiet && n >= 20 &&
+        (now - last_progress > std::chrono::milliseconds(500) || f + 1 == n)) {
+      last_progress = now;
+      const int width = 30;
+      const int done = static_cast<int>(width * (f + 1) / n);
+      std::fprintf(stderr, "\rkincal track [%s%s] %zu/%zu frames, %d found",
+                   std::string(done, '#').c_str(),
+                   std::string(width - done, '.').c_str(), f + 1, n, found);
+      if (f + 1 == n) std::fprintf(stderr, "\n");
+    }
+  }
+  WriteFileAtomic(args.out, points.str());
+  const std::string poses_path = PosesPath(args.out);
+  WriteFileAtomic(poses_path, poses.str());
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start)
+          .count();
+  double median_rms = 0;
+  if (!rms_values.empty()) {
+    std::nth_element(rms_values.begin(),
+                     rms_values.begin() + rms_values.size() / 2,
+                     rms_values.end());
+    median_rms = rms_values[rms_values.size() / 2];
+  }
+  const int full0 = trackers[0]->full_searches();
+  const int full1 = trackers[1]->full_searches();
+  if (args.json) {
+    nlohmann::json j;
+    j["frames"] = n;
+    j["found"] = found;
+    j["seconds"] = seconds;
+    j["out"] = args.out;
+    j["poses"] = poses_path;
+    j["median_reproj_px"] = median_rms;
+    j["full_searches"] = {full0, full1};
+    PrintJson(j);
+    return 0;
+  }
+  std::printf("kincal track: %zu frame pairs, tip found in %d (%.1f s)\n", n,
+              found, seconds);
+  std::printf("  median reprojection RMS %.3f px; full-frame searches %d/%d\n",
+              median_rms, full0, full1);
+  std::printf("  wrote %s and %s\n", args.out.c_str(), poses_path.c_str());
+  return 0;
+}
+
+}  // namespace
+
+void AddTrackCommand(CLI::App& app, Runner* run) {
+  auto args = std::make_shared<TrackArgs>();
+  CLI::App* sub = app.add_subcommand(
+      "track",
+      "Needle tip in the rig frame for every stereo frame pair, from the "
+      "tool's AprilTags (writes points.csv and <out>.poses.csv)");
+  sub->add_option("--rig", args->rig, "rig.yaml (2 cameras)")->required();
+  sub->add_option("--target", args->target, "target.yaml")->required();
+  sub->add_option("--left", args->left, "left images, a glob (quote it)")
+      ->required();
+  sub->add_option("--right", args->right, "right images, a glob (quote it)")
+      ->required();
+  sub->add_option("--out", args->out, "points.csv to write")->required();
+  sub->add_option("--decimate", args->decimate,
+                  "libapriltag quad_decimate (default 2)")
+      ->check(CLI::Range(1.0, 8.0));
+  sub->add_flag("--no-tracking", args->no_tracking,
+                "search every full frame (no region prediction)");
+  sub->add_flag("--quiet", args->quiet, "no progress bar on stderr");
+  sub->add_flag("--json", args->json, "print one JSON object");
+  sub->callback([run, args] { *run = [args] { return RunTrack(*args); }; });
 }
 
 }  // namespace kincal::app

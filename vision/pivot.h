@@ -1,0 +1,37 @@
+#ifndef KINCAL_VISION_PIVOT_H_
+#define KINCAL_VISION_PIVOT_H_
+
+// Pivot calibration of the needle tip offset: the needle tip rests in a fixed
+// divot while the tool is turned about it. For every tool pose i
+//   R_i * tip_in_tool + t_i = pivot_in_rig,
+// i.e. [R_i  -I] [tip_in_tool; pivot_in_rig] = -t_i, stacked over all poses
+// and solved by linear least squares (SVD). The residual of pose i is
+// |R_i * tip_in_tool + t_i - pivot_in_rig| (mm).
+
+#include <Eigen/Core>
+#include <vector>
+
+#include "camcal/camera_model.h"
+
+namespace kincal {
+
+struct PivotResult {
+  Eigen::Vector3d tip_in_tool = Eigen::Vector3d::Zero();
+  Eigen::Vector3d pivot_in_rig = Eigen::Vector3d::Zero();
+  double rms_mm = 0;  // RMS of the per-pose residuals
+  double max_mm = 0;
+  std::vector<double> residuals_mm;  // one per pose
+  // Smallest / largest singular value of the stacked system: near 0 when the
+  // rotations do not span two axes (the offset along the axis is unknown).
+  double conditioning = 0;
+};
+
+// rig_from_tool: tool poses (mm) while pivoting. Throws InputError for fewer
+// than 3 poses or rotations that leave the offset undetermined
+// (conditioning < min_conditioning, e.g. all about one axis).
+PivotResult PivotCalibration(const std::vector<Rigid3>& rig_from_tool,
+                             double min_conditioning = 1e-3);
+
+}  // namespace kincal
+
+#endif  // KINCAL_VISION_PIVOT_H_

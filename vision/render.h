@@ -1,0 +1,185 @@
+#ifndef KINCAL_VISION_RENDER_H_
+#define KINCAL_VISION_RENDER_H_
+
+// Synthetic stereo images of the tool target (and of AprilGrid boards) seen
+// through the rig's camera models, with their ground truth.
+//
+// Rendering is by inverse mapping: every pixel's ray (camcal's UndistortPixel,
+// so distortion is exact) is intersected with the textured planes; the pixel
+// value is the box-filtered texture, i.e. the mean over a Fibonacci lattice of
+// sub-pixel samples wherever the pixel straddles a texel or plane boundary
+// (89 samples: edge positions are exact to ~0.01 px whatever their angle).
+// Then: exposure gain, Gaussian blur (optics), Gaussian noise, 8-bit rounding.
+//
+// Ground-truth pixels follow OpenCV's convention ((0, 0) = centre of the
+// top-left pixel); tag corners are in libapriltag's order
+// (vision/apriltag_detector.h).
+
+#include <Eigen/Core>
+#include <opencv2/core.hpp>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "camcal/camera_model.h"
+#include "camcal/rig.h"
+#include "vision/target.h"
+
+namespace kincal {
+
+// A textured rectangle in the plane z = 0 of its own frame. The texture's
+// row 0 is at y = top_left_mm.y (y grows down the rows, x along the columns);
+// one texel is size_mm / (cols, rows). Seen from the -z side only (z points
+// into the plane, as for tags).
+struct TexturedPlane {
+  Rigid3 rig_from_plane;
+  cv::Mat texture;  // CV_8UC1, 0 = black, 255 = white
+  Eigen::Vector2d top_left_mm = Eigen::Vector2d::Zero();
+  Eigen::Vector2d size_mm = Eigen::Vector2d::Zero();
+};
+
+// The plane of one printed tag (black square of edge size_mm plus its white
+// border) in the tag frame of docs/CONVENTIONS.md.
+TexturedPlane TagPlane(const std::string& family, int id, double size_mm,
+                       const Rigid3& rig_from_tag);
+// All tags of `target` with the tool at rig_from_tool.
+std::vector<TexturedPlane> TargetPlanes(const Target& target,
+                                        const Rigid3& rig_from_tool);
+
+// A straight needle (a thin cylinder) drawn over the planes.
+struct Needle {
+  Eigen::Vector3d base_in_rig = Eigen::Vector3d::Zero();
+  Eigen::Vector3d tip_in_rig = Eigen::Vector3d::Zero();
+  double radius_mm = 0.4;
+  double gray = 200;  // its brightness (0..255)
+};
+
+struct RenderOptions {
+  double background = 90;  // gray level behind the planes
+  double black = 30;       // gray level of texture value 0
+  double white = 220;      // gray level of texture value 255
+  double blur_sigma_px = 0.0;
+  double noise_sigma = 0.0;  // gray levels, Gaussian
+  // Exposure: gain drawn per image from N(1, exposure_jitter), clamped to
+  // [0.5, 1.5], applied to all gray levels.
+  double exposure_jitter = 0.0;
+  // The needle: a cylinder from needle_base_in_tool to the target's tip.
+  bool draw_needle = false;
+  Eigen::Vector3d needle_base_in_tool = Eigen::Vector3d::Zero();
+  double needle_radius_mm = 0.4;
+  double needle_gray = 200;
+
+  void Check() const;  // InputError naming the bad option
+};
+
+// Renders one camera. Holds the camera's per-pixel-corner undistortion grid,
+// so make one per camera and reuse it across frames. Thread-compatible
+// (Render is const).
+class ViewRenderer {
+ public:
+  explicit ViewRenderer(const Camera& camera);
+  // Image of `planes` (nearest plane wins; on a tie the later one, so a tag
+  // lying on a board is drawn over it) and `needles`; CV_8UC1.
+  cv::Mat Render(const std::vector<TexturedPlane>& planes,
+                 const std::vector<Needle>& needles,
+                 const RenderOptions& options, std::mt19937_64* rng) const;
+  const Camera& camera() const { return camera_; }
+
+ private:
+  Camera camera_;
+  int width_ = 0, height_ = 0;
+  // Undistorted normalized (x, y) at pixel corners (u - 0.5, v - 0.5),
+  // (width + 1) x (height + 1), row-major.
+  std::vector<Eigen::Vector2d> corner_rays_;
+};
+
+// Ground truth of one tag in one view.
+struct TagTruth {
+  int id = 0;
+  std::array<Eigen::Vector2d, 4> corners;  // px, libapriltag order
+  // Front-facing, in front of the camera, all corners >= 3 px inside.
+  bool visible = false;
+};
+
+struct ViewTruth {
+  cv::Mat image;
+  std::vector<TagTruth> tags;
+  Eigen::Vector2d tip_px = Eigen::Vector2d::Zero();
+};
+
+struct StereoFrameTruth {
+  Rigid3 rig_from_tool;
+  Eigen::Vector3d tip_in_rig = Eigen::Vector3d::Zero();
+  std::vector<ViewTruth> views;  // one per rig camera
+};
+
+// Projects the target's tag corners into `camera` (ground truth).
+std::vector<TagTruth> ProjectTargetCorners(const Camera& camera,
+                                           const Target& target,
+                                           const Rigid3& rig_from_tool);
+
+// Renders every camera of a rig (caches their undistortion grids).
+class StereoRenderer {
+ public:
+  StereoRenderer(const Rig& rig, const Target& target,
+                 const RenderOptions& options);
+  // Deterministic for a given rng state.
+  StereoFrameTruth Render(const Rigid3& rig_from_tool,
+                          std::mt19937_64* rng) const;
+
+ private:
+  Rig rig_;
+  Target target_;
+  RenderOptions options_;
+  std::vector<ViewRenderer> views_;
+};
+
+// Renders a whole session into `folder` (created if missing):
+//   <camera name>_000000.png ...    one 8-bit PNG per camera and frame
+//   rig.yaml, target.yaml           the inputs, for `kincal track`
+//   truth.csv     frame, r00..r22, tx, ty, tz (rig_from_tool, mm),
+//                 tip_x, tip_y, tip_z (tip in rig, mm)
+//   corners.csv   frame, camera, tag, corner, u, v, visible (px, OpenCV)
+// Every file is written atomically with a provenance comment (CSV/YAML).
+// Noise is seeded by `seed` (recorded in truth.csv). Returns the number of
+// frames written. Throws InputError for bad options or an unwritable folder.
+int RenderSession(const Rig& rig, const Target& target,
+                  const std::vector<Rigid3>& rig_from_tool,
+                  const RenderOptions& options, uint64_t seed,
+                  const std::string& folder);
+
+// A Kalibr-style AprilGrid: cols x rows tags of edge tag_size_mm (black
+// square), spaced by spacing_ratio * tag_size_mm, ids first_id.. row-major
+// from the top-left tag, in the board frame (origin at the top-left corner
+// of the first tag's black square, x along a row, y down the columns, z into
+// the board). As a Target: tags with tool_from_tag = board_from_tag.
+struct AprilGrid {
+  int cols = 6;
+  int rows = 6;
+  double tag_size_mm = 30;
+  double spacing_ratio = 0.3;
+  int first_id = 0;
+  std::string family = "tag36h11";
+  // Kalibr prints small black squares in the gaps at the tags' corners.
+  bool corner_squares = false;
+
+  Target AsTarget() const;
+  // White board (margin of one spacing around the tags), the tags, and the
+  // corner squares if asked, with the board at rig_from_board.
+  std::vector<TexturedPlane> Planes(const Rigid3& rig_from_board) const;
+};
+
+// A demonstration scene for tests, the bench and `kincal simulate --render`:
+// two cameras (fx = fy = 1.40625 * width, the right one 120 mm to the right
+// and turned 5 deg inwards, mild radial-tangential distortion) and a tool of
+// four 25 mm tag36h11 tags (ids 0..3) on two faces folded by +-20 deg, tip at
+// (0, 100, 10) mm in `tool`, working distance about 450 mm.
+Rig ExampleStereoRig(int width = 640, int height = 512);
+Target ExampleTarget();
+// A tool pose near the middle of ExampleStereoRig's common view: `i`
+// varies it deterministically (small rotations and shifts).
+Rigid3 ExampleToolPose(int i);
+
+}  // namespace kincal
+
+#endif  // KINCAL_VISION_RENDER_H_

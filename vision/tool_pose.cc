@@ -1,0 +1,347 @@
+#include "vision/tool_pose.h"
+
+#include <ceres/ceres.h>
+#include <ceres/rotation.h>
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <opencv2/calib3d.hpp>
+#include <opencv2/core/eigen.hpp>
+#include <sstream>
+
+#include "data/error.h"
+#include "vision/triangulate.h"
+
+namespace kincal {
+
+namespace {
+
+// Reprojection of one tag corner of the tool into one camera:
+//   r = pi(K, cam_from_rig * (rig_from_tool * p_in_tool)) - px_measured
+// with rig_from_tool = (q, t), q a unit quaternion in Ceres' order
+// (w, x, y, z; ceres::QuaternionManifold), t in mm. Returns false (no
+// exception) when the point is behind the camera.
+class ToolCornerReprojectionCost {
+ public:
+  ToolCornerReprojectionCost(const Eigen::Vector2d& px_measured,
+                             const Eigen::Vector3d& p_in_tool,
+                             const Camera& camera)
+      : px_measured_(px_measured),
+        p_in_tool_(p_in_tool),
+        intrinsics_(camera.intrinsics.ToArray()),
+        cam_from_rig_(camera.cam_from_rig) {}
+
+  template <typename T>
+  bool operator()(const T* rig_from_tool_q, const T* rig_from_tool_t,
+                  T* residuals) const {
+    const T p_in_tool[3] = {T(p_in_tool_.x()), T(p_in_tool_.y()),
+                            T(p_in_tool_.z())};
+    T p_in_rig[3];
+    ceres::UnitQuaternionRotatePoint(rig_from_tool_q, p_in_tool, p_in_rig);
+    for (int i = 0; i < 3; ++i) p_in_rig[i] += rig_from_tool_t[i];
+    T p_in_cam[3];
+    for (int i = 0; i < 3; ++i) {
+      p_in_cam[i] = T(cam_from_rig_.t(i));
+      for (int j = 0; j < 3; ++j) {
+        p_in_cam[i] += T(cam_from_rig_.R(i, j)) * p_in_rig[j];
+      }
+    }
+    T intrinsics[kNumIntrinsics];
+    for (int i = 0; i < kNumIntrinsics; ++i) intrinsics[i] = T(intrinsics_[i]);
+    T px[2];
+    if (!ProjectPoint(intrinsics, p_in_cam, px)) return false;
+    residuals[0] = px[0] - T(px_measured_.x());
+    residuals[1] = px[1] - T(px_measured_.y());
+    return true;
+  }
+
+  static ceres::CostFunction* Create(const Eigen::Vector2d& px_measured,
+                                     const Eigen::Vector3d& p_in_tool,
+                                     const Camera& camera) {
+    return new ceres::AutoDiffCostFunction<ToolCornerReprojectionCost, 2, 4, 3>(
+        new ToolCornerReprojectionCost(px_measured, p_in_tool, camera));
+  }
+
+ private:
+  const Eigen::Vector2d px_measured_;
+  const Eigen::Vector3d p_in_tool_;
+  const std::array<double, kNumIntrinsics> intrinsics_;
+  const Rigid3 cam_from_rig_;
+};
+
+// One tag seen by one camera, with its target placement.
+struct TagObs {
+  int camera;
+  const TagDetection* det;
+  const TargetTag* tag;
+};
+
+std::vector<TagObs> CollectObservations(
+    const Rig& rig, const Target& target,
+    const std::vector<std::vector<TagDetection>>& detections) {
+  std::vector<TagObs> obs;
+  const size_t n = std::min(rig.cameras.size(), detections.size());
+  for (size_t c = 0; c < n; ++c) {
+    std::map<int, int> count;
+    for (const auto& d : detections[c]) ++count[d.id];
+    for (const auto& d : detections[c]) {
+      const TargetTag* tag = target.FindTag(d.id);
+      if (tag == nullptr || count[d.id] != 1) continue;
+      obs.push_back({static_cast<int>(c), &d, tag});
+    }
+  }
+  return obs;
+}
+
+// Rigid transform b_from_a minimizing sum |b_i - (R a_i + t)|^2 (Kabsch).
+Rigid3 Kabsch(const std::vector<Eigen::Vector3d>& a,
+              const std::vector<Eigen::Vector3d>& b) {
+  Eigen::Vector3d ma = Eigen::Vector3d::Zero(), mb = Eigen::Vector3d::Zero();
+  for (size_t i = 0; i < a.size(); ++i) {
+    ma += a[i];
+    mb += b[i];
+  }
+  ma /= static_cast<double>(a.size());
+  mb /= static_cast<double>(b.size());
+  Eigen::Matrix3d H = Eigen::Matrix3d::Zero();
+  for (size_t i = 0; i < a.size(); ++i) {
+    H += (a[i] - ma) * (b[i] - mb).transpose();
+  }
+  Eigen::JacobiSVD<Eigen::Matrix3d> svd(
+      H, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  Eigen::Matrix3d D = Eigen::Matrix3d::Identity();
+  if ((svd.matrixV() * svd.matrixU().transpose()).determinant() < 0) {
+    D(2, 2) = -1;
+  }
+  Rigid3 out;
+  out.R = svd.matrixV() * D * svd.matrixU().transpose();
+  out.t = mb - out.R * ma;
+  return out;
+}
+
+double TagRms(const Camera& cam, const Rigid3& rig_from_tool, const TagObs& o) {
+  double sum = 0;
+  for (int k = 0; k < 4; ++k) {
+    const Eigen::Vector3d p_in_cam =
+        cam.cam_from_rig * (rig_from_tool * o.tag->CornerInTool(k));
+    const Eigen::Vector2d px = Project(cam.intrinsics, p_in_cam);
+    if (!px.allFinite()) return 1e9;
+    sum += (px - o.det->corners[k]).squaredNorm();
+  }
+  return std::sqrt(sum / 4);
+}
+
+bool InitialFromObservations(const Rig& rig, const std::vector<TagObs>& obs,
+                             Rigid3* rig_from_tool) {
+  // Triangulate corners of tags seen by two or more cameras.
+  std::map<int, std::vector<const TagObs*>> by_id;
+  for (const auto& o : obs) by_id[o.tag->id].push_back(&o);
+  std::vector<Eigen::Vector3d> in_tool, in_rig;
+  for (const auto& kv : by_id) {
+    if (kv.second.size() < 2) continue;
+    for (int k = 0; k < 4; ++k) {
+      std::vector<PixelObservation> px;
+      for (const TagObs* o : kv.second)
+        px.push_back({o->camera, o->det->corners[k]});
+      TriangulationOptions topt;
+      topt.refine = false;
+      const TriangulatedPoint p = TriangulatePoint(rig, px, topt);
+      if (!p.ok) continue;
+      in_tool.push_back(kv.second.front()->tag->CornerInTool(k));
+      in_rig.push_back(p.p_in_rig);
+    }
+  }
+  if (in_tool.size() >= 4) {
+    *rig_from_tool = Kabsch(in_tool, in_rig);
+    return true;
+  }
+  // PnP in the camera that sees the most tags.
+  std::map<int, int> per_camera;
+  for (const auto& o : obs) ++per_camera[o.camera];
+  int best = -1, best_count = 0;
+  for (const auto& kv : per_camera) {
+    if (kv.second > best_count) {
+      best = kv.first;
+      best_count = kv.second;
+    }
+  }
+  if (best < 0) return false;
+  std::vector<cv::Point3d> object;
+  std::vector<cv::Point2d> image;
+  for (const auto& o : obs) {
+    if (o.camera != best) continue;
+    for (int k = 0; k < 4; ++k) {
+      const Eigen::Vector3d p = o.tag->CornerInTool(k);
+      object.emplace_back(p.x(), p.y(), p.z());
+      image.emplace_back(o.det->corners[k].x(), o.det->corners[k].y());
+    }
+  }
+  const CameraIntrinsics& K = rig.cameras[best].intrinsics;
+  cv::Mat camera_matrix =
+      (cv::Mat_<double>(3, 3) << K.fx, 0, K.cx, 0, K.fy, K.cy, 0, 0, 1);
+  cv::Mat dist(K.distortion);
+  cv::Mat rvec, tvec;
+  bool ok = false;
+  try {
+    ok = cv::solvePnP(
+        object, image, camera_matrix, dist, rvec, tvec, false,
+        object.size() == 4 ? cv::SOLVEPNP_IPPE : cv::SOLVEPNP_SQPNP);
+  } catch (const cv::Exception&) {
+    ok = false;
+  }
+  if (!ok) return false;
+  cv::Mat Rcv;
+  cv::Rodrigues(rvec, Rcv);
+  Rigid3 cam_from_tool;
+  cv::cv2eigen(Rcv, cam_from_tool.R);
+  cam_from_tool.t = Eigen::Vector3d(tvec.at<double>(0), tvec.at<double>(1),
+                                    tvec.at<double>(2));
+  *rig_from_tool = rig.cameras[best].cam_from_rig.Inverse() * cam_from_tool;
+  return rig_from_tool->t.allFinite();
+}
+
+// Fits rig_from_tool to the used observations; returns false when Ceres
+// could not produce a usable solution.
+bool FitPose(const Rig& rig, const std::vector<TagObs>& obs,
+             const std::vector<bool>& used, double huber_px, int max_iterations,
+             Rigid3* rig_from_tool) {
+  const Eigen::Quaterniond q0(rig_from_tool->R);
+  double q[4] = {q0.w(), q0.x(), q0.y(), q0.z()};
+  double t[3] = {rig_from_tool->t.x(), rig_from_tool->t.y(),
+                 rig_from_tool->t.z()};
+  ceres::Problem problem;
+  for (size_t i = 0; i < obs.size(); ++i) {
+    if (!used[i]) continue;
+    const Camera& cam = rig.cameras[obs[i].camera];
+    for (int k = 0; k < 4; ++k) {
+      problem.AddResidualBlock(
+          ToolCornerReprojectionCost::Create(obs[i].det->corners[k],
+                                             obs[i].tag->CornerInTool(k), cam),
+          huber_px > 0 ? new ceres::HuberLoss(huber_px) : nullptr, q, t);
+    }
+  }
+  problem.SetManifold(q, new ceres::QuaternionManifold());
+  ceres::Solver::Options so;
+  so.linear_solver_type = ceres::DENSE_QR;
+  so.max_num_iterations = max_iterations;
+  so.num_threads = 1;
+  so.logging_type = ceres::SILENT;
+  so.function_tolerance = 1e-12;
+  so.gradient_tolerance = 1e-12;
+  so.parameter_tolerance = 1e-12;
+  ceres::Solver::Summary summary;
+  ceres::Solve(so, &problem, &summary);
+  if (!summary.IsSolutionUsable()) return false;
+  const Eigen::Quaterniond qs(q[0], q[1], q[2], q[3]);
+  rig_from_tool->R = qs.normalized().toRotationMatrix();
+  rig_from_tool->t = Eigen::Vector3d(t[0], t[1], t[2]);
+  return rig_from_tool->R.allFinite() && rig_from_tool->t.allFinite();
+}
+
+}  // namespace
+
+void ToolPoseOptions::Check() const {
+  auto fail = [](const char* what, double v) {
+    std::ostringstream os;
+    os << "tool pose option " << what << " = " << v;
+    throw InputError(os.str());
+  };
+  if (!(outlier_px > 0)) fail("outlier_px (expected > 0)", outlier_px);
+  if (!(outlier_ratio >= 1))
+    fail("outlier_ratio (expected >= 1)", outlier_ratio);
+  if (!(huber_px >= 0)) fail("huber_px (expected >= 0)", huber_px);
+  if (min_tag_observations < 1) {
+    fail("min_tag_observations (expected >= 1)", min_tag_observations);
+  }
+  if (max_iterations < 1)
+    fail("max_iterations (expected >= 1)", max_iterations);
+}
+
+bool InitialToolPose(const Rig& rig, const Target& target,
+                     const std::vector<std::vector<TagDetection>>& detections,
+                     Rigid3* rig_from_tool) {
+  return InitialFromObservations(
+      rig, CollectObservations(rig, target, detections), rig_from_tool);
+}
+
+ToolPoseResult EstimateToolPose(
+    const Rig& rig, const Target& target,
+    const std::vector<std::vector<TagDetection>>& detections,
+    const ToolPoseOptions& options) {
+  options.Check();
+  ToolPoseResult result;
+  const std::vector<TagObs> obs = CollectObservations(rig, target, detections);
+  if (static_cast<int>(obs.size()) < options.min_tag_observations ||
+      obs.empty()) {
+    result.why_not = "no tag of the target seen";
+    return result;
+  }
+  Rigid3 pose;
+  if (!InitialFromObservations(rig, obs, &pose)) {
+    result.why_not = "no initial pose (triangulation and PnP failed)";
+    return result;
+  }
+  std::vector<bool> used(obs.size(), true);
+  if (!FitPose(rig, obs, used, options.huber_px, options.max_iterations,
+               &pose)) {
+    result.why_not = "pose fit failed";
+    return result;
+  }
+  // Reject the worst tag observation while it is an outlier, refitting.
+  std::vector<double> rms(obs.size());
+  for (;;) {
+    int n_used = 0;
+    std::vector<double> used_rms;
+    for (size_t i = 0; i < obs.size(); ++i) {
+      rms[i] = TagRms(rig.cameras[obs[i].camera], pose, obs[i]);
+      if (used[i]) {
+        ++n_used;
+        used_rms.push_back(rms[i]);
+      }
+    }
+    std::nth_element(used_rms.begin(), used_rms.begin() + used_rms.size() / 2,
+                     used_rms.end());
+    const double median = used_rms[used_rms.size() / 2];
+    const double limit =
+        std::max(options.outlier_px, options.outlier_ratio * median);
+    int worst = -1;
+    for (size_t i = 0; i < obs.size(); ++i) {
+      if (used[i] && rms[i] > limit && (worst < 0 || rms[i] > rms[worst])) {
+        worst = static_cast<int>(i);
+      }
+    }
+    if (worst < 0 || n_used - 1 < options.min_tag_observations) break;
+    used[worst] = false;
+    if (!FitPose(rig, obs, used, options.huber_px, options.max_iterations,
+                 &pose)) {
+      result.why_not = "pose fit failed after outlier rejection";
+      return result;
+    }
+  }
+  // Final plain least-squares fit on the inliers.
+  if (!FitPose(rig, obs, used, 0.0, options.max_iterations, &pose)) {
+    result.why_not = "final pose fit failed";
+    return result;
+  }
+  double sum = 0;
+  int corners = 0;
+  for (size_t i = 0; i < obs.size(); ++i) {
+    const double r = TagRms(rig.cameras[obs[i].camera], pose, obs[i]);
+    result.tags.push_back({obs[i].camera, obs[i].tag->id, r, used[i]});
+    if (!used[i]) continue;
+    sum += 4 * r * r;
+    corners += 4;
+    ++result.tags_used;
+  }
+  // A single tag in a single camera fixes the pose only weakly, but it does
+  // fix it; the caller sees tags_used.
+  result.found = true;
+  result.rig_from_tool = pose;
+  result.tip_in_rig = pose * target.tip_in_tool;
+  result.rms_px = std::sqrt(sum / corners);
+  return result;
+}
+
+}  // namespace kincal

@@ -1,0 +1,138 @@
+#include "vision/tool_pose.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+
+#include "vision/render.h"
+#include "vision/triangulate.h"
+
+namespace kincal {
+namespace {
+
+double RotationErrorDeg(const Eigen::Matrix3d& a, const Eigen::Matrix3d& b) {
+  return Eigen::AngleAxisd(a.transpose() * b).angle() * 180.0 / M_PI;
+}
+
+TEST(Triangulate, ExactOnDistortedRig) {
+  const Rig rig = ExampleStereoRig(640, 512);
+  for (const Eigen::Vector3d& p :
+       {Eigen::Vector3d(50, -30, 420), Eigen::Vector3d(80, 60, 520),
+        Eigen::Vector3d(20, 10, 380)}) {
+    std::vector<PixelObservation> obs;
+    for (int c = 0; c < 2; ++c) {
+      obs.push_back({c, Project(rig.cameras[c].intrinsics,
+                                rig.cameras[c].cam_from_rig * p)});
+    }
+    TriangulationOptions linear;
+    linear.refine = false;
+    const TriangulatedPoint a = TriangulatePoint(rig, obs, linear);
+    const TriangulatedPoint b = TriangulatePoint(rig, obs);
+    ASSERT_TRUE(a.ok);
+    ASSERT_TRUE(b.ok);
+    EXPECT_LT((a.p_in_rig - p).norm(), 1e-6);
+    EXPECT_LT((b.p_in_rig - p).norm(), 1e-9);
+    EXPECT_LT(b.rms_px, 1e-9);
+    // With noise, the refined point reprojects no worse than the linear one.
+    obs[0].px += Eigen::Vector2d(0.3, -0.2);
+    obs[1].px += Eigen::Vector2d(-0.1, 0.25);
+    EXPECT_LE(TriangulatePoint(rig, obs).rms_px,
+              TriangulatePoint(rig, obs, linear).rms_px + 1e-12);
+  }
+  EXPECT_FALSE(TriangulatePoint(rig, {{0, {1, 2}}}).ok);
+}
+
+TEST(Triangulate, MatchesCornersById) {
+  TagDetection a, b, c;
+  a.id = 1;
+  b.id = 2;
+  c.id = 1;
+  a.corners[2] = {10, 20};
+  c.corners[2] = {30, 40};
+  const auto m = MatchTagCorners({a, b}, {c});
+  ASSERT_EQ(m.size(), 4u);
+  EXPECT_EQ(m[2].tag_id, 1);
+  EXPECT_EQ(m[2].corner, 2);
+  EXPECT_EQ(m[2].px0, Eigen::Vector2d(10, 20));
+  EXPECT_EQ(m[2].px1, Eigen::Vector2d(30, 40));
+  // A duplicated id is ambiguous.
+  EXPECT_TRUE(MatchTagCorners({a, a}, {c}).empty());
+}
+
+struct PoseErrors {
+  double rot_deg = 0, trans_mm = 0, tip_mm = 0, rms_px = 0;
+};
+
+// Rendered stereo frames of the example tool: pose and tip against truth.
+TEST(ToolPose, RenderedFramesRecoverPoseAndTip) {
+  const Rig rig = ExampleStereoRig(640, 512);
+  const Target target = ExampleTarget();
+  RenderOptions o;
+  o.blur_sigma_px = 0.6;
+  o.noise_sigma = 1.0;
+  StereoRenderer renderer(rig, target, o);
+  AprilTagDetector detector;
+  std::mt19937_64 rng(11);
+  double worst_tip = 0, worst_rot = 0, sum_tip2 = 0;
+  const int n = 4;
+  for (int i = 0; i < n; ++i) {
+    const StereoFrameTruth frame = renderer.Render(ExampleToolPose(i), &rng);
+    std::vector<std::vector<TagDetection>> dets;
+    for (const auto& v : frame.views) dets.push_back(detector.Detect(v.image));
+    const ToolPoseResult r = EstimateToolPose(rig, target, dets);
+    ASSERT_TRUE(r.found) << r.why_not;
+    EXPECT_EQ(r.tags_used, 8);
+    EXPECT_LT(r.rms_px, 0.2);
+    const double tip = (r.tip_in_rig - frame.tip_in_rig).norm();
+    const double rot =
+        RotationErrorDeg(r.rig_from_tool.R, frame.rig_from_tool.R);
+    worst_tip = std::max(worst_tip, tip);
+    worst_rot = std::max(worst_rot, rot);
+    sum_tip2 += tip * tip;
+    EXPECT_LT((r.rig_from_tool.t - frame.rig_from_tool.t).norm(), 0.3);
+  }
+  std::printf("tool pose: tip RMS %.4f mm, worst %.4f mm, worst rot %.4f deg\n",
+              std::sqrt(sum_tip2 / n), worst_tip, worst_rot);
+  EXPECT_LT(worst_tip, 0.1);
+  EXPECT_LT(worst_rot, 0.05);
+}
+
+// One tag observation moved by 6 px is rejected and does not spoil the pose;
+// with the left camera only, PnP + fit still find the tool.
+TEST(ToolPose, RejectsOutlierTagAndWorksWithOneCamera) {
+  const Rig rig = ExampleStereoRig(640, 512);
+  const Target target = ExampleTarget();
+  RenderOptions o;
+  o.blur_sigma_px = 0.6;
+  StereoRenderer renderer(rig, target, o);
+  std::mt19937_64 rng(2);
+  const StereoFrameTruth frame = renderer.Render(ExampleToolPose(2), &rng);
+  AprilTagDetector detector;
+  std::vector<std::vector<TagDetection>> dets;
+  for (const auto& v : frame.views) dets.push_back(detector.Detect(v.image));
+  ASSERT_FALSE(dets[1].empty());
+  for (auto& c : dets[1][0].corners) c += Eigen::Vector2d(6, -2);
+  const ToolPoseResult r = EstimateToolPose(rig, target, dets);
+  ASSERT_TRUE(r.found);
+  EXPECT_EQ(r.tags_used, static_cast<int>(dets[0].size() + dets[1].size()) - 1);
+  bool rejected = false;
+  for (const auto& t : r.tags) {
+    if (t.camera == 1 && t.tag_id == dets[1][0].id) rejected = !t.used;
+  }
+  EXPECT_TRUE(rejected);
+  EXPECT_LT((r.tip_in_rig - frame.tip_in_rig).norm(), 0.3);
+
+  const ToolPoseResult left = EstimateToolPose(rig, target, {dets[0], {}});
+  ASSERT_TRUE(left.found);
+  EXPECT_EQ(left.tags_used, static_cast<int>(dets[0].size()));
+  // One camera: depth is weakly fixed, a few mm at most here.
+  EXPECT_LT((left.tip_in_rig - frame.tip_in_rig).norm(), 3.0);
+
+  const ToolPoseResult none = EstimateToolPose(rig, target, {{}, {}});
+  EXPECT_FALSE(none.found);
+  EXPECT_FALSE(none.why_not.empty());
+}
+
+}  // namespace
+}  // namespace kincal
