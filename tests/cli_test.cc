@@ -1,0 +1,176 @@
+// End-to-end tests of simulate, calibrate and evaluate through the public
+// command line: the contract of ../shared/spec/formats.md (JSON fields, exit
+// codes 0/1/2, no partial output on bad input).
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <nlohmann/json.hpp>
+
+#include "data/atomic_file.h"
+#include "data/robot.h"
+#include "tests/testing/paths.h"
+#include "tests/testing/run.h"
+
+namespace kincal::testing {
+namespace {
+
+using ::testing::HasSubstr;
+
+class CliTest : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    dir_ = new std::string(MakeTempDir("cli"));
+    const RunResult r = RunKincal(
+        "simulate --robot " + SourceDir() +
+        "/data/robots/bh7.yaml --out " + *dir_ +
+        "/s --poses 120 --noise 0.03 --seed 4 --json");
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+  }
+  static std::string Dir() { return *dir_; }
+  static std::string Robot() { return Dir() + "/s/robot.yaml"; }
+  static std::string Obs() { return Dir() + "/s/observations.csv"; }
+  static std::string* dir_;
+};
+std::string* CliTest::dir_ = nullptr;
+
+void WriteText(const std::string& path, const std::string& text) {
+  std::ofstream(path) << text;
+}
+
+TEST_F(CliTest, SimulateWritesSessionWithProvenance) {
+  for (const char* f : {"robot.yaml", "observations.csv", "truth.json"}) {
+    EXPECT_TRUE(Exists(Dir() + "/s/" + f)) << f;
+  }
+  const std::string obs = ReadFile(Obs());
+  EXPECT_THAT(obs, HasSubstr("# written by kincal"));
+  EXPECT_THAT(obs, HasSubstr("--seed 4"));
+  EXPECT_THAT(obs, HasSubstr("pose,j1,j2,j3,j4,j5,x,y,z,t"));
+  // Same seed, same bytes (apart from the command line with its folder).
+  const RunResult again = RunKincal("simulate --robot " + SourceDir() +
+                                    "/data/robots/bh7.yaml --out " + Dir() +
+                                    "/s2 --poses 120 --noise 0.03 --seed 4");
+  ASSERT_EQ(again.exit_code, 0);
+  const std::string obs2 = ReadFile(Dir() + "/s2/observations.csv");
+  EXPECT_EQ(obs.substr(obs.find("pose,")), obs2.substr(obs2.find("pose,")));
+}
+
+TEST_F(CliTest, CalibrateJsonContract) {
+  const std::string out = Dir() + "/cal.yaml";
+  const RunResult r = RunKincal("calibrate --robot " + Robot() + " --obs " +
+                                Obs() + " --out " + out + " --json");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  for (const char* key : {"train_rms_mm", "heldout_rms_mm", "identifiable",
+                          "unidentifiable", "seconds", "command"}) {
+    EXPECT_TRUE(j.contains(key)) << key;
+  }
+  EXPECT_LT(j["heldout_rms_mm"].get<double>(), 0.07);
+  EXPECT_GT(j["identifiable"].size(), 6u);
+  EXPECT_THAT(j["unidentifiable"].dump(), HasSubstr("j1.theta"));
+  // The calibrated model is a valid robot.yaml and evaluates better than the
+  // nominal one.
+  const kincal::Robot cal = ReadRobotYaml(out);
+  EXPECT_EQ(cal.joints.size(), 5u);
+  const RunResult ev =
+      RunKincal("evaluate --robot " + out + " --obs " + Obs() + " --json");
+  ASSERT_EQ(ev.exit_code, 0) << ev.err;
+  const auto e = nlohmann::json::parse(ev.out);
+  for (const char* key : {"n", "rms_mm", "mean_mm", "max_mm", "std_mm"}) {
+    EXPECT_TRUE(e.contains(key)) << key;
+  }
+  EXPECT_EQ(e["n"].get<int>(), 120);
+  const RunResult nominal =
+      RunKincal("evaluate --robot " + Robot() + " --obs " + Obs() + " --json");
+  EXPECT_GT(nlohmann::json::parse(nominal.out)["rms_mm"].get<double>(),
+            5 * e["rms_mm"].get<double>());
+}
+
+TEST_F(CliTest, HumanReadableOutputWithoutJson) {
+  const RunResult r =
+      RunKincal("calibrate --robot " + Robot() + " --obs " + Obs());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_THAT(r.out, HasSubstr("held-out RMS"));
+  EXPECT_THAT(r.out, HasSubstr("held at nominal"));
+}
+
+// Bad input: exit 2, a message with file:line:column, and no output file.
+TEST_F(CliTest, BadInputExitsTwoAndWritesNothing) {
+  const std::string out = Dir() + "/never.yaml";
+  std::string obs = ReadFile(Obs());
+  const std::string bad_obs = Dir() + "/bad.csv";
+  // Corrupt the first data row's j3 cell.
+  const size_t row = obs.find('\n', obs.find("pose,")) + 1;
+  size_t cell = row;
+  for (int k = 0; k < 3; ++k) cell = obs.find(',', cell) + 1;
+  obs.replace(cell, obs.find(',', cell) - cell, "nan");
+  WriteText(bad_obs, obs);
+  RunResult r = RunKincal("calibrate --robot " + Robot() + " --obs " +
+                          bad_obs + " --out " + out + " --json");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_THAT(r.err, HasSubstr(bad_obs + ":"));
+  EXPECT_THAT(r.err, HasSubstr("column 'j3'"));
+  EXPECT_TRUE(r.out.empty());
+  EXPECT_FALSE(Exists(out));
+
+  r = RunKincal("calibrate --robot " + Dir() + "/missing.yaml --obs " + Obs() +
+                " --out " + out);
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_THAT(r.err, HasSubstr("missing.yaml: cannot open"));
+  EXPECT_FALSE(Exists(out));
+
+  WriteText(Dir() + "/bad_robot.yaml", "kincal_robot: 1\njoints: 3\n");
+  r = RunKincal("calibrate --robot " + Dir() + "/bad_robot.yaml --obs " +
+                Obs() + " --out " + out);
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_THAT(r.err, HasSubstr("bad_robot.yaml:2:9: joints: expected a list"));
+
+  r = RunKincal("calibrate --robot " + Robot() + " --obs " + Obs() +
+                " --no-such-option");
+  EXPECT_EQ(r.exit_code, 2);
+
+  r = RunKincal("evaluate --robot " + Robot() + " --obs " + bad_obs + " --json");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_TRUE(r.out.empty());
+  EXPECT_FALSE(Exists(out));
+}
+
+// Data that determine no robot parameter are bad input.
+TEST_F(CliTest, DataThatDetermineNothingExitTwo) {
+  const std::string one = Dir() + "/one_pose.csv";
+  WriteText(one,
+            "pose,j1,j2,j3,j4,j5,x,y,z\n"
+            "0,10,20,30,40,50,100,200,300\n");
+  RunResult r = RunKincal("calibrate --robot " + Robot() + " --obs " + one);
+  EXPECT_EQ(r.exit_code, 2);
+  const std::string same = Dir() + "/same_pose.csv";
+  WriteText(same,
+            "pose,j1,j2,j3,j4,j5,x,y,z\n"
+            "0,10,20,30,40,50,100,200,300\n"
+            "1,10,20,30,40,50,100.1,200,300\n"
+            "2,10,20,30,40,50,100,200.1,300\n");
+  r = RunKincal("calibrate --robot " + Robot() + " --obs " + same);
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_THAT(r.err, HasSubstr("same joint readings"));
+  const std::string few = Dir() + "/few.csv";
+  std::string obs = ReadFile(Obs());
+  size_t pos = obs.find("pose,");
+  for (int k = 0; k < 5; ++k) pos = obs.find('\n', pos) + 1;
+  WriteText(few, obs.substr(0, pos));
+  r = RunKincal("calibrate --robot " + Robot() + " --obs " + few + " --json");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_THAT(r.err, HasSubstr("too few poses"));
+}
+
+TEST_F(CliTest, FailedRunKeepsExistingOutput) {
+  const std::string out = Dir() + "/keep.yaml";
+  WriteText(out, "previous\n");
+  const RunResult r = RunKincal("calibrate --robot " + Robot() +
+                                " --obs /nonexistent.csv --out " + out);
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_EQ(ReadFile(out), "previous\n");
+}
+
+}  // namespace
+}  // namespace kincal::testing
