@@ -1,17 +1,120 @@
+// kincal import: converts public real-data sets into observations.csv.
+//   kincal import ipa-ur10 --in Series_C/measurements_random_poses.csv --out
+//   O.csv kincal import mukca --dir mukca/data/panda_6/front --out O.csv
+
+#include <cstdio>
+#include <memory>
+#include <sstream>
+
 #include "app/command.h"
+#include "data/atomic_file.h"
+#include "data/error.h"
+#include "data/import_ipa.h"
+#include "data/import_mukca.h"
+#include "data/urdf.h"
 
 namespace kincal::app {
+namespace {
 
-// Not built yet: registers the subcommand so usage is stable; exits 1.
+struct ImportArgs {
+  std::string in, dir, out, robot, root, tip;
+  int every = 1;
+  bool json = false;
+};
+
+// Joint names from --robot when given, else the data set's defaults.
+std::vector<std::string> JointNames(const ImportArgs& args,
+                                    const std::vector<std::string>& fallback) {
+  if (args.robot.empty()) return fallback;
+  return ReadRobot(args.robot, args.root, args.tip).JointNames();
+}
+
+Observations EveryNth(const Observations& obs, int every) {
+  Require(every >= 1, "--every must be >= 1");
+  std::vector<int> keep;
+  for (int i = 0; i < static_cast<int>(obs.rows.size()); i += every) {
+    keep.push_back(i);
+  }
+  return Subset(obs, keep);
+}
+
+int Finish(const ImportArgs& args, const Observations& obs,
+           const std::vector<std::string>& comment) {
+  WriteFileAtomic(args.out, FormatObservationsCsv(obs, comment));
+  if (args.json) {
+    PrintJson({{"rows", obs.rows.size()},
+               {"with_points", obs.CountWithPoints()},
+               {"with_fixed_point", obs.CountWithFixedPoint()},
+               {"joints", obs.joint_names},
+               {"out", args.out}});
+  } else {
+    std::printf("kincal import: %zu rows -> %s\n", obs.rows.size(),
+                args.out.c_str());
+  }
+  return 0;
+}
+
+int RunIpa(const ImportArgs& args) {
+  const IpaSeries s =
+      ReadIpaSeries(args.in, JointNames(args, IpaUr10JointNames()));
+  const Observations obs = EveryNth(s.observations, args.every);
+  std::ostringstream c;
+  c << "imported from " << args.in
+    << " (ipa-robot-accuracy UR10, Landgraf et al. 2021, MIT): joint angles "
+       "rad -> deg, Leica T-Mac position in mm (tracker frame)";
+  std::vector<std::string> comment = {c.str()};
+  if (args.every > 1) {
+    comment.push_back("every " + std::to_string(args.every) +
+                      "th row kept; pose ids are the source row numbers");
+  }
+  if (!s.has_time)
+    comment.push_back("no t column: the file's timestamps are truncated");
+  return Finish(args, obs, comment);
+}
+
+int RunMukca(const ImportArgs& args) {
+  const Observations obs = EveryNth(
+      ReadMukcaDir(args.dir, JointNames(args, PandaJointNames())), args.every);
+  return Finish(args, obs,
+                {"imported from " + args.dir +
+                 " (MUKCa, platonics-delft/kinematics_calibration, MIT): "
+                 "hole_0.csv, hole_1.csv joint sets rad -> deg; sockets "
+                 "50 mm apart (use --fixed-distance hole_0,hole_1,50)"});
+}
+
+void CommonOptions(CLI::App* sub, ImportArgs* args) {
+  sub->add_option("--out", args->out, "observations.csv to write")->required();
+  sub->add_option("--robot", args->robot,
+                  "robot file whose joint names the columns map to (in order)");
+  sub->add_option("--root", args->root, "URDF root link");
+  sub->add_option("--tip", args->tip, "URDF tip link");
+  sub->add_option("--every", args->every, "keep every N-th row")
+      ->capture_default_str();
+  sub->add_flag("--json", args->json, "print one JSON object");
+}
+
+}  // namespace
+
 void AddImportCommand(CLI::App& app, Runner* run) {
-  CLI::App* sub = app.add_subcommand("import", "(not implemented yet)");
-  sub->allow_extras();
-  sub->callback([run] {
-    *run = [] {
-      std::fprintf(stderr, "kincal import: not implemented yet\n");
-      return 1;
-    };
-  });
+  CLI::App* sub = app.add_subcommand(
+      "import", "Convert public real-data sets into observations.csv");
+  sub->require_subcommand(1);
+
+  auto ipa = std::make_shared<ImportArgs>();
+  CLI::App* s1 = sub->add_subcommand(
+      "ipa-ur10",
+      "UR10 laser-tracker series of ipa-robot-accuracy (';', decimal commas)");
+  s1->add_option("--in", ipa->in, "Series_X/measurements_*.csv")->required();
+  CommonOptions(s1, ipa.get());
+  s1->callback([run, ipa] { *run = [ipa] { return RunIpa(*ipa); }; });
+
+  auto mukca = std::make_shared<ImportArgs>();
+  CLI::App* s2 = sub->add_subcommand(
+      "mukca", "MUKCa Panda socket recording (hole_0.csv, hole_1.csv)");
+  s2->add_option("--dir", mukca->dir, "folder with hole_0.csv and hole_1.csv")
+      ->required();
+  CommonOptions(s2, mukca.get());
+  s2->callback([run, mukca] { *run = [mukca] { return RunMukca(*mukca); }; });
 }
 
 }  // namespace kincal::app

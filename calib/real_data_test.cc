@@ -1,0 +1,185 @@
+// Real data (../shared/data, skipped when absent): the UR10 laser-tracker
+// series of ipa-robot-accuracy and the MUKCa Panda socket recordings.
+// Bounds are what was measured (docs/REAL_DATA.md) with a margin, so a
+// regression in the calibration shows up here.
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <map>
+
+#include "calib/calibrate.h"
+#include "calib/evaluate.h"
+#include "calib/paper_method.h"
+#include "data/import_ipa.h"
+#include "data/import_mukca.h"
+#include "data/robot.h"
+#include "data/urdf.h"
+#include "tests/testing/paths.h"
+
+namespace kincal {
+namespace {
+
+std::string Ipa(const std::string& file) {
+  return testing::SharedDataDir() + "/ipa-robot-accuracy/" + file;
+}
+
+Robot Ur10() {
+  return ReadRobotYaml(testing::SourceDir() + "/data/robots/ur10.yaml");
+}
+
+Observations EveryNth(const Observations& obs, int every) {
+  std::vector<int> keep;
+  for (int i = 0; i < static_cast<int>(obs.rows.size()); i += every)
+    keep.push_back(i);
+  return Subset(obs, keep);
+}
+
+// data/robots/ur10.yaml against the data set's own commanded positions:
+// the "Goal" TCP (the T-Mac, 109 mm out of the flange) of every pose of
+// series C is where the nominal model puts it, in the ROS `base` frame,
+// which is the DH base turned 180 deg about z (ur_description's base vs
+// base_link).
+TEST(RealDataTest, Ur10NominalModelReproducesTheCommandedGoals) {
+  KINCAL_REQUIRE_SHARED_DATA("ipa-robot-accuracy");
+  const IpaSeries c =
+      ReadIpaSeries(Ipa("Series_C/measurements_random_poses.csv"));
+  const Chain chain = Chain::FromRobot(Ur10());
+  double worst = 0.0;
+  for (size_t i = 0; i < c.observations.rows.size(); ++i) {
+    PoseInput in;
+    for (double q : c.observations.rows[i].q) in.q.push_back(q * M_PI / 180);
+    in.s.assign(6, 0.0);
+    in.tau.assign(6, 0.0);
+    const Eigen::Vector3d tip = TipInBase(chain, in);
+    const Eigen::Vector3d in_ros_base(-tip.x(), -tip.y(), tip.z());
+    worst = std::max(worst, (in_ros_base - c.goal_mm[i]).norm());
+  }
+  // Goals and joint angles have 6 significant digits (0.1 mm at 1 m), and
+  // the controller solved them with its own factory kinematics: agreement
+  // to a fraction of a millimetre, with the 109 mm tool; a wrong tool
+  // length or joint sign would be off by centimetres.
+  EXPECT_LT(worst, 1.0);
+}
+
+// Calibrate on series C (20 % held out), then register only the frame on
+// series B and on every 10th pose of series A. Measured (Release, seed 1):
+// C held-out 0.501 mm, B 0.922 mm, A 0.858 mm with the 23 identifiable DH
+// parameters; with gravity compliance of the shoulder and elbow joints
+// freed as well: C 0.496, B 0.563, A 0.625 mm. Nominal on B: 2.92 mm.
+TEST(RealDataTest, Ur10CalibrateOnSeriesCPredictsSeriesAAndB) {
+  KINCAL_REQUIRE_SHARED_DATA("ipa-robot-accuracy");
+  const Robot nominal = Ur10();
+  const Observations c =
+      ReadIpaSeries(Ipa("Series_C/measurements_random_poses.csv")).observations;
+  const Observations b =
+      ReadIpaSeries(Ipa("Series_B/measurements_joint_configurations.csv"))
+          .observations;
+  const Observations a = EveryNth(
+      ReadIpaSeries(Ipa("Series_A/measurements_grid.csv")).observations, 10);
+
+  const EvaluateResult nominal_b = Evaluate(nominal, b);
+  EXPECT_GT(nominal_b.stats.rms_mm, 2.0);
+
+  const CalibrateResult dh = Calibrate(nominal, c, {});
+  EXPECT_EQ(dh.heldout.n, 555);
+  EXPECT_LT(dh.heldout.rms_mm, 0.55);
+  EXPECT_LT(dh.train.rms_mm, 0.52);
+  EXPECT_EQ(dh.identifiability.identifiable.size(), 6u + 17u);
+  EXPECT_LT(Evaluate(dh.calibrated, b).stats.rms_mm, 1.0);
+  EXPECT_LT(Evaluate(dh.calibrated, a).stats.rms_mm, 0.95);
+
+  CalibrateOptions with_compliance;
+  with_compliance.extra_params = {"shoulder_lift_joint.compliance",
+                                  "elbow_joint.compliance"};
+  const CalibrateResult comp = Calibrate(nominal, c, with_compliance);
+  const double on_b = Evaluate(comp.calibrated, b).stats.rms_mm;
+  const double on_a = Evaluate(comp.calibrated, a).stats.rms_mm;
+  RecordProperty("heldout_b_mm", std::to_string(on_b));
+  EXPECT_LT(comp.heldout.rms_mm, 0.55);
+  EXPECT_LT(on_b, 0.62);  // the target: <= 0.80 mm
+  EXPECT_LT(on_a, 0.70);
+}
+
+std::string Mukca(const std::string& path) {
+  return testing::SharedDataDir() + "/mukca/" + path;
+}
+
+// RMS distance to the socket centroid per socket (hole_0, hole_1).
+std::map<std::string, double> PerSocketRms(const Observations& obs,
+                                           const EvaluateResult& r) {
+  std::map<std::string, double> sum;
+  std::map<std::string, int> n;
+  for (size_t i = 0; i < r.rows.size(); ++i) {
+    const std::string& label = obs.rows[r.rows[i]].fixed_point;
+    sum[label] += r.errors_mm[i] * r.errors_mm[i];
+    ++n[label];
+  }
+  for (auto& kv : sum) kv.second = std::sqrt(kv.second / n[kv.first]);
+  return sum;
+}
+
+// The seed's single-point method on a real Panda (panda_6, recording
+// "front", 62 poses in two sockets 50 mm apart) with the known distance as
+// scale. The authors' kpis.yaml for the same recording: per-axis variances
+// 5.5e-9, 9.5e-9, 1.31e-8 m^2 (hole 1) and 7.8e-9, 2.31e-8, 1.88e-8 m^2
+// (hole 2), i.e. RMS 0.168 and 0.223 mm, distance error -0.0029 mm.
+TEST(RealDataTest, MukcaPandaSinglePointWithKnownDistance) {
+  KINCAL_REQUIRE_SHARED_DATA("mukca");
+  const Robot urdf =
+      ReadRobot(Mukca("calibrated_urdf/panda_6/panda.urdf"), "", "ball_link");
+  const Observations front = ReadMukcaDir(Mukca("data/panda_6/front"));
+  ASSERT_EQ(urdf.JointNames(), PandaJointNames());
+
+  const EvaluateResult before = Evaluate(urdf, front);
+  const auto before_socket = PerSocketRms(front, before);
+
+  // The parameters the data determine (least-squares pass, 0.1 s), then
+  // eq. (9) on them with a bounded budget (the CLI's default budget of
+  // 200000 evaluations takes ~30 s here and ends at the same eps +- 1 um).
+  CalibrateOptions lsq_opt;
+  lsq_opt.holdout_fraction = 0.0;
+  lsq_opt.distances.push_back({"hole_0", "hole_1", 50.0});
+  const CalibrateResult lsq = Calibrate(urdf, front, lsq_opt);
+  const Chain nominal = Chain::FromRobot(urdf);
+  ModelState state;
+  state.chain = nominal;
+  const std::vector<Measurement> ms = MakeMeasurements(nominal, front, &state);
+  PaperOptions po;
+  po.bounds_center = &nominal;
+  po.max_evaluations = 30000;
+  for (const ParamInfo& p : lsq.identifiability.identifiable) {
+    if (p.kind == ParamKind::kRow) po.free.push_back(p);
+  }
+  PointDistance d;
+  d.a = state.PointIndex("hole_0");
+  d.b = state.PointIndex("hole_1");
+  d.distance_mm = 50.0;
+  po.distances.push_back(d);
+  EXPECT_GT(po.free.size(), 20u);
+  FitPaperObjective(ms, po, &state);
+  const double eps = PaperEpsilon(state, ms);
+  const auto& p0 = state.points_in_base[d.a];
+  const auto& p1 = state.points_in_base[d.b];
+  const double distance = std::sqrt((p0[0] - p1[0]) * (p0[0] - p1[0]) +
+                                    (p0[1] - p1[1]) * (p0[1] - p1[1]) +
+                                    (p0[2] - p1[2]) * (p0[2] - p1[2]));
+  // The exact penalty holds the known distance.
+  EXPECT_LT(std::abs(distance - 50.0), 0.003);
+  Robot calibrated = state.chain.ToRobot(urdf);
+  // Per-socket scatter at the authors' level (0.17 / 0.22 mm) and not above
+  // the model the data came with.
+  const EvaluateResult after = Evaluate(calibrated, front);
+  const auto socket = PerSocketRms(front, after);
+  ASSERT_EQ(socket.size(), 2u);
+  EXPECT_LT(socket.at("hole_0"), 0.25);
+  EXPECT_LT(socket.at("hole_1"), 0.25);
+  EXPECT_LE(eps, before.stats.mean_mm + 1e-3);
+  EXPECT_LE(eps, lsq.epsilon.mean_mm + 0.01);
+  EXPECT_LT(eps, 0.2);
+  EXPECT_GT(before_socket.at("hole_0"), 0.1);  // real seating scatter
+}
+
+}  // namespace
+}  // namespace kincal
