@@ -1,0 +1,347 @@
+#include "capture/recorder.h"
+
+#include <dirent.h>
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+#include <yaml-cpp/yaml.h>
+
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
+#include <ctime>
+#include <opencv2/imgcodecs.hpp>
+#include <set>
+#include <sstream>
+#include <thread>
+
+#include "data/atomic_file.h"
+#include "data/csv.h"
+#include "data/error.h"
+#include "data/provenance.h"
+
+namespace kincal::capture {
+namespace {
+
+Status IoError(const std::string& path, const std::string& what, int err) {
+  return Status::Error(Status::Kind::kIoError,
+                       path + ": " + what + ": " + std::strerror(err));
+}
+
+// True when `dir` does not exist or holds no entries.
+bool IsAbsentOrEmpty(const std::string& dir) {
+  DIR* d = ::opendir(dir.c_str());
+  if (d == nullptr) return errno == ENOENT;
+  bool empty = true;
+  while (dirent* e = ::readdir(d)) {
+    if (std::strcmp(e->d_name, ".") != 0 && std::strcmp(e->d_name, "..") != 0) {
+      empty = false;
+      break;
+    }
+  }
+  ::closedir(d);
+  return empty;
+}
+
+std::string UtcNow() {
+  const std::time_t now = std::time(nullptr);
+  std::tm tm{};
+  ::gmtime_r(&now, &tm);
+  char buf[32];
+  std::strftime(buf, sizeof(buf), "%Y-%m-%dT%H:%M:%SZ", &tm);
+  return buf;
+}
+
+std::string Fixed(double v, int digits) {
+  char buf[64];
+  std::snprintf(buf, sizeof(buf), "%.*f", digits, v);
+  return buf;
+}
+
+// Runs a data/ writer (which throws InputError) and returns its Status.
+template <typename F>
+Status Guard(F&& f) {
+  try {
+    f();
+    return Status::Ok();
+  } catch (const std::exception& e) {
+    return Status::Error(Status::Kind::kIoError, e.what());
+  }
+}
+
+}  // namespace
+
+Status WriteBytes(const std::string& path, const void* data, size_t size) {
+  const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  if (fd < 0) return IoError(path, "cannot create", errno);
+  const char* p = static_cast<const char*>(data);
+  size_t left = size;
+  while (left > 0) {
+    const ssize_t n = ::write(fd, p, left);
+    if (n < 0) {
+      if (errno == EINTR) continue;
+      const int err = errno;
+      ::close(fd);
+      return IoError(path, "write failed", err);
+    }
+    p += n;
+    left -= static_cast<size_t>(n);
+  }
+  // close() reports delayed write errors (e.g. ENOSPC on network folders).
+  if (::close(fd) != 0) return IoError(path, "write failed", errno);
+  return Status::Ok();
+}
+
+Status WritePngAtomic(const std::string& path, const cv::Mat& image,
+                      int compression, size_t* bytes) {
+  std::vector<uchar> png;
+  bool encoded = false;
+  try {
+    encoded = !image.empty() &&
+              cv::imencode(".png", image, png,
+                           {cv::IMWRITE_PNG_COMPRESSION, compression});
+  } catch (const cv::Exception& e) {
+    return Status::Error(Status::Kind::kUnsupported,
+                         path + ": cannot encode PNG: " + e.what());
+  }
+  if (!encoded) {
+    return Status::Error(Status::Kind::kUnsupported,
+                         path +
+                             ": cannot encode an empty or non-8/16-bit "
+                             "image as PNG");
+  }
+  const std::string part = path + ".part";
+  Status s = WriteBytes(part, png.data(), png.size());
+  if (!s.ok()) {
+    ::unlink(part.c_str());
+    return s;
+  }
+  if (::rename(part.c_str(), path.c_str()) != 0) {
+    const int err = errno;
+    ::unlink(part.c_str());
+    return IoError(path, "cannot rename " + part, err);
+  }
+  if (bytes) *bytes = png.size();
+  return Status::Ok();
+}
+
+Status MakeDirs(const std::string& dir) {
+  if (dir.empty()) {
+    return Status::Error(Status::Kind::kIoError, "empty folder name");
+  }
+  size_t pos = 0;
+  while (pos != std::string::npos) {
+    pos = dir.find('/', pos + 1);
+    const std::string part = dir.substr(0, pos);
+    if (part.empty()) continue;
+    if (::mkdir(part.c_str(), 0755) != 0 && errno != EEXIST) {
+      return IoError(part, "cannot create folder", errno);
+    }
+    struct stat st {};
+    if (::stat(part.c_str(), &st) != 0 || !S_ISDIR(st.st_mode)) {
+      return Status::Error(Status::Kind::kIoError,
+                           part + ": exists and is not a folder");
+    }
+  }
+  return Status::Ok();
+}
+
+SessionRecorder::~SessionRecorder() {
+  if (journal_) std::fclose(journal_);
+}
+
+std::string SessionRecorder::FrameFileName(int64_t frame) {
+  char buf[32];
+  std::snprintf(buf, sizeof(buf), "%06lld.png", static_cast<long long>(frame));
+  return buf;
+}
+
+std::string SessionRecorder::CsvHeader() const {
+  std::string h = "frame,t_left,t_right,seq_left,seq_right";
+  for (const std::string& j : info_.joint_names) h += "," + CsvQuote(j);
+  return h + "\n";
+}
+
+Status SessionRecorder::Open(const std::string& dir, const SessionInfo& info) {
+  if (open_) {
+    return Status::Error(Status::Kind::kIoError,
+                         "recorder already open on " + dir_);
+  }
+  std::set<std::string> names = {"frame", "t_left", "t_right", "seq_left",
+                                 "seq_right"};
+  for (const std::string& j : info.joint_names) {
+    if (j.empty() || !names.insert(j).second) {
+      return Status::Error(
+          Status::Kind::kUnsupported,
+          "joint column '" + j + "' is empty or repeats another column");
+    }
+  }
+  if (!IsAbsentOrEmpty(dir)) {
+    return Status::Error(Status::Kind::kIoError,
+                         dir +
+                             ": exists and is not empty (kincal never "
+                             "overwrites a session; choose a new folder)");
+  }
+  for (const std::string& d : {dir, dir + "/left", dir + "/right"}) {
+    Status s = MakeDirs(d);
+    if (!s.ok()) return s;
+  }
+  dir_ = dir;
+  info_ = info;
+  started_utc_ = UtcNow();
+  rows_.clear();
+  frames_ = 0;
+  bytes_ = 0;
+  const std::string journal = dir_ + "/frames.csv.part";
+  journal_ = std::fopen(journal.c_str(), "w");
+  if (journal_ == nullptr) return IoError(journal, "cannot create", errno);
+  if (std::fputs(CsvHeader().c_str(), journal_) < 0 ||
+      std::fflush(journal_) != 0) {
+    return IoError(journal, "write failed", errno);
+  }
+  Status s = Guard(
+      [&] { WriteFileAtomic(dir_ + "/session.yaml", SessionYaml(nullptr)); });
+  if (!s.ok()) return s;
+  open_ = true;
+  return Status::Ok();
+}
+
+Status SessionRecorder::Write(const StereoFrame& pair,
+                              const std::vector<double>& joints) {
+  if (!open_) {
+    return Status::Error(Status::Kind::kIoError, "recorder not open");
+  }
+  if (joints.size() != info_.joint_names.size()) {
+    return Status::Error(
+        Status::Kind::kUnsupported,
+        "frame " + std::to_string(frames_) + ": " +
+            std::to_string(joints.size()) + " joint values for " +
+            std::to_string(info_.joint_names.size()) + " joint columns");
+  }
+  if (frames_ >= kMaxFrames) {
+    return Status::Error(Status::Kind::kUnsupported,
+                         "a session holds at most " +
+                             std::to_string(kMaxFrames) +
+                             " frames (file names must sort in order)");
+  }
+  const std::string name = FrameFileName(frames_);
+  const std::string left = dir_ + "/left/" + name;
+  const std::string right = dir_ + "/right/" + name;
+  // PNG encoding dominates; the two sides are encoded on two threads.
+  size_t left_bytes = 0, right_bytes = 0;
+  Status left_status;
+  std::thread left_writer([&] {
+    left_status = WritePngAtomic(left, pair.left.image,
+                                 options_.png_compression, &left_bytes);
+  });
+  const Status right_status = WritePngAtomic(
+      right, pair.right.image, options_.png_compression, &right_bytes);
+  left_writer.join();
+  if (!left_status.ok() || !right_status.ok()) {
+    ::unlink(left.c_str());  // never leave half a pair
+    ::unlink(right.c_str());
+    return left_status.ok() ? right_status : left_status;
+  }
+  std::string row = std::to_string(frames_) + "," +
+                    Fixed(pair.left.timestamp_s, 6) + "," +
+                    Fixed(pair.right.timestamp_s, 6) + "," +
+                    std::to_string(pair.left.sequence) + "," +
+                    std::to_string(pair.right.sequence);
+  for (double v : joints) {
+    std::ostringstream os;
+    os.precision(10);
+    os << v;
+    row += "," + os.str();
+  }
+  row += "\n";
+  if (std::fputs(row.c_str(), journal_) < 0 || std::fflush(journal_) != 0) {
+    const int err = errno;
+    ::unlink(left.c_str());
+    ::unlink(right.c_str());
+    return IoError(dir_ + "/frames.csv.part", "write failed", err);
+  }
+  rows_.push_back(std::move(row));
+  bytes_ += left_bytes + right_bytes;
+  ++frames_;
+  return Status::Ok();
+}
+
+Status SessionRecorder::Finalize(const SessionSummary& summary) {
+  if (!open_) {
+    return Status::Error(Status::Kind::kIoError, "recorder not open");
+  }
+  open_ = false;
+  std::string csv = "# " + CommandLine() + "\n" + CsvHeader();
+  for (const std::string& r : rows_) csv += r;
+  Status s = Guard([&] { WriteFileAtomic(dir_ + "/frames.csv", csv); });
+  if (s.ok()) {
+    s = Guard([&] {
+      WriteFileAtomic(dir_ + "/session.yaml", SessionYaml(&summary));
+    });
+  }
+  if (journal_) {
+    std::fclose(journal_);
+    journal_ = nullptr;
+  }
+  // Keep the journal when frames.csv could not be written.
+  if (s.ok()) ::unlink((dir_ + "/frames.csv.part").c_str());
+  return s;
+}
+
+std::string SessionRecorder::SessionYaml(const SessionSummary* summary) const {
+  YAML::Emitter y;
+  y << YAML::BeginMap;
+  y << YAML::Key << "kincal_session" << YAML::Value << 1;
+  y << YAML::Key << "status" << YAML::Value
+    << (summary == nullptr ? "recording"
+                           : (summary->complete ? "complete" : "failed"));
+  y << YAML::Key << "started_utc" << YAML::Value << started_utc_;
+  y << YAML::Key << "tool" << YAML::Value << ToolVersion();
+  y << YAML::Key << "command" << YAML::Value << CommandLine();
+  y << YAML::Key << "frames" << YAML::Value << frames_;
+  y << YAML::Key << "images" << YAML::Value << YAML::BeginMap;
+  y << YAML::Key << "left" << YAML::Value << "left/*.png";
+  y << YAML::Key << "right" << YAML::Value << "right/*.png";
+  y << YAML::Key << "format" << YAML::Value << "png";
+  y << YAML::Key << "png_compression" << YAML::Value
+    << options_.png_compression;
+  y << YAML::EndMap;
+  y << YAML::Key << "frames_csv" << YAML::Value << "frames.csv";
+  y << YAML::Key << "sources" << YAML::Value << YAML::BeginMap;
+  for (int side = 0; side < 2; ++side) {
+    y << YAML::Key << (side == 0 ? "left" : "right") << YAML::Value
+      << YAML::BeginMap;
+    y << YAML::Key << "uri" << YAML::Value
+      << (side == 0 ? info_.left_uri : info_.right_uri);
+    y << YAML::Key << "description" << YAML::Value
+      << (side == 0 ? info_.left_description : info_.right_description);
+    y << YAML::EndMap;
+  }
+  y << YAML::EndMap;
+  y << YAML::Key << "live" << YAML::Value << info_.live;
+  y << YAML::Key << "time_base" << YAML::Value << info_.time_base;
+  y << YAML::Key << "pairing" << YAML::Value << YAML::BeginMap;
+  y << YAML::Key << "mode" << YAML::Value << info_.pairing;
+  y << YAML::Key << "tolerance_s" << YAML::Value << info_.tolerance_s;
+  if (summary != nullptr) {
+    y << YAML::Key << "dropped_left" << YAML::Value << summary->dropped_left;
+    y << YAML::Key << "dropped_right" << YAML::Value << summary->dropped_right;
+    y << YAML::Key << "length_mismatch" << YAML::Value
+      << summary->length_mismatch;
+  }
+  y << YAML::EndMap;
+  y << YAML::Key << "joints" << YAML::Value << YAML::Flow << info_.joint_names;
+  y << YAML::Key << "settings" << YAML::Value << YAML::BeginMap;
+  for (const auto& [k, v] : info_.settings) {
+    y << YAML::Key << k << YAML::Value << v;
+  }
+  y << YAML::EndMap;
+  if (summary != nullptr) {
+    y << YAML::Key << "stop_reason" << YAML::Value << summary->stop_reason;
+    y << YAML::Key << "seconds" << YAML::Value << summary->seconds;
+  }
+  y << YAML::EndMap;
+  return "# " + CommandLine() + "\n" + y.c_str() + "\n";
+}
+
+}  // namespace kincal::capture

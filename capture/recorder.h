@@ -1,0 +1,114 @@
+#ifndef KINCAL_CAPTURE_RECORDER_H_
+#define KINCAL_CAPTURE_RECORDER_H_
+
+#include <cstddef>
+#include <cstdint>
+#include <cstdio>
+#include <map>
+#include <opencv2/core.hpp>
+#include <string>
+#include <vector>
+
+#include "capture/stereo_grabber.h"
+
+namespace kincal::capture {
+
+// What session.yaml records about how a session was made.
+struct SessionInfo {
+  std::string left_uri;
+  std::string right_uri;
+  std::string left_description;
+  std::string right_description;
+  bool live = false;
+  std::string pairing;  // "lockstep" / "timestamp"
+  double tolerance_s = 0;
+  std::string time_base;  // "host_monotonic" / "media"
+  // Extra frames.csv columns (robot joint readings), in order; each Write
+  // passes one value per name.
+  std::vector<std::string> joint_names;
+  // Free-form settings recorded as given (e.g. "frames": "200").
+  std::map<std::string, std::string> settings;
+};
+
+// How a session ended, recorded by Finalize.
+struct SessionSummary {
+  std::string stop_reason;  // "frames", "seconds", "end_of_stream", ...
+  bool complete = true;     // false after a failure
+  int64_t dropped_left = 0;
+  int64_t dropped_right = 0;
+  bool length_mismatch = false;
+  double seconds = 0;  // wall time of the recording
+};
+
+// Writes a session folder that `kincal track` reads directly:
+//
+//   DIR/left/000000.png, 000001.png, ...    lossless PNG, one per pair
+//   DIR/right/000000.png, ...               same names: sorted, they pair
+//   DIR/frames.csv                          frame,t_left,t_right,seq_left,
+//                                           seq_right[,joint columns]
+//   DIR/session.yaml                        sources, settings, command line,
+//                                           start time, how it ended
+//
+// Images are written as they come (each to a ".part" file renamed when
+// complete, so no truncated PNG is ever matched by left/*.png); rows go to
+// frames.csv.part as they come, and Finalize writes frames.csv and
+// session.yaml atomically. Every failure (disk full, folder removed) is a
+// Status; after a failed Write the pair is not on disk.
+class SessionRecorder {
+ public:
+  struct Options {
+    int png_compression = 1;  // 0..9: zlib level, all lossless; 1 is fastest
+  };
+
+  SessionRecorder() = default;
+  explicit SessionRecorder(Options options) : options_(options) {}
+  ~SessionRecorder();
+  SessionRecorder(const SessionRecorder&) = delete;
+  SessionRecorder& operator=(const SessionRecorder&) = delete;
+
+  // Creates DIR (and parents), DIR/left and DIR/right, and a first
+  // session.yaml (status: recording). DIR must not exist or be empty.
+  Status Open(const std::string& dir, const SessionInfo& info);
+  // Writes one pair as frame frames(); `joints` has one value per
+  // SessionInfo::joint_names entry (kUnsupported otherwise).
+  Status Write(const StereoFrame& pair, const std::vector<double>& joints = {});
+  // Writes frames.csv and session.yaml (atomically) and removes the journal.
+  Status Finalize(const SessionSummary& summary);
+
+  int64_t frames() const { return frames_; }
+  uint64_t bytes_written() const { return bytes_; }
+  const std::string& dir() const { return dir_; }
+
+  // "000042.png"
+  static std::string FrameFileName(int64_t frame);
+  // The largest frame count whose names still sort in numeric order.
+  static constexpr int64_t kMaxFrames = 1000000;
+
+ private:
+  std::string SessionYaml(const SessionSummary* summary) const;
+  std::string CsvHeader() const;
+
+  Options options_;
+  std::string dir_;
+  SessionInfo info_;
+  std::string started_utc_;
+  std::vector<std::string> rows_;
+  int64_t frames_ = 0;
+  uint64_t bytes_ = 0;
+  bool open_ = false;
+  std::FILE* journal_ = nullptr;  // frames.csv.part, one row per Write
+};
+
+// Writes `size` bytes to `path` (created or truncated), reporting any
+// failure (ENOSPC, EIO, EACCES, ...) as kIoError with the OS message.
+Status WriteBytes(const std::string& path, const void* data, size_t size);
+// Encodes `image` as PNG (lossless) and writes it to path + ".part", then
+// renames it to `path`.
+Status WritePngAtomic(const std::string& path, const cv::Mat& image,
+                      int compression, size_t* bytes = nullptr);
+// mkdir -p; kIoError naming the part that could not be made.
+Status MakeDirs(const std::string& dir);
+
+}  // namespace kincal::capture
+
+#endif  // KINCAL_CAPTURE_RECORDER_H_

@@ -1,0 +1,7 @@
+# End-to-end tests of `kincal capture` (runs build/bin/kincal).
+kincal_test(e2e_capture_cli_test
+  SOURCES ${CMAKE_CURRENT_SOURCE_DIR}/capture_cli_test.cc
+  DEPS kincal_capture nlohmann_json::nlohmann_json)
+if(TARGET e2e_capture_cli_test)
+  add_dependencies(e2e_capture_cli_test kincal)
+endif()
