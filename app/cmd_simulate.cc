@@ -1,5 +1,6 @@
 // kincal simulate: a seeded synthetic session for any robot file.
 
+#include <algorithm>
 #include <cstdio>
 #include <iostream>
 #include <memory>
@@ -12,6 +13,7 @@
 #include "data/error.h"
 #include "data/provenance.h"
 #include "data/urdf.h"
+#include "vision/render.h"
 
 namespace kincal::app {
 namespace {
@@ -21,9 +23,77 @@ struct SimulateArgs {
   std::vector<std::string> effects;
   SimulateOptions options;
   bool no_time = false, no_points = false, json = false;
+  // --render: stereo images of the tool target at every pose.
+  bool render = false;
+  int render_width = 1280, render_height = 1024;
+  RenderOptions render_options;
 };
 
-int RunSimulate(const SimulateArgs& args) {
+// The tool frame of vision's example target relative to the needle tip
+// frame: the needle (tip z) runs along tool y from the tags to the tip, tool
+// z (into the tags) along tip x. tip_from_tool maps tool points to tip.
+Rigid3 TipFromTool(const Target& target) {
+  Rigid3 tip_from_tool;
+  tip_from_tool.R << 0, 0, 1,  //
+      1, 0, 0,                  //
+      0, 1, 0;
+  tip_from_tool.t = -(tip_from_tool.R * target.tip_in_tool);
+  return tip_from_tool;
+}
+
+Rigid3 ToRigid(const Eigen::Matrix4d& m) {
+  Rigid3 r;
+  r.R = m.block<3, 3>(0, 0);
+  r.t = m.block<3, 1>(0, 3);
+  return r;
+}
+
+// Places the stereo rig so that it sees every tip and looks along the mean
+// direction the tags face away from (so they face the cameras on average):
+// rig_from_base as [rotation vector rad, t mm]. Returns the distance.
+double PlaceRig(const std::vector<Eigen::Matrix4d>& base_from_tip,
+                const Rig& rig, const Rigid3& tip_from_tool,
+                std::array<double, 6>* rig_from_base) {
+  Eigen::Vector3d centroid = Eigen::Vector3d::Zero(), mean_z = Eigen::Vector3d::Zero();
+  for (const Eigen::Matrix4d& m : base_from_tip) {
+    centroid += m.block<3, 1>(0, 3);
+    mean_z += m.block<3, 3>(0, 0) * tip_from_tool.R.col(2);
+  }
+  centroid /= static_cast<double>(base_from_tip.size());
+  Eigen::Vector3d z = mean_z.norm() > 1e-6 ? mean_z.normalized()
+                                           : Eigen::Vector3d(0, 0, -1);
+  const Eigen::Vector3d e = std::abs(z.z()) < 0.9 ? Eigen::Vector3d::UnitZ()
+                                                  : Eigen::Vector3d::UnitX();
+  const Eigen::Vector3d x = z.cross(e).normalized();
+  const Eigen::Vector3d y = z.cross(x);
+  const auto& cam = rig.cameras.at(0).intrinsics;
+  const double tan_half =
+      0.8 * std::min(cam.width / (2.0 * cam.fx), cam.height / (2.0 * cam.fy));
+  // Distance at which 90 % of the tips are in view (the rest leave the
+  // image, as on a real rig), at least the target's working distance.
+  std::vector<double> needed;
+  for (const Eigen::Matrix4d& m : base_from_tip) {
+    const Eigen::Vector3d d = m.block<3, 1>(0, 3) - centroid;
+    const double lateral = std::hypot(d.dot(x), d.dot(y));
+    needed.push_back(lateral / tan_half - d.dot(z));
+  }
+  std::sort(needed.begin(), needed.end());
+  const double distance =
+      std::max(450.0, needed[static_cast<size_t>(0.9 * (needed.size() - 1))]);
+  Eigen::Matrix3d base_from_rig;
+  base_from_rig.col(0) = x;
+  base_from_rig.col(1) = y;
+  base_from_rig.col(2) = z;
+  const Eigen::Matrix3d r = base_from_rig.transpose();
+  const Eigen::Vector3d origin = centroid - distance * z;
+  const Eigen::Vector3d t = -(r * origin);
+  const Eigen::AngleAxisd aa(r);
+  const Eigen::Vector3d w = aa.axis() * aa.angle();
+  *rig_from_base = {w.x(), w.y(), w.z(), t.x(), t.y(), t.z()};
+  return distance;
+}
+
+int RunSimulate(SimulateArgs args) {
   const Robot nominal = ReadRobot(args.robot, args.root, args.tip);
   SimulateOptions opt = args.options;
   if (args.mode == "random") {
@@ -39,6 +109,27 @@ int RunSimulate(const SimulateArgs& args) {
   }
   if (args.no_time) opt.seconds_per_pose = 0;
   opt.measure_points = !args.no_points;
+  const Rig rig = ExampleStereoRig(args.render_width, args.render_height);
+  Target target = ExampleTarget();
+  double rig_distance = 0.0;
+  if (args.render) {
+    args.render_options.Check();
+    // Same seed, so the same poses and truth; only the frame is placed.
+    std::array<double, 6> rig_from_base;
+    rig_distance = PlaceRig(Simulate(nominal, opt).base_from_tip, rig,
+                            TipFromTool(target), &rig_from_base);
+    opt.meas_from_base = rig_from_base;
+    // Tags at least ~40 px wide at that distance: scale the example tool.
+    const double tag_mm =
+        40.0 * rig_distance / rig.cameras.at(0).intrinsics.fx;
+    const double scale = std::max(1.0, tag_mm / target.tags.at(0).size_mm);
+    for (TargetTag& tag : target.tags) {
+      tag.size_mm *= scale;
+      tag.tool_from_tag.t *= scale;
+    }
+    target.tip_in_tool *= scale;
+  }
+  const Rigid3 tip_from_tool = TipFromTool(target);
   const SimulatedSession s = Simulate(nominal, opt);
 
   // Truth, for tests and for judging a diagnosis.
@@ -78,22 +169,61 @@ int RunSimulate(const SimulateArgs& args) {
   const std::string truth_robot_text = FormatRobotYaml(s.truth, {"TRUE robot of a simulated session (for tests)"});
   const std::string obs_text = FormatObservationsCsv(s.observations, comment);
   MakeDirs(args.out);
+  int rendered = 0;
+  if (args.render) {
+    const Rigid3 rig_from_base = ToRigid([&] {
+      Eigen::Matrix4d m = Eigen::Matrix4d::Identity();
+      const Eigen::Vector3d w(s.meas_from_base[0], s.meas_from_base[1],
+                              s.meas_from_base[2]);
+      if (w.norm() > 0) {
+        m.block<3, 3>(0, 0) = Eigen::AngleAxisd(w.norm(), w.normalized()).toRotationMatrix();
+      }
+      m.block<3, 1>(0, 3) = Eigen::Vector3d(s.meas_from_base[3], s.meas_from_base[4],
+                                            s.meas_from_base[5]);
+      return m;
+    }());
+    std::vector<Rigid3> rig_from_tool;
+    for (const Eigen::Matrix4d& m : s.base_from_tip) {
+      rig_from_tool.push_back(rig_from_base * ToRigid(m) * tip_from_tool);
+    }
+    rendered = RenderSession(rig, target, rig_from_tool, args.render_options,
+                             opt.seed, args.out + "/images");
+  }
   WriteFileAtomic(args.out + "/robot.yaml", robot_text);
   WriteFileAtomic(args.out + "/truth_robot.yaml", truth_robot_text);
   WriteFileAtomic(args.out + "/observations.csv", obs_text);
   WriteFileAtomic(args.out + "/truth.json", truth.dump(2) + "\n");
 
   if (args.json) {
-    PrintJson({{"out", args.out},
-               {"poses", s.observations.rows.size()},
-               {"effects", effects},
-               {"files",
-                {"robot.yaml", "observations.csv", "truth.json",
-                 "truth_robot.yaml"}}});
+    nlohmann::json j = {{"out", args.out},
+                        {"poses", s.observations.rows.size()},
+                        {"effects", effects},
+                        {"files",
+                         {"robot.yaml", "observations.csv", "truth.json",
+                          "truth_robot.yaml"}}};
+    if (args.render) {
+      j["render"] = {{"folder", args.out + "/images"},
+                     {"frames", rendered},
+                     {"rig_distance_mm", rig_distance},
+                     {"tag_size_mm", target.tags.at(0).size_mm}};
+    }
+    PrintJson(j);
   } else {
     std::cout << "simulated " << s.observations.rows.size() << " poses of "
               << nominal.name << " into " << args.out
               << "/ (robot.yaml, observations.csv, truth.json)\n";
+    if (args.render) {
+      std::cout << "rendered " << rendered << " stereo pairs into " << args.out
+                << "/images/ (rig " << rig_distance
+                << " mm from the workspace centre); track them with\n  kincal "
+                   "track --rig "
+                << args.out << "/images/rig.yaml --target " << args.out
+                << "/images/target.yaml --left '" << args.out
+                << "/images/left_*.png' --right '" << args.out
+                << "/images/right_*.png' --out points.csv --obs " << args.out
+                << "/observations.csv --robot " << args.out
+                << "/robot.yaml --out-obs tracked.csv\n";
+    }
   }
   return 0;
 }
@@ -142,6 +272,25 @@ void AddSimulateCommand(CLI::App& app, Runner* run) {
   sub->add_flag("--no-time", args->no_time, "omit the t column");
   sub->add_flag("--no-points", args->no_points,
                 "fixed-point mode: omit measured x,y,z (joint readings only)");
+  sub->add_flag("--render", args->render,
+                "also render stereo images of a tagged tool at every pose "
+                "(the rig is placed to see the workspace; its frame is the "
+                "measuring frame); into OUT/images");
+  sub->add_option("--render-width", args->render_width, "image width, px")
+      ->capture_default_str();
+  sub->add_option("--render-height", args->render_height, "image height, px")
+      ->capture_default_str();
+  sub->add_option("--render-noise", args->render_options.noise_sigma,
+                  "image noise, gray levels")
+      ->capture_default_str();
+  sub->add_option("--render-blur", args->render_options.blur_sigma_px,
+                  "optical blur sigma, px")
+      ->capture_default_str();
+  sub->add_option("--render-exposure", args->render_options.exposure_jitter,
+                  "exposure gain jitter (std of the gain)")
+      ->capture_default_str();
+  sub->add_flag("--render-needle", args->render_options.draw_needle,
+                "draw the needle");
   sub->add_flag("--json", args->json, "print a JSON summary");
   sub->callback([run, args] { *run = [args] { return RunSimulate(*args); }; });
 }

@@ -16,7 +16,9 @@
 #include "data/atomic_file.h"
 #include "data/csv.h"
 #include "data/error.h"
+#include "data/observations.h"
 #include "data/provenance.h"
+#include "data/urdf.h"
 #include "data/yaml_util.h"
 #include "vision/target.h"
 #include "vision/tool_pose.h"
@@ -27,6 +29,14 @@ namespace {
 
 struct TrackArgs {
   std::string rig, target, left, right, out;
+  // Optional: joint readings of the same frames (one row per frame pair, in
+  // order) to merge with the tracked tips into observations for calibrate.
+  std::string obs, robot, out_obs;
+  // Quality gate for the merge: a tip is merged only when the tool pose used
+  // at least min_tags tags and fits them within max_reproj_px (one small tag
+  // leaves the rotation, and so the tip at the end of its lever, ambiguous).
+  int min_tags = 2;
+  double max_reproj_px = 0.5;
   bool json = false;
   bool no_tracking = false;
   double decimate = 2.0;
@@ -86,6 +96,21 @@ int RunTrack(const TrackArgs& args) {
                      " images but --right matches " +
                      std::to_string(right.size()) + "; frames pair in order");
   }
+  // Validate the merge inputs before any work, so bad input writes nothing.
+  Observations merged;
+  if (!args.obs.empty() || !args.out_obs.empty()) {
+    if (args.obs.empty() || args.robot.empty() || args.out_obs.empty()) {
+      throw InputError(
+          "--obs, --robot and --out-obs go together (merge tracked tips "
+          "into the joint readings of the same frames)");
+    }
+    merged = ReadObservationsCsv(args.obs, ReadRobot(args.robot).JointNames());
+    if (merged.rows.size() != left.size()) {
+      throw InputError(args.obs + ": " + std::to_string(merged.rows.size()) +
+                       " observation rows but " + std::to_string(left.size()) +
+                       " frame pairs; rows must match frames in order");
+    }
+  }
   TrackerOptions topt;
   topt.detector.family = target.family;
   topt.detector.quad_decimate = args.decimate;
@@ -103,7 +128,7 @@ int RunTrack(const TrackArgs& args) {
   poses << header << "# rig_from_tool: R row-major, t in mm; tip in rig, mm\n"
         << "frame,found,r00,r01,r02,r10,r11,r12,r20,r21,r22,tx,ty,tz,"
            "reproj_px,tags,left_image,right_image\n";
-  int found = 0;
+  int found = 0, merged_count = 0;
   std::vector<double> rms_values;
   auto last_progress = start;
   for (size_t f = 0; f < n; ++f) {
@@ -128,6 +153,13 @@ int RunTrack(const TrackArgs& args) {
     const ToolPoseResult r = EstimateToolPose(rig, target, dets);
     points << f;
     poses << f << "," << (r.found ? 1 : 0);
+    if (!merged.rows.empty()) {
+      const bool good = r.found && r.tags_used >= args.min_tags &&
+                        r.rms_px <= args.max_reproj_px;
+      merged.rows[f].has_point = good;
+      if (good) merged.rows[f].p_in_meas = r.tip_in_rig;
+      merged_count += good ? 1 : 0;
+    }
     if (r.found) {
       ++found;
       rms_values.push_back(r.rms_px);
@@ -161,6 +193,17 @@ int RunTrack(const TrackArgs& args) {
   WriteFileAtomic(args.out, points.str());
   const std::string poses_path = PosesPath(args.out);
   WriteFileAtomic(poses_path, poses.str());
+  if (!merged.rows.empty()) {
+    WriteFileAtomic(args.out_obs,
+                    FormatObservationsCsv(
+                        merged, {"joint readings from " + args.obs +
+                                 "; x,y,z = needle tip tracked in the rig "
+                                 "frame (empty where the tool was not found, "
+                                 "or seen with fewer than " +
+                                 std::to_string(args.min_tags) +
+                                 " tags or a reprojection RMS over " +
+                                 FormatDouble(args.max_reproj_px) + " px)"}));
+  }
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start)
           .count();
@@ -182,6 +225,10 @@ int RunTrack(const TrackArgs& args) {
     j["poses"] = poses_path;
     j["median_reproj_px"] = median_rms;
     j["full_searches"] = {full0, full1};
+    if (!merged.rows.empty()) {
+      j["out_obs"] = args.out_obs;
+      j["merged"] = merged_count;
+    }
     PrintJson(j);
     return 0;
   }
@@ -214,6 +261,18 @@ void AddTrackCommand(CLI::App& app, Runner* run) {
   sub->add_flag("--no-tracking", args->no_tracking,
                 "search every full frame (no region prediction)");
   sub->add_flag("--quiet", args->quiet, "no progress bar on stderr");
+  sub->add_option("--obs", args->obs,
+                  "observations.csv with the joint readings of the same "
+                  "frames (one row per pair, in order)");
+  sub->add_option("--robot", args->robot, "robot.yaml naming the joints of --obs");
+  sub->add_option("--out-obs", args->out_obs,
+                  "write --obs with x,y,z replaced by the tracked tips");
+  sub->add_option("--min-tags", args->min_tags,
+                  "merge a tip only if its pose used at least this many tags")
+      ->capture_default_str();
+  sub->add_option("--max-reproj", args->max_reproj_px,
+                  "merge a tip only if its pose fits within this RMS, px")
+      ->capture_default_str();
   sub->add_flag("--json", args->json, "print one JSON object");
   sub->callback([run, args] { *run = [args] { return RunTrack(*args); }; });
 }

@@ -190,6 +190,7 @@ SimulatedSession Simulate(const Robot& nominal, const SimulateOptions& opt) {
   dir = dir.normalized() * opt.frame_distance_mm;
   out.meas_from_base = {axis.x() * angle, axis.y() * angle, axis.z() * angle,
                         dir.x(), dir.y(), dir.z()};
+  if (opt.meas_from_base) out.meas_from_base = *opt.meas_from_base;
 
   std::vector<double> lo, hi;
   Limits(nominal, nominal_chain, &lo, &hi);
@@ -327,6 +328,17 @@ SimulatedSession Simulate(const Robot& nominal, const SimulateOptions& opt) {
       obs.rows[i].has_point = true;
       obs.rows[i].p_in_meas = p;
     }
+  }
+  for (size_t i = 0; i < obs.rows.size(); ++i) {
+    std::vector<double> q(n);
+    for (int j = 0; j < n; ++j) {
+      q[j] = ModelJointValue<double>(truth.rows[j].type, inputs[i].q[j],
+                                     inputs[i].s[j], inputs[i].tau[j],
+                                     truth.joint_errors[j].data());
+    }
+    Eigen::Matrix4d m = BaseFromTipAt(truth, q);
+    for (int k = 0; k < 3; ++k) m(k, 3) += truth.drift[k] * inputs[i].t_h;
+    out.base_from_tip.push_back(m);
   }
   out.truth = truth.ToRobot(nominal);
   return out;

@@ -51,6 +51,10 @@ struct SimulateOptions {
   // When not empty, only these geometric parameters (names as j3.a) deviate
   // from nominal; e.g. to compare estimates with truth parameter by parameter.
   std::vector<std::string> perturbed;
+  // When set, the measuring frame meas_from_base ([rotation vector rad, mm])
+  // instead of a random one (the random draws still happen, so the rest of
+  // the session is the same for the same seed).
+  std::optional<std::array<double, 6>> meas_from_base;
 };
 
 struct SimulatedSession {
@@ -61,6 +65,9 @@ struct SimulatedSession {
   std::vector<Effect> effects;  // as injected (magnitudes in spec units)
   // Per effect, the model parameters chosen (e.g. compliance per torque).
   std::vector<std::string> effect_notes;
+  // True pose of the tip frame per row (base frame, mm), effects included:
+  // what a camera watching the tool sees.
+  std::vector<Eigen::Matrix4d> base_from_tip;
 };
 
 SimulatedSession Simulate(const Robot& nominal, const SimulateOptions& options);

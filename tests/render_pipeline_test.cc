@@ -1,0 +1,109 @@
+// The whole measuring chain on synthetic rendered images, through the public
+// commands: simulate --render (robot poses -> stereo images of the tagged
+// tool) -> track (tips b' in the rig frame, merged with the joint readings)
+// -> calibrate. The tracked tips must agree with the simulated truth within
+// the stereo depth resolution, and the calibration from images must beat the
+// nominal model by far.
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <nlohmann/json.hpp>
+
+#include "data/observations.h"
+#include "data/robot.h"
+#include "tests/testing/paths.h"
+#include "tests/testing/run.h"
+
+namespace kincal::testing {
+namespace {
+
+TEST(RenderPipelineTest, ImagesToCalibratedRobot) {
+  const std::string dir = MakeTempDir("render");
+  RunResult r = RunKincal("simulate --robot " + SourceDir() +
+                          "/data/robots/bh7.yaml --out " + dir +
+                          "/s --poses 90 --noise 0 --seed 21 --render "
+                          "--render-noise 1.5 --render-blur 0.5 --json");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto sim = nlohmann::json::parse(r.out);
+  ASSERT_EQ(sim["render"]["frames"].get<int>(), 90);
+  const double distance = sim["render"]["rig_distance_mm"].get<double>();
+
+  const std::string img = dir + "/s/images";
+  r = RunKincal("track --rig " + img + "/rig.yaml --target " + img +
+                "/target.yaml --left '" + img + "/left_*.png' --right '" + img +
+                "/right_*.png' --out " + dir + "/points.csv --obs " + dir +
+                "/s/observations.csv --robot " + dir +
+                "/s/robot.yaml --out-obs " + dir + "/tracked.csv --json --quiet");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto track = nlohmann::json::parse(r.out);
+  const int found = track["found"].get<int>();
+  const int merged = track["merged"].get<int>();
+  // Tags face away from the cameras in part of the random poses; the merge
+  // keeps only well-determined tool poses (>= 2 tags, <= 0.5 px).
+  EXPECT_GT(found, 25);
+  EXPECT_GT(merged, 20);
+
+  const kincal::Robot robot = ReadRobotYaml(dir + "/s/robot.yaml");
+  const Observations truth =
+      ReadObservationsCsv(dir + "/s/observations.csv", robot.JointNames());
+  const Observations tracked =
+      ReadObservationsCsv(dir + "/tracked.csv", robot.JointNames());
+  ASSERT_EQ(truth.rows.size(), tracked.rows.size());
+  // Stereo depth resolution at this distance (f = 1800 px, B = 120 mm,
+  // 0.05 px disparity noise): sigma_z = z^2 sigma_d / (f B); the tip sits at
+  // the end of a lever (tip_in_tool) and adds the rotation error of the tool,
+  // about sigma_z / tag size of arc: a few mm at most at ~2 m.
+  const double sigma_z = distance * distance * 0.05 / (1800.0 * 120.0);
+  const double lever = sim["render"]["tag_size_mm"].get<double>() * 4.0;
+  const double sigma_tip = sigma_z * (1.0 + lever / (2.0 * sim["render"]["tag_size_mm"].get<double>()));
+  double sum_sq = 0;
+  int n = 0;
+  for (size_t i = 0; i < truth.rows.size(); ++i) {
+    if (!tracked.rows[i].has_point) continue;
+    const double e = (tracked.rows[i].p_in_meas - truth.rows[i].p_in_meas).norm();
+    EXPECT_LT(e, 6 * sigma_tip + 0.2) << "frame " << i;
+    sum_sq += e * e;
+    ++n;
+  }
+  ASSERT_EQ(n, merged);
+  const double rms = std::sqrt(sum_sq / n);
+  EXPECT_LT(rms, 2 * sigma_tip + 0.1);
+
+  r = RunKincal("calibrate --robot " + dir + "/s/robot.yaml --obs " + dir +
+                "/tracked.csv --out " + dir + "/cal.yaml --json");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto cal = nlohmann::json::parse(r.out);
+  r = RunKincal("evaluate --robot " + dir + "/s/robot.yaml --obs " + dir +
+                "/tracked.csv --json");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const double nominal_rms = nlohmann::json::parse(r.out)["rms_mm"].get<double>();
+  EXPECT_LT(cal["train_rms_mm"].get<double>(), 2 * rms + 0.1);
+  EXPECT_LT(cal["train_rms_mm"].get<double>(), 0.5 * nominal_rms);
+}
+
+TEST(RenderPipelineTest, MergeNeedsMatchingRows) {
+  const std::string dir = MakeTempDir("render_bad");
+  RunResult r = RunKincal("simulate --robot " + SourceDir() +
+                          "/data/robots/bh7.yaml --out " + dir +
+                          "/s --poses 3 --seed 2 --render --render-width 640 "
+                          "--render-height 512");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  r = RunKincal("simulate --robot " + SourceDir() +
+                "/data/robots/bh7.yaml --out " + dir + "/other --poses 5");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const std::string img = dir + "/s/images";
+  r = RunKincal("track --rig " + img + "/rig.yaml --target " + img +
+                "/target.yaml --left '" + img + "/left_*.png' --right '" + img +
+                "/right_*.png' --out " + dir + "/points.csv --obs " + dir +
+                "/other/observations.csv --robot " + dir +
+                "/s/robot.yaml --out-obs " + dir + "/tracked.csv --quiet");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_THAT(r.err, ::testing::HasSubstr("rows must match frames"));
+  EXPECT_FALSE(Exists(dir + "/points.csv"));
+  EXPECT_FALSE(Exists(dir + "/tracked.csv"));
+}
+
+}  // namespace
+}  // namespace kincal::testing
