@@ -1,17 +1,253 @@
+// kincal diagnose: why the robot model is wrong.
+//   diagnose model      model-discrepancy analysis (catalogue of causes)
+//   diagnose clearance  the seed's Section 4 joint motion error test
+//   diagnose compare    per-joint clearance before / after maintenance
+
+#include <cstdio>
+#include <memory>
+#include <sstream>
+
+#include "app/app_util.h"
 #include "app/command.h"
+#include "data/atomic_file.h"
+#include "data/error.h"
+#include "data/urdf.h"
+#include "diagnose/clearance.h"
+#include "diagnose/compare.h"
+#include "diagnose/model_diagnosis.h"
 
 namespace kincal::app {
+namespace {
 
-// Not built yet: registers the subcommand so usage is stable; exits 1.
+struct ModelArgs {
+  std::string robot, obs, out, residuals, root, tip;
+  bool json = false;
+  DiagnoseOptions options;
+};
+
+std::string FormatJoint(const std::string& joint) {
+  return joint.empty() ? "-" : joint;
+}
+
+int RunModel(const ModelArgs& args) {
+  const Robot robot = ReadRobot(args.robot, args.root, args.tip);
+  const Observations obs = ReadObservationsCsv(args.obs, robot.JointNames());
+  const DiagnosisResult r = DiagnoseModel(robot, obs, args.options);
+  if (!args.out.empty()) {
+    std::ostringstream note;
+    note << "diagnose model from " << args.obs << ": verdict " << r.verdict
+         << ", held-out RMS " << r.nominal_heldout_rms_mm << " -> "
+         << r.final_heldout_rms_mm << " mm";
+    std::vector<std::string> comment = {note.str()};
+    for (const Finding& f : r.findings) {
+      std::ostringstream line;
+      line << "finding: " << f.cause << " " << FormatJoint(f.joint) << " "
+           << f.magnitude << " " << f.unit << " (95 % CI " << f.ci_low << " .. "
+           << f.ci_high << ")";
+      comment.push_back(line.str());
+    }
+    WriteFileAtomic(args.out, FormatRobotYaml(r.extended, comment));
+  }
+  if (!args.residuals.empty()) {
+    WriteFileAtomic(args.residuals, ResidualsCsv(r, obs));
+  }
+  if (args.json) {
+    nlohmann::json j = DiagnosisJson(r, args.options);
+    if (!args.out.empty()) j["out"] = args.out;
+    PrintJson(j);
+    return 0;
+  }
+  std::printf(
+      "kincal diagnose model: %d training + %d held-out poses, seed %llu\n",
+      r.train_poses, r.heldout_poses,
+      static_cast<unsigned long long>(args.options.seed));
+  std::printf("  geometric model: train RMS %.4f mm, held-out RMS %.4f mm\n",
+              r.nominal_train_rms_mm, r.nominal_heldout_rms_mm);
+  std::printf("  noise %.4f mm per axis (%s), residual %.4f mm per axis\n",
+              r.noise_mm, r.noise_source.c_str(), r.residual_sigma_mm);
+  std::printf("  verdict: %s\n", r.verdict.c_str());
+  if (!r.findings.empty()) {
+    std::printf("  %-12s %-6s %12s %-5s %-25s %s\n", "cause", "joint",
+                "magnitude", "unit", "95% interval",
+                "held-out RMS before -> after");
+  }
+  for (const Finding& f : r.findings) {
+    char ci[64];
+    std::snprintf(ci, sizeof(ci), "[%.5g, %.5g]", f.ci_low, f.ci_high);
+    std::printf("  %-12s %-6s %12.5g %-5s %-25s %.4f -> %.4f mm\n",
+                f.cause.c_str(), FormatJoint(f.joint).c_str(), f.magnitude,
+                f.unit.c_str(), ci, f.heldout_rms_before_mm,
+                f.heldout_rms_after_mm);
+    for (const Equivalent& e : f.equivalent) {
+      std::printf("    equivalent on this data: %s %s %.5g %s\n",
+                  e.cause.c_str(), FormatJoint(e.joint).c_str(), e.magnitude,
+                  e.unit.c_str());
+    }
+  }
+  std::printf("  final held-out RMS %.4f mm (%.3f s)\n", r.final_heldout_rms_mm,
+              r.seconds);
+  if (!args.out.empty()) std::printf("  wrote %s\n", args.out.c_str());
+  return 0;
+}
+
+struct ClearanceArgs {
+  std::string robot, obs, plot, csv, root, tip;
+  bool json = false;
+  ClearanceOptions options;
+};
+
+int RunClearance(const ClearanceArgs& args) {
+  const Robot robot = ReadRobot(args.robot, args.root, args.tip);
+  const Observations obs = ReadObservationsCsv(args.obs, robot.JointNames());
+  const ClearanceResult r = DiagnoseClearance(robot, obs, args.options);
+  if (!args.csv.empty()) WriteFileAtomic(args.csv, ClearanceCsv(r));
+  if (!args.plot.empty()) WriteFileAtomic(args.plot, ClearanceSvg(r));
+  if (args.json) {
+    PrintJson(ClearanceJson(r));
+    return 0;
+  }
+  std::printf("kincal diagnose clearance: %d poses, RMS %.4f mm, gamma %g\n",
+              r.stats.n, r.stats.rms_mm, r.gamma);
+  if (!r.sweeps.empty()) {
+    const PoseSweep& w = r.sweeps[0];
+    std::printf("  worst pose %s: eps %.4f mm\n", w.pose.c_str(), w.error_mm);
+    std::printf("  %-6s %12s %12s %10s %5s %8s\n", "joint", "before_mm",
+                "min_mm", "at_offset", "wins", "median");
+    for (const SweepCurve& c : w.joints) {
+      std::printf("  %-6s %12.4f %12.4f %10.3f %5d %8.3f\n",
+                  r.joint_names[c.joint].c_str(), c.error_before_mm,
+                  c.error_min_mm, c.at_offset, r.wins[c.joint],
+                  r.median_ratio[c.joint]);
+    }
+  }
+  std::printf(
+      "  suspect: %s (best joint at a majority of the %zu worst poses, "
+      "median error ratio <= %.2f)\n",
+      r.suspect >= 0 ? r.joint_names[r.suspect].c_str() : "none",
+      r.sweeps.size(), args.options.reduction_threshold);
+  return 0;
+}
+
+struct CompareArgs {
+  std::string robot, before, after, root, tip;
+  bool json = false;
+};
+
+int RunCompare(const CompareArgs& args) {
+  const Robot robot = ReadRobot(args.robot, args.root, args.tip);
+  const Observations before =
+      ReadObservationsCsv(args.before, robot.JointNames());
+  const Observations after =
+      ReadObservationsCsv(args.after, robot.JointNames());
+  const CompareResult r = CompareClearance(robot, before, after);
+  if (args.json) {
+    PrintJson(CompareJson(r));
+    return 0;
+  }
+  std::printf(
+      "kincal diagnose compare: clearance per joint, 95 %% intervals\n");
+  std::printf("  %-6s %-4s %24s %24s %8s %s\n", "joint", "unit", "before",
+              "after", "z", "changed");
+  for (const JointClearanceChange& c : r.joints) {
+    char b[64], a[64];
+    std::snprintf(b, sizeof(b), "%.4f [%.4f, %.4f]", c.before.value,
+                  c.before.ci_low, c.before.ci_high);
+    std::snprintf(a, sizeof(a), "%.4f [%.4f, %.4f]", c.after.value,
+                  c.after.ci_low, c.after.ci_high);
+    std::printf("  %-6s %-4s %24s %24s %8.2f %s\n", c.joint.c_str(),
+                c.unit.c_str(), b, a, c.z, c.changed ? "yes" : "no");
+  }
+  std::printf("  verdict: %s (|z| > %.2f)\n", r.verdict.c_str(), r.z_critical);
+  return 0;
+}
+
+}  // namespace
+
 void AddDiagnoseCommand(CLI::App& app, Runner* run) {
-  CLI::App* sub = app.add_subcommand("diagnose", "(not implemented yet)");
-  sub->allow_extras();
-  sub->callback([run] {
-    *run = [] {
-      std::fprintf(stderr, "kincal diagnose: not implemented yet\n");
-      return 1;
-    };
-  });
+  CLI::App* diag = app.add_subcommand(
+      "diagnose",
+      "Find why the robot model is wrong: model, clearance, compare");
+  diag->require_subcommand(1);
+
+  auto margs = std::make_shared<ModelArgs>();
+  CLI::App* model = diag->add_subcommand(
+      "model",
+      "Fit geometry, test the catalogue of causes (backlash, compliance, "
+      "cyclic, gain, axis_tilt, drift) against held-out poses, report "
+      "findings");
+  model->add_option("--robot", margs->robot, "robot.yaml or .urdf")->required();
+  model->add_option("--root", margs->root, "URDF root link");
+  model->add_option("--tip", margs->tip, "URDF tip link");
+  model->add_option("--obs", margs->obs, "observations.csv")->required();
+  model->add_option(
+      "--out", margs->out,
+      "write the extended model (extensions:) to this robot.yaml");
+  model->add_option("--residuals", margs->residuals,
+                    "write the final per-pose residual vectors to this CSV");
+  model->add_option("--noise", margs->options.noise_mm,
+                    "measurement noise per axis, mm (default: estimate)");
+  model->add_option("--seed", margs->options.seed, "seed of the held-out split")
+      ->capture_default_str();
+  model
+      ->add_option("--holdout", margs->options.holdout_fraction,
+                   "fraction of poses held out")
+      ->capture_default_str();
+  model
+      ->add_option("--false-alarm", margs->options.false_alarm,
+                   "family-wise false-alarm probability per selection step")
+      ->capture_default_str();
+  model
+      ->add_option("--max-findings", margs->options.max_findings,
+                   "stop after this many findings")
+      ->capture_default_str();
+  model->add_option("--causes", margs->options.causes,
+                    "restrict the catalogue (e.g. --causes backlash gain)");
+  model->add_option("--threads", margs->options.num_threads, "threads")
+      ->capture_default_str();
+  model->add_flag("--json", margs->json, "print one JSON object");
+  model->callback(
+      [run, margs] { *run = [margs] { return RunModel(*margs); }; });
+
+  auto cargs = std::make_shared<ClearanceArgs>();
+  CLI::App* clear = diag->add_subcommand(
+      "clearance",
+      "The seed's Section 4 joint motion error test: sweep each joint at the "
+      "worst poses");
+  clear->add_option("--robot", cargs->robot, "robot.yaml (calibrated) or .urdf")
+      ->required();
+  clear->add_option("--root", cargs->root, "URDF root link");
+  clear->add_option("--tip", cargs->tip, "URDF tip link");
+  clear->add_option("--obs", cargs->obs, "observations.csv")->required();
+  clear
+      ->add_option("--gamma", cargs->options.gamma,
+                   "sweep half-range, deg (revolute) or mm (prismatic)")
+      ->capture_default_str();
+  clear
+      ->add_option("--worst", cargs->options.worst_poses,
+                   "worst poses examined (step 3)")
+      ->capture_default_str();
+  clear->add_flag("--calibrate", cargs->options.calibrate_geometry,
+                  "calibrate the geometry on the same data first (the paper "
+                  "runs the test on its calibrated robot)");
+  clear->add_option("--plot", cargs->plot, "write an SVG of Fig. 4 and Fig. 5");
+  clear->add_option("--csv", cargs->csv, "write deviations and curves as CSV");
+  clear->add_flag("--json", cargs->json, "print one JSON object");
+  clear->callback(
+      [run, cargs] { *run = [cargs] { return RunClearance(*cargs); }; });
+
+  auto pargs = std::make_shared<CompareArgs>();
+  CLI::App* cmp = diag->add_subcommand(
+      "compare",
+      "Per-joint clearance of two sessions (before / after maintenance)");
+  cmp->add_option("before", pargs->before, "observations.csv before")
+      ->required();
+  cmp->add_option("after", pargs->after, "observations.csv after")->required();
+  cmp->add_option("--robot", pargs->robot, "robot.yaml or .urdf")->required();
+  cmp->add_option("--root", pargs->root, "URDF root link");
+  cmp->add_option("--tip", pargs->tip, "URDF tip link");
+  cmp->add_flag("--json", pargs->json, "print one JSON object");
+  cmp->callback(
+      [run, pargs] { *run = [pargs] { return RunCompare(*pargs); }; });
 }
 
 }  // namespace kincal::app

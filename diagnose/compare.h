@@ -1,0 +1,49 @@
+#ifndef KINCAL_DIAGNOSE_COMPARE_H_
+#define KINCAL_DIAGNOSE_COMPARE_H_
+
+// `kincal diagnose compare BEFORE.csv AFTER.csv --robot R.yaml`: the joint
+// clearance check after maintenance (the seed's Fig. 4 -> Fig. 6). Each
+// session gets its own fit of frame + identifiable geometry + the clearance
+// (backlash width) of every joint whose approach direction changes in the
+// data, all jointly; the clearances carry 95 % intervals from the fit's
+// covariance. A joint has changed when |b_after - b_before| exceeds
+// z * sqrt(sigma_before^2 + sigma_after^2), with z the two-sided 95 % point
+// Bonferroni-corrected over the compared joints.
+
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "data/observations.h"
+#include "data/robot.h"
+#include "diagnose/model_diagnosis.h"
+
+namespace kincal {
+
+struct JointClearanceChange {
+  std::string joint;
+  std::string unit;  // deg | mm
+  Magnitude before, after;
+  double difference = 0.0;  // after - before
+  double z = 0.0;           // difference / its sigma
+  bool changed = false;
+};
+
+struct CompareResult {
+  std::vector<JointClearanceChange> joints;
+  double z_critical = 0.0;
+  double before_sigma0_mm = 0.0, after_sigma0_mm = 0.0;
+  std::string verdict;  // "changed" | "unchanged"
+};
+
+CompareResult CompareClearance(const Robot& robot, const Observations& before,
+                               const Observations& after);
+
+nlohmann::json CompareJson(const CompareResult& result);
+
+// Upper point of the standard normal: z with P(Z > z) = p.
+double NormalUpperQuantile(double p);
+
+}  // namespace kincal
+
+#endif  // KINCAL_DIAGNOSE_COMPARE_H_

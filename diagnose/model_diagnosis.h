@@ -1,0 +1,171 @@
+#ifndef KINCAL_DIAGNOSE_MODEL_DIAGNOSIS_H_
+#define KINCAL_DIAGNOSE_MODEL_DIAGNOSIS_H_
+
+// `kincal diagnose model`: what the geometric model gets wrong, and why.
+//
+// Method (docs/DIAGNOSE.md has the statistics and the measured rates):
+//   1. Seeded split of the measured poses into training and held-out.
+//   2. Fit frame + identifiable geometry on the training poses (the base).
+//   3. Candidates from the spec's catalogue, for every joint where they apply
+//      and are identifiable on this data (a candidate whose Jacobian columns
+//      lie in the span of the base's is equivalent to geometry and skipped):
+//      backlash (s), compliance (gravity torque), cyclic (cos q, sin q), gain
+//      (q), axis_tilt (Hayati beta on nominally parallel axes), drift (t).
+//   4. Each candidate is refitted JOINTLY with geometry and frame (Ceres, one
+//      Fit with the candidate's parameters freed). Nested-model F-test,
+//      F = ((RSS0 - RSS1) / k) / (RSS1 / (n - p - k)), Bonferroni-corrected
+//      over the candidates of the step (family-wise false-alarm rate
+//      `false_alarm` per step), and the held-out RMS must drop as well.
+//   5. Greedy forward selection: the most significant candidate is added and
+//      the step repeats while a candidate stays significant.
+//   6. Candidates whose fits explain the data as well as the chosen one (RSS
+//      difference below the chi-square(1) 95 % point of the noise) are
+//      reported as equivalent instead of guessing between them.
+//   7. Final refit of the selected model on all poses; magnitudes in the
+//      spec's units with 95 % intervals from the covariance (delta method).
+//   8. `unexplained` when the final residuals stay clearly above the
+//      measurement noise (stated, from repeated poses, or an upper bound from
+//      nearest-neighbour pose pairs).
+
+#include <cstdint>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "calib/fit.h"
+#include "calib/model_state.h"
+#include "data/observations.h"
+#include "data/robot.h"
+
+namespace kincal {
+
+struct DiagnoseOptions {
+  double holdout_fraction = 0.25;  // of the measured poses, seeded
+  uint64_t seed = 1;
+  // Per-axis measurement noise (mm); 0 = estimate from the data.
+  double noise_mm = 0.0;
+  // Family-wise false-alarm probability of one selection step (Bonferroni
+  // over that step's candidates).
+  double false_alarm = 0.01;
+  int max_findings = 5;
+  // Smallest effect worth naming: RMS (3D, over the training poses) of the
+  // tip error a candidate explains, mm. Far below any measuring system's
+  // resolution; it stops noise-free data from naming second-order
+  // linearisation rests of the geometry (~1 um) as effects.
+  double min_effect_mm = 0.002;
+  // Residual scatter above this multiple of the noise counts as systematic.
+  double unexplained_ratio = 1.5;
+  int num_threads = 2;
+  // Restrict candidates to these causes (empty = all of the catalogue).
+  std::vector<std::string> causes;
+
+  void Check() const;  // InputError on invalid values
+};
+
+// One catalogue candidate: a cause on a joint (joint -1 for drift).
+struct Candidate {
+  std::string cause;
+  int joint = -1;
+  std::vector<ParamInfo> params;
+  std::string Label(const Chain& chain) const;  // "backlash:j3", "drift"
+};
+
+// All catalogue candidates that apply to this chain and data (before the
+// identifiability check). `measurements` give s, tau and t.
+std::vector<Candidate> CatalogueCandidates(
+    const Chain& chain, const std::vector<Measurement>& measurements,
+    const std::vector<std::string>& causes = {});
+
+// A candidate's magnitude in the spec's units with its 95 % interval, from a
+// fitted state and its FitSummary covariance (NaN interval when absent).
+struct Magnitude {
+  double value = 0.0;
+  double sigma = 0.0;
+  double ci_low = 0.0, ci_high = 0.0;
+  std::string unit;
+};
+Magnitude CandidateMagnitude(const Candidate& c, const ModelState& state,
+                             const FitSummary& fit, double max_abs_tau);
+
+// Score of one candidate in one selection step.
+struct CandidateScore {
+  std::string cause, joint;  // joint "" for drift
+  bool identifiable = true;
+  int k = 0;  // parameters added
+  double train_rms_mm = 0.0, heldout_rms_mm = 0.0;
+  double rss = 0.0;  // training sum of squared residuals, mm^2
+  double f = 0.0, p_value = 1.0;
+  bool significant = false;
+  double magnitude = 0.0;  // spec units, from the training fit
+  std::string unit;
+};
+
+struct Equivalent {
+  std::string cause, joint;
+  double magnitude = 0.0;
+  std::string unit;
+  double train_rms_mm = 0.0, heldout_rms_mm = 0.0;
+};
+
+struct Finding {
+  std::string cause, joint;  // joint "" = none (drift, unexplained)
+  double magnitude = 0.0;
+  std::string unit;
+  double ci_low = 0.0, ci_high = 0.0;
+  double heldout_rms_before_mm = 0.0, heldout_rms_after_mm = 0.0;
+  double train_rms_after_mm = 0.0;
+  double f = 0.0, p_value = 1.0;
+  std::vector<Equivalent> equivalent;
+};
+
+struct DiagnosisResult {
+  std::string verdict;  // "effect_found" | "no_significant_effect"
+  int train_poses = 0, heldout_poses = 0;
+  double nominal_train_rms_mm = 0.0, nominal_heldout_rms_mm = 0.0;
+  std::vector<Finding> findings;
+  double final_train_rms_mm = 0.0, final_heldout_rms_mm = 0.0;
+  // Noise per axis (mm) and where it came from: "stated", "repeated poses",
+  // "nearest poses (upper bound)", "none".
+  double noise_mm = 0.0;
+  std::string noise_source;
+  double residual_sigma_mm = 0.0;  // per axis, final model, training
+  double systematic_rms_mm = 0.0;  // 3D RMS above the noise
+  std::vector<std::vector<CandidateScore>> steps;  // every selection step
+  std::vector<std::string> not_identifiable;       // candidate labels
+  double bonferroni_alpha = 0.0;  // per-candidate level of the first step
+  // Per measured pose (visit order): its row in the observations, whether it
+  // was held out, and the final model's residual (model - measured, mm).
+  std::vector<int> rows;
+  std::vector<bool> heldout;
+  std::vector<Eigen::Vector3d> residuals;
+  Robot extended;    // nominal + fitted geometry + extensions
+  ModelState state;  // final model (all poses)
+  double seconds = 0.0;
+};
+
+DiagnosisResult DiagnoseModel(const Robot& nominal, const Observations& obs,
+                              const DiagnoseOptions& options);
+
+// Fits frame + identifiable geometry + the given candidates jointly on all
+// measured poses of `obs` and returns each candidate's magnitude (spec units,
+// 95 % interval). Used by `diagnose compare` and the Monte-Carlo check of the
+// intervals.
+std::vector<Magnitude> FitCandidates(const Robot& nominal,
+                                     const Observations& obs,
+                                     const std::vector<std::string>& labels,
+                                     double* sigma0_mm = nullptr);
+
+// JSON per the spec ("Diagnosis result"): verdict, nominal, findings, final;
+// plus the noise, the candidate table of every step and the seed.
+nlohmann::json DiagnosisJson(const DiagnosisResult& result,
+                             const DiagnoseOptions& options);
+// CSV of the final residuals: pose,set,dx_mm,dy_mm,dz_mm,error_mm.
+std::string ResidualsCsv(const DiagnosisResult& result,
+                         const Observations& obs);
+
+// Upper tail of the F(d1, d2) distribution: P(F > f).
+double FDistributionUpperTail(double f, double d1, double d2);
+
+}  // namespace kincal
+
+#endif  // KINCAL_DIAGNOSE_MODEL_DIAGNOSIS_H_
