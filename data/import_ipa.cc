@@ -44,6 +44,14 @@ std::vector<std::string> IpaUr10JointNames() {
           "wrist_1_joint",      "wrist_2_joint",       "wrist_3_joint"};
 }
 
+Eigen::Matrix3d IpaRotation(const Eigen::Vector3d& rx_ry_rz_deg) {
+  const Eigen::Vector3d r = rx_ry_rz_deg * M_PI / 180.0;
+  return (Eigen::AngleAxisd(r.x(), Eigen::Vector3d::UnitX()) *
+          Eigen::AngleAxisd(r.y(), Eigen::Vector3d::UnitY()) *
+          Eigen::AngleAxisd(r.z(), Eigen::Vector3d::UnitZ()))
+      .toRotationMatrix();
+}
+
 bool ParseDecimalComma(const std::string& text, double* value) {
   std::string s = text;
   const size_t comma = s.find(',');

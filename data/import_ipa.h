@@ -13,16 +13,24 @@
 //                             truncated to 6 digits ("2,02011E+13"), useless
 //   shoulder_pan_joint ... wrist_3_joint   joint angles, rad
 //   measurement_x/y/z         Leica T-Mac position in the tracker frame, mm
-//   measurement_rx/ry/rz      T-Mac orientation, deg (kept, not used)
+//   measurement_rx/ry/rz      T-Mac orientation, deg (kept, not used by the
+//                             point calibration): tracker_from_tmac =
+//                             Rx(rx) Ry(ry) Rz(rz) (IpaRotation)
 //   measurement_std_x/y/z     tracker standard deviation, mm (B, C only)
 //   measurement_temperature   environment temperature, deg C
-//   Goal x/y/z                commanded T-Mac position in the robot base, m
+//   Goal x/y/z                commanded TCP (109 mm out of the flange) in
+//                             the ROS base frame, m
 //
-// The measured point is the T-Mac (tracker target), which the data set's
-// Trafo_TM_F_init.txt places 109 mm along the flange z axis: the tool row of
-// data/robots/ur10.yaml.
+// The measured point is the origin of the T-Mac frame, 93.0 mm along the
+// flange z axis (the tool row of data/robots/ur10.yaml). The data set's
+// Trafo_TM_F_init.txt says 109 mm: that is the TCP the planner commanded
+// (the Goal columns match the nominal chain with a 109 mm tool within
+// 1 mm), not the measured point; the tracker's own orientations place the
+// measured point 92.8 (series C) / 93.0 mm (series B) from the flange
+// (calib/real_data_test.cc, docs/REAL_DATA.md).
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 #include <string>
 #include <vector>
 
@@ -57,6 +65,13 @@ IpaSeries ReadIpaSeries(
 IpaSeries ParseIpaSeries(
     const std::string& text, const std::string& file_label,
     const std::vector<std::string>& joint_names = IpaUr10JointNames());
+
+// The T-Mac orientation of one row (measurement_rx/ry/rz, deg) as
+// tracker_from_tmac = Rx(rx) Ry(ry) Rz(rz) (intrinsic x-y-z). Checked on
+// series C against the nominal chain: relative rotations between successive
+// poses agree within 0.06 deg RMS; the extrinsic order Rz Ry Rx is off by
+// 2.6 deg.
+Eigen::Matrix3d IpaRotation(const Eigen::Vector3d& rx_ry_rz_deg);
 
 // "2,02011E+13" / "0,365141" / "-1.5" -> double; false when not a finite
 // number. A decimal comma is accepted; a single trailing '.' after a value
