@@ -2,7 +2,6 @@
 // exits (code 2, nothing written).
 
 #include <gtest/gtest.h>
-#include <sys/wait.h>
 
 #include <array>
 #include <cstdio>
@@ -11,29 +10,13 @@
 
 #include "camcal/rig.h"
 #include "tests/testing/paths.h"
+#include "tests/testing/run.h"
 
 namespace kincal {
 namespace {
 
-struct RunResult {
-  int code = -1;
-  std::string out;
-};
-
-RunResult RunKincal(const std::string& args) {
-  const std::string cmd = testing::KincalBinary() + " " + args + " 2>/dev/null";
-  RunResult r;
-  FILE* pipe = ::popen(cmd.c_str(), "r");
-  if (!pipe) return r;
-  std::array<char, 4096> buf;
-  size_t n;
-  while ((n = std::fread(buf.data(), 1, buf.size(), pipe)) > 0) {
-    r.out.append(buf.data(), n);
-  }
-  const int status = ::pclose(pipe);
-  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return r;
-}
+using testing::RunKincal;
+using testing::RunResult;
 
 std::string StereoDir() {
   return testing::SharedDataDir() + "/opencv-stereo-left-right";
@@ -45,7 +28,7 @@ TEST(CamcalCli, StereoChessboardJsonAndRig) {
   const RunResult r = RunKincal(
       "camcal --left '" + StereoDir() + "/left*.jpg' --right '" + StereoDir() +
       "/right*.jpg' --target chessboard:9x6:1 --out " + out + " --json");
-  ASSERT_EQ(r.code, 0) << r.out;
+  ASSERT_EQ(r.exit_code, 0) << r.out;
   const nlohmann::json j = nlohmann::json::parse(r.out);
   EXPECT_LE(j.at("rms_px").get<double>(), 0.445);
   EXPECT_NEAR(j.at("baseline").get<double>(), 3.34, 0.05);
@@ -77,16 +60,16 @@ TEST(CamcalCli, BadInputExitsTwoAndWritesNothing) {
   // Bad target spec (checked before any image is read).
   EXPECT_EQ(RunKincal("camcal --left " + left +
                       " --target chessboard:9x6 --out " + out)
-                .code,
+                .exit_code,
             2);
   EXPECT_EQ(RunKincal("camcal --left " + left +
                       " --target squares:9x6:1 --out " + out)
-                .code,
+                .exit_code,
             2);
   // A glob with no images.
   EXPECT_EQ(RunKincal("camcal --left '" + dir +
                       "/none*.png' --target chessboard:9x6:1 --out " + out)
-                .code,
+                .exit_code,
             2);
   // Unreadable images.
   {
@@ -97,20 +80,20 @@ TEST(CamcalCli, BadInputExitsTwoAndWritesNothing) {
   }
   EXPECT_EQ(RunKincal("camcal --left '" + dir +
                       "/img*.png' --target chessboard:9x6:1 --out " + out)
-                .code,
+                .exit_code,
             2);
   // Missing required option.
-  EXPECT_EQ(RunKincal("camcal --left " + left + " --out " + out).code, 2);
+  EXPECT_EQ(RunKincal("camcal --left " + left + " --out " + out).exit_code, 2);
   if (testing::Exists(StereoDir())) {
     // Target not found (wrong size): too few views.
     EXPECT_EQ(RunKincal("camcal --left " + left +
                         " --target chessboard:7x7:1 --out " + out)
-                  .code,
+                  .exit_code,
               2);
     // Unequal left/right counts.
     EXPECT_EQ(RunKincal("camcal --left " + left + " --right '" + StereoDir() +
                         "/right0*.jpg' --target chessboard:9x6:1 --out " + out)
-                  .code,
+                  .exit_code,
               2);
   }
   EXPECT_FALSE(testing::Exists(out));

@@ -4,7 +4,6 @@
 
 #include <glob.h>
 #include <gtest/gtest.h>
-#include <sys/wait.h>
 
 #include <algorithm>
 #include <cstdio>
@@ -17,36 +16,15 @@
 
 #include "data/atomic_file.h"
 #include "tests/testing/paths.h"
+#include "tests/testing/run.h"
 
 namespace kincal {
 namespace {
 
+using testing::RunKincal;
+using testing::RunResult;
+
 using testing::Exists;
-
-struct RunResult {
-  int exit_code = -1;
-  std::string out;
-  std::string err;
-};
-
-RunResult RunKincal(const std::string& args, const std::string& dir) {
-  const std::string err_file = dir + "/stderr.txt";
-  const std::string cmd =
-      testing::KincalBinary() + " " + args + " 2>" + err_file;
-  RunResult r;
-  FILE* p = ::popen(cmd.c_str(), "r");
-  if (p == nullptr) return r;
-  char buf[4096];
-  size_t n;
-  while ((n = std::fread(buf, 1, sizeof(buf), p)) > 0) r.out.append(buf, n);
-  const int status = ::pclose(p);
-  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  std::ifstream in(err_file);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  r.err = ss.str();
-  return r;
-}
 
 std::vector<std::string> Glob(const std::string& pattern) {
   glob_t g{};
@@ -84,9 +62,8 @@ TEST(CaptureCli, ReplaysFoldersIntoASessionThatTrackReads) {
   const std::string work = testing::MakeTempDir("capture_cli");
   const std::string out = work + "/session";
   const RunResult r = RunKincal("capture --left 'folder:" + in +
-                                    "/cam_l_*.png' --right 'folder:" + in +
-                                    "/cam_r_*.png' --out " + out + " --json",
-                                work);
+                                "/cam_l_*.png' --right 'folder:" + in +
+                                "/cam_r_*.png' --out " + out + " --json");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const auto j = nlohmann::json::parse(r.out);
   EXPECT_EQ(j["frames"], kFrames);
@@ -149,11 +126,10 @@ TEST(CaptureCli, ReplaysFoldersIntoASessionThatTrackReads) {
                   "kincal_target: 1\nfamily: tag36h11\ntags:\n"
                   "  - {id: 0, size: 30.0, tool_from_tag: {R: [1,0,0, 0,1,0, "
                   "0,0,1], t: [0, 0, 0]}}\ntip_in_tool: [0, 0, 150]\n");
-  const RunResult t = RunKincal(
-      "track --rig " + rig + " --target " + target + " --left '" + out +
-          "/left/*.png' --right '" + out + "/right/*.png' --out " + work +
-          "/points.csv --quiet --json",
-      work);
+  const RunResult t =
+      RunKincal("track --rig " + rig + " --target " + target + " --left '" +
+                out + "/left/*.png' --right '" + out + "/right/*.png' --out " +
+                work + "/points.csv --quiet --json");
   ASSERT_EQ(t.exit_code, 0) << t.err;
   const auto tj = nlohmann::json::parse(t.out);
   EXPECT_EQ(tj["frames"], kFrames);
@@ -165,8 +141,7 @@ TEST(CaptureCli, FramesLimitStopsEarly) {
   const std::string work = testing::MakeTempDir("capture_cli_n");
   const RunResult r = RunKincal(
       "capture --left 'folder:" + in + "/cam_l_*.png' --right 'folder:" + in +
-          "/cam_r_*.png' --out " + work + "/s --frames 3 --json",
-      work);
+      "/cam_r_*.png' --out " + work + "/s --frames 3 --json");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_EQ(nlohmann::json::parse(r.out)["stop_reason"], "frames");
   EXPECT_EQ(Glob(work + "/s/left/*.png").size(), 3u);
@@ -178,9 +153,8 @@ TEST(CaptureCli, UnequalReplayLengthsRecordOnlyPairs) {
   ASSERT_EQ(std::remove((in + "/cam_r_04.png").c_str()), 0);
   const std::string work = testing::MakeTempDir("capture_cli_len");
   const RunResult r = RunKincal("capture --left 'folder:" + in +
-                                    "/cam_l_*.png' --right 'folder:" + in +
-                                    "/cam_r_*.png' --out " + work + "/s --json",
-                                work);
+                                "/cam_l_*.png' --right 'folder:" + in +
+                                "/cam_r_*.png' --out " + work + "/s --json");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const auto j = nlohmann::json::parse(r.out);
   EXPECT_EQ(j["frames"], kFrames - 1);
@@ -193,8 +167,7 @@ TEST(CaptureCli, UnequalReplayLengthsRecordOnlyPairs) {
 // Bad input: exit 2, a clear message, and no session folder.
 void ExpectBadInput(const std::string& args, const std::string& message) {
   const std::string work = testing::MakeTempDir("capture_cli_bad");
-  const RunResult r =
-      RunKincal("capture " + args + " --out " + work + "/s", work);
+  const RunResult r = RunKincal("capture " + args + " --out " + work + "/s");
   EXPECT_EQ(r.exit_code, 2) << args << "\n" << r.err;
   EXPECT_NE(r.err.find(message), std::string::npos) << r.err;
   EXPECT_TRUE(r.out.empty()) << r.out;
@@ -224,9 +197,9 @@ TEST(CaptureCli, NeverOverwritesASession) {
   const std::string args = "capture --left 'folder:" + in +
                            "/cam_l_*.png' --right 'folder:" + in +
                            "/cam_r_*.png' --out " + work + "/s --frames 2";
-  ASSERT_EQ(RunKincal(args, work).exit_code, 0);
+  ASSERT_EQ(RunKincal(args).exit_code, 0);
   const std::string before = ReadFile(work + "/s/frames.csv");
-  const RunResult again = RunKincal(args, work);
+  const RunResult again = RunKincal(args);
   EXPECT_EQ(again.exit_code, 2);
   EXPECT_NE(again.err.find("not empty"), std::string::npos) << again.err;
   EXPECT_EQ(ReadFile(work + "/s/frames.csv"), before);
@@ -236,8 +209,7 @@ TEST(CaptureCli, MissingCameraFailsWithExit1AndNoSession) {
   const std::string work = testing::MakeTempDir("capture_cli_cam");
   const RunResult r = RunKincal(
       "capture --left v4l2:/dev/video97 --right v4l2:/dev/video98 --out " +
-          work + "/s --frames 1",
-      work);
+      work + "/s --frames 1");
   EXPECT_EQ(r.exit_code, 1) << r.err;
   EXPECT_NE(r.err.find("/dev/video97"), std::string::npos) << r.err;
   EXPECT_FALSE(Exists(work + "/s"));
@@ -245,7 +217,7 @@ TEST(CaptureCli, MissingCameraFailsWithExit1AndNoSession) {
 
 TEST(CaptureCli, ListPrintsCameraArrays) {
   const std::string work = testing::MakeTempDir("capture_cli_list");
-  const RunResult r = RunKincal("capture --list --json", work);
+  const RunResult r = RunKincal("capture --list --json");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const auto j = nlohmann::json::parse(r.out);
   EXPECT_TRUE(j["v4l2"].is_array());

@@ -2,7 +2,6 @@
 // build/bin/kincal track on them, and compare points.csv with the truth.
 
 #include <gtest/gtest.h>
-#include <sys/wait.h>
 
 #include <cstdio>
 #include <fstream>
@@ -13,35 +12,14 @@
 
 #include "data/atomic_file.h"
 #include "tests/testing/paths.h"
+#include "tests/testing/run.h"
 #include "vision/render.h"
 
 namespace kincal {
 namespace {
 
-struct RunResult {
-  int exit_code = -1;
-  std::string out;
-  std::string err;
-};
-
-RunResult RunKincal(const std::string& args, const std::string& dir) {
-  const std::string err_file = dir + "/stderr.txt";
-  const std::string cmd =
-      testing::KincalBinary() + " " + args + " 2>" + err_file;
-  RunResult r;
-  FILE* p = ::popen(cmd.c_str(), "r");
-  if (p == nullptr) return r;
-  char buf[4096];
-  size_t n;
-  while ((n = std::fread(buf, 1, sizeof(buf), p)) > 0) r.out.append(buf, n);
-  const int status = ::pclose(p);
-  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  std::ifstream in(err_file);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  r.err = ss.str();
-  return r;
-}
+using testing::RunKincal;
+using testing::RunResult;
 
 std::vector<std::vector<std::string>> ReadCsvRows(const std::string& path) {
   std::vector<std::vector<std::string>> rows;
@@ -95,7 +73,7 @@ std::string Args(const std::string& s, const std::string& out) {
 TEST_F(TrackCli, TipsMatchRenderedTruth) {
   const std::string s = dir_ + "/session";
   const std::string out = dir_ + "/points.csv";
-  const RunResult r = RunKincal(Args(s, out) + " --json", dir_);
+  const RunResult r = RunKincal(Args(s, out) + " --json");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const nlohmann::json j = nlohmann::json::parse(r.out);
   EXPECT_EQ(j["frames"], 5);
@@ -130,13 +108,12 @@ TEST_F(TrackCli, TipsMatchRenderedTruth) {
 TEST_F(TrackCli, FullFrameModeGivesTheSameTips) {
   const std::string s = dir_ + "/session";
   const RunResult r =
-      RunKincal(Args(s, dir_ + "/full.csv") + " --no-tracking --json", dir_);
+      RunKincal(Args(s, dir_ + "/full.csv") + " --no-tracking --json");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const auto a = ReadCsvRows(dir_ + "/full.csv");
   EXPECT_EQ(nlohmann::json::parse(r.out)["found"], 4);
   ASSERT_EQ(a.size(), 6u);
-  const RunResult t =
-      RunKincal(Args(s, dir_ + "/tracked.csv") + " --json", dir_);
+  const RunResult t = RunKincal(Args(s, dir_ + "/tracked.csv") + " --json");
   ASSERT_EQ(t.exit_code, 0) << t.err;
   const auto b = ReadCsvRows(dir_ + "/tracked.csv");
   ASSERT_EQ(b.size(), 6u);
@@ -160,8 +137,7 @@ TEST_F(TrackCli, BadInputExits2AndWritesNothing) {
   const std::string out1 = dir_ + "/bad1.csv";
   RunResult r = RunKincal(
       "track --rig " + s + "/rig.yaml --target " + bad_target + " --left '" +
-          s + "/left_*.png' --right '" + s + "/right_*.png' --out " + out1,
-      dir_);
+      s + "/left_*.png' --right '" + s + "/right_*.png' --out " + out1);
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_NE(r.err.find("bad_target.yaml:3:"), std::string::npos) << r.err;
   EXPECT_FALSE(testing::Exists(out1));
@@ -169,24 +145,22 @@ TEST_F(TrackCli, BadInputExits2AndWritesNothing) {
   // No image matches.
   const std::string out2 = dir_ + "/bad2.csv";
   r = RunKincal("track --rig " + s + "/rig.yaml --target " + s +
-                    "/target.yaml --left '" + s + "/nothing_*.png' --right '" +
-                    s + "/right_*.png' --out " + out2,
-                dir_);
+                "/target.yaml --left '" + s + "/nothing_*.png' --right '" + s +
+                "/right_*.png' --out " + out2);
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_FALSE(testing::Exists(out2));
 
   // Different numbers of left and right images.
   const std::string out3 = dir_ + "/bad3.csv";
   r = RunKincal("track --rig " + s + "/rig.yaml --target " + s +
-                    "/target.yaml " + "--left '" + s +
-                    "/left_00000[01].png' --right '" + s +
-                    "/right_*.png' --out " + out3,
-                dir_);
+                "/target.yaml " + "--left '" + s +
+                "/left_00000[01].png' --right '" + s + "/right_*.png' --out " +
+                out3);
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_FALSE(testing::Exists(out3));
 
   // Missing required option.
-  r = RunKincal("track --rig " + s + "/rig.yaml --out " + out3, dir_);
+  r = RunKincal("track --rig " + s + "/rig.yaml --out " + out3);
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_FALSE(testing::Exists(out3));
 }
