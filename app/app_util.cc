@@ -14,10 +14,11 @@ void MakeDirs(const std::string& dir) {
   std::string path;
   for (size_t i = 0; i <= dir.size(); ++i) {
     if (i == dir.size() || dir[i] == '/') {
-      if (!path.empty() && ::mkdir(path.c_str(), 0755) != 0 && errno != EEXIST) {
-        throw InputError(path, 0, 0,
-                         std::string("cannot create folder: ") +
-                             std::strerror(errno));
+      if (!path.empty() && ::mkdir(path.c_str(), 0755) != 0 &&
+          errno != EEXIST) {
+        throw InputError(
+            path, 0, 0,
+            std::string("cannot create folder: ") + std::strerror(errno));
       }
     }
     if (i < dir.size()) path += dir[i];
@@ -45,7 +46,8 @@ std::string ParamUnit(const ParamInfo& p) {
   return p.angle ? "deg" : "mm";
 }
 
-nlohmann::json ParametersJson(const FitSummary& fit, const ModelState& nominal) {
+nlohmann::json ParametersJson(const FitSummary& fit,
+                              const ModelState& nominal) {
   nlohmann::json out = nlohmann::json::array();
   for (size_t i = 0; i < fit.params.size(); ++i) {
     const ParamInfo& p = fit.params[i];

@@ -62,15 +62,17 @@ int RunCalibrate(CalibrateArgs args) {
 
   if (!args.out.empty()) {
     std::ostringstream note;
-    note << "calibrated by " << r.method << " from " << args.obs << ": train RMS "
-         << r.train.rms_mm << " mm (" << r.train.n << " poses), held-out RMS "
-         << r.heldout.rms_mm << " mm (" << r.heldout.n << " poses)";
+    note << "calibrated by " << r.method << " from " << args.obs
+         << ": train RMS " << r.train.rms_mm << " mm (" << r.train.n
+         << " poses), held-out RMS " << r.heldout.rms_mm << " mm ("
+         << r.heldout.n << " poses)";
     std::vector<std::string> comment = {note.str()};
     std::string held;
     for (const auto& name : r.identifiability.UnidentifiableNames()) {
       held += (held.empty() ? "" : ", ") + name;
     }
-    if (!held.empty()) comment.push_back("held at nominal (not identifiable): " + held);
+    if (!held.empty())
+      comment.push_back("held at nominal (not identifiable): " + held);
     WriteFileAtomic(args.out, FormatRobotYaml(r.calibrated, comment));
   }
 
@@ -105,7 +107,8 @@ int RunCalibrate(CalibrateArgs args) {
                     {"std_mm", r.epsilon.std_mm},
                     {"n", r.epsilon.n}};
   }
-  if (!r.distance_errors_mm.empty()) j["distance_errors_mm"] = r.distance_errors_mm;
+  if (!r.distance_errors_mm.empty())
+    j["distance_errors_mm"] = r.distance_errors_mm;
   if (!args.out.empty()) j["out"] = args.out;
   if (args.json) {
     PrintJson(j);
@@ -113,26 +116,29 @@ int RunCalibrate(CalibrateArgs args) {
   }
   std::printf("kincal calibrate (%s): %d training poses, %d held out\n",
               r.method.c_str(), r.train.n, r.heldout.n);
-  std::printf("  train RMS    %.4f mm   (mean %.4f, max %.4f)\n", r.train.rms_mm,
-              r.train.mean_mm, r.train.max_mm);
+  std::printf("  train RMS    %.4f mm   (mean %.4f, max %.4f)\n",
+              r.train.rms_mm, r.train.mean_mm, r.train.max_mm);
   if (r.heldout.n > 0) {
     std::printf("  held-out RMS %.4f mm   (mean %.4f, max %.4f)\n",
                 r.heldout.rms_mm, r.heldout.mean_mm, r.heldout.max_mm);
   }
   if (r.has_epsilon) {
-    std::printf("  epsilon (mean distance to the fixed point) %.4f mm, max %.4f, std %.4f\n",
-                r.epsilon.mean_mm, r.epsilon.max_mm, r.epsilon.std_mm);
+    std::printf(
+        "  epsilon (mean distance to the fixed point) %.4f mm, max %.4f, std "
+        "%.4f\n",
+        r.epsilon.mean_mm, r.epsilon.max_mm, r.epsilon.std_mm);
   }
   std::printf("  %zu identifiable parameters, %zu held at nominal; %s\n",
               id.identifiable.size(), id.unidentifiable.size(),
               r.fit.termination.c_str());
   for (const auto& rel : id.relations) std::printf("    %s\n", rel.c_str());
-  std::printf("  %-14s %12s %12s %10s\n", "parameter", "nominal", "value", "sigma");
+  std::printf("  %-14s %12s %12s %10s\n", "parameter", "nominal", "value",
+              "sigma");
   for (const auto& p : j["parameters"]) {
     if (!p.contains("nominal")) continue;
     std::printf("  %-14s %12.4f %12.4f %10.4f %s\n",
-                p["name"].get<std::string>().c_str(), p["nominal"].get<double>(),
-                p["value"].get<double>(),
+                p["name"].get<std::string>().c_str(),
+                p["nominal"].get<double>(), p["value"].get<double>(),
                 p["sigma"].is_null() ? NAN : p["sigma"].get<double>(),
                 p["unit"].get<std::string>().c_str());
   }

@@ -35,7 +35,7 @@ struct SimulateArgs {
 Rigid3 TipFromTool(const Target& target) {
   Rigid3 tip_from_tool;
   tip_from_tool.R << 0, 0, 1,  //
-      1, 0, 0,                  //
+      1, 0, 0,                 //
       0, 1, 0;
   tip_from_tool.t = -(tip_from_tool.R * target.tip_in_tool);
   return tip_from_tool;
@@ -54,14 +54,15 @@ Rigid3 ToRigid(const Eigen::Matrix4d& m) {
 double PlaceRig(const std::vector<Eigen::Matrix4d>& base_from_tip,
                 const Rig& rig, const Rigid3& tip_from_tool,
                 std::array<double, 6>* rig_from_base) {
-  Eigen::Vector3d centroid = Eigen::Vector3d::Zero(), mean_z = Eigen::Vector3d::Zero();
+  Eigen::Vector3d centroid = Eigen::Vector3d::Zero(),
+                  mean_z = Eigen::Vector3d::Zero();
   for (const Eigen::Matrix4d& m : base_from_tip) {
     centroid += m.block<3, 1>(0, 3);
     mean_z += m.block<3, 3>(0, 0) * tip_from_tool.R.col(2);
   }
   centroid /= static_cast<double>(base_from_tip.size());
-  Eigen::Vector3d z = mean_z.norm() > 1e-6 ? mean_z.normalized()
-                                           : Eigen::Vector3d(0, 0, -1);
+  Eigen::Vector3d z =
+      mean_z.norm() > 1e-6 ? mean_z.normalized() : Eigen::Vector3d(0, 0, -1);
   const Eigen::Vector3d e = std::abs(z.z()) < 0.9 ? Eigen::Vector3d::UnitZ()
                                                   : Eigen::Vector3d::UnitX();
   const Eigen::Vector3d x = z.cross(e).normalized();
@@ -120,8 +121,7 @@ int RunSimulate(SimulateArgs args) {
                             TipFromTool(target), &rig_from_base);
     opt.meas_from_base = rig_from_base;
     // Tags at least ~40 px wide at that distance: scale the example tool.
-    const double tag_mm =
-        40.0 * rig_distance / rig.cameras.at(0).intrinsics.fx;
+    const double tag_mm = 40.0 * rig_distance / rig.cameras.at(0).intrinsics.fx;
     const double scale = std::max(1.0, tag_mm / target.tags.at(0).size_mm);
     for (TargetTag& tag : target.tags) {
       tag.size_mm *= scale;
@@ -153,7 +153,8 @@ int RunSimulate(SimulateArgs args) {
       {"rotation_vector_deg",
        {s.meas_from_base[0] * 180 / M_PI, s.meas_from_base[1] * 180 / M_PI,
         s.meas_from_base[2] * 180 / M_PI}},
-      {"t_mm", {s.meas_from_base[3], s.meas_from_base[4], s.meas_from_base[5]}}};
+      {"t_mm",
+       {s.meas_from_base[3], s.meas_from_base[4], s.meas_from_base[5]}}};
   ModelState truth_state;
   truth_state.chain = Chain::FromRobot(s.truth);
   nlohmann::json params;
@@ -165,8 +166,10 @@ int RunSimulate(SimulateArgs args) {
   const std::vector<std::string> comment = {
       "simulated session, seed " + std::to_string(opt.seed) +
       "; the true robot and injected effects are in truth.json"};
-  const std::string robot_text = FormatRobotYaml(nominal, {"nominal robot of a simulated session"});
-  const std::string truth_robot_text = FormatRobotYaml(s.truth, {"TRUE robot of a simulated session (for tests)"});
+  const std::string robot_text =
+      FormatRobotYaml(nominal, {"nominal robot of a simulated session"});
+  const std::string truth_robot_text = FormatRobotYaml(
+      s.truth, {"TRUE robot of a simulated session (for tests)"});
   const std::string obs_text = FormatObservationsCsv(s.observations, comment);
   MakeDirs(args.out);
   int rendered = 0;
@@ -176,10 +179,11 @@ int RunSimulate(SimulateArgs args) {
       const Eigen::Vector3d w(s.meas_from_base[0], s.meas_from_base[1],
                               s.meas_from_base[2]);
       if (w.norm() > 0) {
-        m.block<3, 3>(0, 0) = Eigen::AngleAxisd(w.norm(), w.normalized()).toRotationMatrix();
+        m.block<3, 3>(0, 0) =
+            Eigen::AngleAxisd(w.norm(), w.normalized()).toRotationMatrix();
       }
-      m.block<3, 1>(0, 3) = Eigen::Vector3d(s.meas_from_base[3], s.meas_from_base[4],
-                                            s.meas_from_base[5]);
+      m.block<3, 1>(0, 3) = Eigen::Vector3d(
+          s.meas_from_base[3], s.meas_from_base[4], s.meas_from_base[5]);
       return m;
     }());
     std::vector<Rigid3> rig_from_tool;
@@ -195,12 +199,12 @@ int RunSimulate(SimulateArgs args) {
   WriteFileAtomic(args.out + "/truth.json", truth.dump(2) + "\n");
 
   if (args.json) {
-    nlohmann::json j = {{"out", args.out},
-                        {"poses", s.observations.rows.size()},
-                        {"effects", effects},
-                        {"files",
-                         {"robot.yaml", "observations.csv", "truth.json",
-                          "truth_robot.yaml"}}};
+    nlohmann::json j = {
+        {"out", args.out},
+        {"poses", s.observations.rows.size()},
+        {"effects", effects},
+        {"files",
+         {"robot.yaml", "observations.csv", "truth.json", "truth_robot.yaml"}}};
     if (args.render) {
       j["render"] = {{"folder", args.out + "/images"},
                      {"frames", rendered},

@@ -264,7 +264,8 @@ void AddTrackCommand(CLI::App& app, Runner* run) {
   sub->add_option("--obs", args->obs,
                   "observations.csv with the joint readings of the same "
                   "frames (one row per pair, in order)");
-  sub->add_option("--robot", args->robot, "robot.yaml naming the joints of --obs");
+  sub->add_option("--robot", args->robot,
+                  "robot.yaml naming the joints of --obs");
   sub->add_option("--out-obs", args->out_obs,
                   "write --obs with x,y,z replaced by the tracked tips");
   sub->add_option("--min-tags", args->min_tags,

@@ -83,8 +83,8 @@ CalibrateResult Calibrate(const Robot& nominal, const Observations& obs,
   Require(options.holdout_fraction >= 0 && options.holdout_fraction < 0.9,
           "--holdout must be in [0, 0.9)");
   CalibrateResult result;
-  result.method = options.method == CalibrateOptions::kPaper ? "paper"
-                                                             : "least_squares";
+  result.method =
+      options.method == CalibrateOptions::kPaper ? "paper" : "least_squares";
   const Chain nominal_chain = Chain::FromRobot(nominal);
   ModelState& state = result.state;
   state.chain = nominal_chain;
@@ -122,10 +122,9 @@ CalibrateResult Calibrate(const Robot& nominal, const Observations& obs,
   const std::vector<Measurement> held = Pick(all, result.heldout_rows);
   InitializeFrameAndPoints(train, &state);
 
-  const bool any_measured =
-      std::any_of(train.begin(), train.end(), [](const Measurement& m) {
-        return m.kind == Measurement::kMeasured;
-      });
+  const bool any_measured = std::any_of(
+      train.begin(), train.end(),
+      [](const Measurement& m) { return m.kind == Measurement::kMeasured; });
   std::vector<ParamInfo> nuisance;  // frame and fixed points
   if (any_measured) nuisance = FrameParams();
   for (const ParamInfo& p : PointParams(state)) nuisance.push_back(p);
@@ -139,7 +138,8 @@ CalibrateResult Calibrate(const Robot& nominal, const Observations& obs,
 
   std::vector<ParamInfo> candidates = nuisance;
   if (options.fit_geometry) {
-    for (const ParamInfo& p : GeometryParams(state.chain)) candidates.push_back(p);
+    for (const ParamInfo& p : GeometryParams(state.chain))
+      candidates.push_back(p);
     for (const std::string& name : options.extra_params) {
       candidates.push_back(FindParam(state, name));
     }
@@ -148,7 +148,8 @@ CalibrateResult Calibrate(const Robot& nominal, const Observations& obs,
       train, state, candidates, options.identifiability, distances);
   int robot_params = 0;
   for (const ParamInfo& p : result.identifiability.identifiable) {
-    if (p.kind != ParamKind::kFrame && p.kind != ParamKind::kPoint) ++robot_params;
+    if (p.kind != ParamKind::kFrame && p.kind != ParamKind::kPoint)
+      ++robot_params;
   }
   if (options.fit_geometry && robot_params == 0) {
     throw InputError(obs.source, 0, 0,
@@ -157,14 +158,16 @@ CalibrateResult Calibrate(const Robot& nominal, const Observations& obs,
                          " distinct poses): use more poses that differ in "
                          "every joint");
   }
-  const int num_free = static_cast<int>(result.identifiability.identifiable.size());
-  const int num_residuals = 3 * static_cast<int>(train.size()) +
-                            static_cast<int>(distances.size());
+  const int num_free =
+      static_cast<int>(result.identifiability.identifiable.size());
+  const int num_residuals =
+      3 * static_cast<int>(train.size()) + static_cast<int>(distances.size());
   if (num_residuals <= num_free) {
     throw InputError(obs.source, 0, 0,
                      "too few poses: " + std::to_string(train.size()) +
-                         " training poses give " + std::to_string(num_residuals) +
-                         " equations for " + std::to_string(num_free) +
+                         " training poses give " +
+                         std::to_string(num_residuals) + " equations for " +
+                         std::to_string(num_free) +
                          " identifiable parameters; need at least " +
                          std::to_string(num_free / 3 + 1) +
                          " distinct training poses (more for a useful fit)");
@@ -198,8 +201,8 @@ CalibrateResult Calibrate(const Robot& nominal, const Observations& obs,
   if (options.fit_geometry && result.fit.sigma0_mm > 0) {
     IdentifiabilityOptions second = options.identifiability;
     second.noise_sigma_mm = result.fit.sigma0_mm;
-    Identifiability at_solution = AnalyzeIdentifiability(
-        train, state, candidates, second, distances);
+    Identifiability at_solution =
+        AnalyzeIdentifiability(train, state, candidates, second, distances);
     if (at_solution.identifiable.size() <
         result.identifiability.identifiable.size()) {
       for (const ParamInfo& p : at_solution.unidentifiable) {

@@ -63,8 +63,8 @@ CalibrateResult Calibrate(const Robot& nominal, const Observations& obs,
 
 // Splits measurement indices into train / held-out, seeded; fixed-point
 // groups are split per group so that each keeps at least 3 training poses.
-void SplitHoldout(const std::vector<Measurement>& measurements,
-                  double fraction, uint64_t seed, std::vector<int>* train,
+void SplitHoldout(const std::vector<Measurement>& measurements, double fraction,
+                  uint64_t seed, std::vector<int>* train,
                   std::vector<int>* heldout);
 
 // The seed's epsilon for fixed-point measurements: for each group, distances

@@ -54,8 +54,8 @@ TEST(CalibrateTest, IdentifiabilityOfBh7From3dPoints) {
   EXPECT_EQ(un.size(), 12u);
   using ::testing::Contains;
   using ::testing::Not;
-  EXPECT_THAT(un, Contains("j1.theta"));  // = rotation of the frame about z
-  EXPECT_THAT(un, Contains("j2.d"));      // parallel axes: d's collapse
+  EXPECT_THAT(un, Contains("j1.theta"));    // = rotation of the frame about z
+  EXPECT_THAT(un, Contains("j2.d"));        // parallel axes: d's collapse
   EXPECT_THAT(un, Contains("tool.alpha"));  // no effect on a point
   EXPECT_THAT(id, Contains("j3.a"));
   EXPECT_THAT(id, Contains("tool.d"));
@@ -163,7 +163,8 @@ TEST(CalibrateTest, SinglePointLeastSquares) {
     opt.noise_mm = 0.02;
     opt.seed = 8;
     const SimulatedSession s = Simulate(Bh7(), opt);
-    EXPECT_EQ(s.observations.rows.size(), static_cast<size_t>(points * per_point));
+    EXPECT_EQ(s.observations.rows.size(),
+              static_cast<size_t>(points * per_point));
     return Calibrate(s.nominal, s.observations, {});
   };
   auto robot_params = [](const CalibrateResult& r) {

@@ -12,11 +12,15 @@ constexpr double kDegToRad = M_PI / 180.0;
 RowBlock RowFromDescription(Convention convention, const RobotRow& r) {
   RowBlock p{};
   if (convention == Convention::kUrdf) {
-    p = {r.xyz_mm.x(), r.xyz_mm.y(), r.xyz_mm.z(), r.rpy_deg.x() * kDegToRad,
-         r.rpy_deg.y() * kDegToRad, r.rpy_deg.z() * kDegToRad};
+    p = {r.xyz_mm.x(),
+         r.xyz_mm.y(),
+         r.xyz_mm.z(),
+         r.rpy_deg.x() * kDegToRad,
+         r.rpy_deg.y() * kDegToRad,
+         r.rpy_deg.z() * kDegToRad};
   } else {
     p = {r.theta_deg * kDegToRad, r.d_mm, r.a_mm, r.alpha_deg * kDegToRad,
-         r.beta_deg * kDegToRad, 0.0};
+         r.beta_deg * kDegToRad,  0.0};
   }
   return p;
 }
@@ -101,10 +105,10 @@ Robot Chain::ToRobot(const Robot& description) const {
       robot.extensions.push_back(
           {"compliance", name, {{"per_torque", err[kCompliance] / unit}}});
     if (err[kCyclicCos] != 0.0 || err[kCyclicSin] != 0.0)
-      robot.extensions.push_back({"cyclic",
-                                  name,
-                                  {{"cos", err[kCyclicCos] / unit},
-                                   {"sin", err[kCyclicSin] / unit}}});
+      robot.extensions.push_back(
+          {"cyclic",
+           name,
+           {{"cos", err[kCyclicCos] / unit}, {"sin", err[kCyclicSin] / unit}}});
     if (err[kGain] != 0.0)
       robot.extensions.push_back({"gain", name, {{"g", err[kGain]}}});
   }
@@ -185,9 +189,9 @@ void JointAxesInBase(const Chain& chain, const std::vector<double>& q,
 std::vector<PoseInput> MakePoseInputs(const Chain& chain,
                                       const Observations& obs) {
   const int n = chain.num_joints();
-  KINCAL_CHECK(static_cast<int>(obs.joint_names.size()) == n,
-               "observations have " << obs.joint_names.size()
-                                    << " joints, chain " << n);
+  KINCAL_CHECK(
+      static_cast<int>(obs.joint_names.size()) == n,
+      "observations have " << obs.joint_names.size() << " joints, chain " << n);
   double t0 = 0.0;
   bool any_time = false;
   for (const auto& r : obs.rows) {

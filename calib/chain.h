@@ -29,7 +29,13 @@ constexpr int kRowBlockSize = 6;
 //   [gain (1), backlash (rad|mm, full width), compliance (rad|mm per mm of
 //    unit-mass torque), cyclic_cos (rad), cyclic_sin (rad)]
 constexpr int kJointErrorBlockSize = 5;
-enum JointErrorIndex { kGain = 0, kBacklash, kCompliance, kCyclicCos, kCyclicSin };
+enum JointErrorIndex {
+  kGain = 0,
+  kBacklash,
+  kCompliance,
+  kCyclicCos,
+  kCyclicSin
+};
 // Drift block: tip drift in the base frame, mm per hour.
 constexpr int kDriftBlockSize = 3;
 // Measuring frame block (meas_from_base): [rx, ry, rz (angle-axis, rad),
@@ -50,8 +56,8 @@ struct Chain {
   std::string name;
   Convention convention = Convention::kDh;
   Eigen::Vector3d gravity = Eigen::Vector3d(0, 0, -1);
-  std::vector<ChainRow> rows;                  // joints in order, tool last
-  std::vector<JointErrorBlock> joint_errors;   // one per joint, zero = none
+  std::vector<ChainRow> rows;                   // joints in order, tool last
+  std::vector<JointErrorBlock> joint_errors;    // one per joint, zero = none
   std::array<double, kDriftBlockSize> drift{};  // mm per hour
   double bound_length_mm = 5.0;
   double bound_angle_rad = 5.0 * M_PI / 180.0;
@@ -190,7 +196,8 @@ Mat4<T> RowTransform(Convention convention, const ChainRow& row, const T* p,
              Trans(zero, zero, d);
     }
     case Convention::kUrdf: {
-      Mat4<T> m = Trans(p[0], p[1], p[2]) * RotZ(p[5]) * RotY(p[4]) * RotX(p[3]);
+      Mat4<T> m =
+          Trans(p[0], p[1], p[2]) * RotZ(p[5]) * RotY(p[4]) * RotX(p[3]);
       if (revolute) return m * RotAxis(row.axis, q);
       if (prismatic) {
         return m * Trans(T(row.axis.x()) * q, T(row.axis.y()) * q,
@@ -213,7 +220,8 @@ T ModelJointValue(JointType type, double q_read, double s, double tau,
   T q = (T(1) + err[kGain]) * q_read - T(0.5 * s) * err[kBacklash] +
         err[kCompliance] * tau;
   if (type == JointType::kRevolute) {
-    q += err[kCyclicCos] * std::cos(q_read) + err[kCyclicSin] * std::sin(q_read);
+    q +=
+        err[kCyclicCos] * std::cos(q_read) + err[kCyclicSin] * std::sin(q_read);
   }
   return q;
 }
@@ -281,7 +289,8 @@ Vec3<T> RowApply(Convention convention, const ChainRow& row, const T* p,
       y[2] += prismatic ? p[1] + q : p[1];
       return RotZApply(revolute ? p[0] + q : p[0], y);
     }
-    case Convention::kMdh: {  // Rx(alpha) Ry(beta) Tx(a) Rz(theta + q) Tz(d + q)
+    case Convention::kMdh: {  // Rx(alpha) Ry(beta) Tx(a) Rz(theta + q) Tz(d +
+                              // q)
       Vec3<T> y = x;
       y[2] += prismatic ? p[1] + q : p[1];
       y = RotZApply(revolute ? p[0] + q : p[0], y);
@@ -339,7 +348,8 @@ Vec3<T> ApplyFrame(const T* frame, const Vec3<T>& p_in_base) {
   using std::sin;
   using std::sqrt;
   // Rodrigues with the small-angle branch, as ceres::AngleAxisRotatePoint.
-  const T theta2 = frame[0] * frame[0] + frame[1] * frame[1] + frame[2] * frame[2];
+  const T theta2 =
+      frame[0] * frame[0] + frame[1] * frame[1] + frame[2] * frame[2];
   Vec3<T> r;
   if (theta2 > T(1e-24)) {
     const T theta = sqrt(theta2);

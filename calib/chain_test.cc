@@ -91,8 +91,9 @@ TEST(ChainTest, DhAndMdhAgreeOnPlanarArm) {
       const Eigen::Vector3d a = TipInBase(c_dh, Input(c_dh, {q1, q2}));
       const Eigen::Vector3d b = TipInBase(c_mdh, Input(c_mdh, {q1, q2}));
       EXPECT_NEAR((a - b).norm(), 0.0, 1e-9);
-      EXPECT_NEAR(a.x(), 300 * std::cos(q1 * kDeg) +
-                             250 * std::cos((q1 + q2) * kDeg), 1e-9);
+      EXPECT_NEAR(a.x(),
+                  300 * std::cos(q1 * kDeg) + 250 * std::cos((q1 + q2) * kDeg),
+                  1e-9);
     }
   }
 }
@@ -100,8 +101,8 @@ TEST(ChainTest, DhAndMdhAgreeOnPlanarArm) {
 // Autodiff through the templated FK equals central differences.
 TEST(ChainTest, AutodiffJacobianMatchesNumeric) {
   const Chain chain = Bh7();
-  const PoseInput in = Input(chain, {78.4602, 36.0462, 95.4866, 153.0275,
-                                     -45.1143});
+  const PoseInput in =
+      Input(chain, {78.4602, 36.0462, 95.4866, 153.0275, -45.1143});
   using J = ceres::Jet<double, kRowBlockSize>;
   for (int row = 0; row < static_cast<int>(chain.rows.size()); ++row) {
     std::vector<std::array<J, kRowBlockSize>> rows_j(chain.rows.size());
@@ -136,14 +137,16 @@ TEST(ChainTest, JointErrorModelShiftsJointValue) {
   PoseInput in = Input(nominal, {50, 10, 20, 30, 40});
   in.s[2] = 1.0;  // j3 approached moving positive: q = q_read - b/2
   PoseInput shifted = Input(nominal, {50, 10, 19.75, 30, 40});
-  EXPECT_NEAR((TipInBase(with_backlash, in) - TipInBase(nominal, shifted)).norm(),
-              0.0, 1e-9);
+  EXPECT_NEAR(
+      (TipInBase(with_backlash, in) - TipInBase(nominal, shifted)).norm(), 0.0,
+      1e-9);
   // Gain: q = (1 + g) q_read.
   Chain with_gain = nominal;
   with_gain.joint_errors[1][kGain] = 0.01;
   PoseInput gain_shifted = Input(nominal, {50, 10.1, 20, 30, 40});
   EXPECT_NEAR((TipInBase(with_gain, Input(nominal, {50, 10, 20, 30, 40})) -
-               TipInBase(nominal, gain_shifted)).norm(),
+               TipInBase(nominal, gain_shifted))
+                  .norm(),
               0.0, 1e-9);
 }
 
@@ -185,8 +188,8 @@ TEST(ChainTest, RobotRoundTripKeepsValuesAndExtensions) {
   const Robot out = chain.ToRobot(robot);
   EXPECT_DOUBLE_EQ(out.joints[2].a_mm, 199.5);
   ASSERT_EQ(out.extensions.size(), 2u);
-  const Chain back = Chain::FromRobot(
-      ParseRobotYaml(FormatRobotYaml(out), "roundtrip.yaml"));
+  const Chain back =
+      Chain::FromRobot(ParseRobotYaml(FormatRobotYaml(out), "roundtrip.yaml"));
   EXPECT_NEAR(back.joint_errors[2][kBacklash], 0.3 * kDeg, 1e-15);
   EXPECT_DOUBLE_EQ(back.drift[0], 0.1);
   EXPECT_DOUBLE_EQ(back.rows[2].p[2], 199.5);

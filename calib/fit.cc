@@ -13,8 +13,9 @@ namespace kincal {
 namespace {
 
 // Residual of one measurement.
-//   kMeasured:   r = meas_from_base * tip_in_base(q; rows, errors, drift) - p_in_meas
-//   kFixedPoint: r = tip_in_base(q; rows, errors, drift) - point_in_base
+//   kMeasured:   r = meas_from_base * tip_in_base(q; rows, errors, drift) -
+//   p_in_meas kFixedPoint: r = tip_in_base(q; rows, errors, drift) -
+//   point_in_base
 // Parameter blocks, in order: the n+1 row geometry blocks (tool last), the n
 // joint error blocks, the drift block, then meas_from_base (6) or
 // point_in_base (3). The chain is copied for its structure (row kinds, axes);
@@ -45,9 +46,8 @@ class TipResidual {
   }
 
   static ceres::CostFunction* Create(const Chain& chain, const Measurement& m) {
-    auto* cost =
-        new ceres::DynamicAutoDiffCostFunction<TipResidual, kStride>(
-            new TipResidual(chain, m));
+    auto* cost = new ceres::DynamicAutoDiffCostFunction<TipResidual, kStride>(
+        new TipResidual(chain, m));
     for (int r = 0; r <= chain.num_joints(); ++r) {
       cost->AddParameterBlock(kRowBlockSize);
     }
@@ -76,7 +76,8 @@ struct DistanceResidual {
     using std::sqrt;
     const T dx = point_a[0] - point_b[0], dy = point_a[1] - point_b[1],
             dz = point_a[2] - point_b[2];
-    residual[0] = T(weight_) * (sqrt(dx * dx + dy * dy + dz * dz) - distance_mm_);
+    residual[0] =
+        T(weight_) * (sqrt(dx * dx + dy * dy + dz * dz) - distance_mm_);
     return true;
   }
   static ceres::CostFunction* Create(double distance_mm, double weight) {
@@ -201,9 +202,9 @@ FitSummary Fit(const std::vector<Measurement>& measurements,
       if (!it->second[k]) constant.push_back(static_cast<int>(k));
     }
     if (!constant.empty()) {
-      problem.SetManifold(block, new ceres::SubsetManifold(
-                                     static_cast<int>(it->second.size()),
-                                     constant));
+      problem.SetManifold(
+          block, new ceres::SubsetManifold(static_cast<int>(it->second.size()),
+                                           constant));
     }
   }
   if (options.bounds_center != nullptr) {
@@ -214,8 +215,10 @@ FitSummary Fit(const std::vector<Measurement>& measurements,
       const double center = c.rows.at(p.block).p.at(p.index);
       const double bound =
           IsAngle(c, p) ? c.bound_angle_rad : c.bound_length_mm;
-      problem.SetParameterLowerBound(address - p.index, p.index, center - bound);
-      problem.SetParameterUpperBound(address - p.index, p.index, center + bound);
+      problem.SetParameterLowerBound(address - p.index, p.index,
+                                     center - bound);
+      problem.SetParameterUpperBound(address - p.index, p.index,
+                                     center + bound);
       // Start inside the box.
       *address = std::min(std::max(*address, center - bound), center + bound);
     }
@@ -394,7 +397,8 @@ void InitializeFrameAndPoints(const std::vector<Measurement>& measurements,
   }
   const Eigen::Matrix3Xd centered = a.colwise() - a.rowwise().mean();
   const Eigen::JacobiSVD<Eigen::Matrix3Xd> svd(centered);
-  if (src.size() < 3 || svd.singularValues()(1) < 1e-6 * svd.singularValues()(0)) {
+  if (src.size() < 3 ||
+      svd.singularValues()(1) < 1e-6 * svd.singularValues()(0)) {
     throw InputError(
         "the measured tip points are fewer than 3 or all on one line: the "
         "base-to-measuring-frame transform cannot be determined");
@@ -402,8 +406,12 @@ void InitializeFrameAndPoints(const std::vector<Measurement>& measurements,
   const Eigen::Matrix4d meas_from_base = Eigen::umeyama(a, b, false);
   const Eigen::AngleAxisd aa(Eigen::Matrix3d(meas_from_base.block<3, 3>(0, 0)));
   const Eigen::Vector3d w = aa.axis() * aa.angle();
-  state->meas_from_base = {w.x(), w.y(), w.z(), meas_from_base(0, 3),
-                           meas_from_base(1, 3), meas_from_base(2, 3)};
+  state->meas_from_base = {w.x(),
+                           w.y(),
+                           w.z(),
+                           meas_from_base(0, 3),
+                           meas_from_base(1, 3),
+                           meas_from_base(2, 3)};
 }
 
 ErrorStats ComputeErrorStats(const std::vector<double>& e) {

@@ -89,10 +89,10 @@ FitSummary Fit(const std::vector<Measurement>& measurements,
 // Jacobian of all stacked residuals (3 per measurement, then one per
 // distance) with respect to `params` (internal units), evaluated at `state`,
 // by the same autodiff functors the fit uses.
-Eigen::MatrixXd ResidualJacobian(const std::vector<Measurement>& measurements,
-                                 const ModelState& state,
-                                 const std::vector<ParamInfo>& params,
-                                 const std::vector<PointDistance>& distances = {});
+Eigen::MatrixXd ResidualJacobian(
+    const std::vector<Measurement>& measurements, const ModelState& state,
+    const std::vector<ParamInfo>& params,
+    const std::vector<PointDistance>& distances = {});
 
 // Registers the measuring frame only (robot held fixed): an Umeyama
 // (rigid, no scale) initial value from the model's tips, refined by Fit.

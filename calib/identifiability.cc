@@ -33,8 +33,8 @@ Identifiability AnalyzeIdentifiability(
   std::vector<Eigen::VectorXd> unit_columns;
   for (int c = 0; c < static_cast<int>(candidates.size()); ++c) {
     const double norm = jac.col(c).norm();
-    Eigen::VectorXd col =
-        norm > 0 ? Eigen::VectorXd(jac.col(c) / norm) : Eigen::VectorXd(jac.col(c));
+    Eigen::VectorXd col = norm > 0 ? Eigen::VectorXd(jac.col(c) / norm)
+                                   : Eigen::VectorXd(jac.col(c));
     unit_columns.push_back(col);
     Eigen::VectorXd rest = col;
     // Two passes of Gram-Schmidt for numerical orthogonality.
@@ -50,8 +50,8 @@ Identifiability AnalyzeIdentifiability(
     if (determined && options.noise_sigma_mm > 0 &&
         candidates[c].kind == ParamKind::kRow) {
       const bool angle = candidates[c].angle;
-      const double bound = angle ? state.chain.bound_angle_rad
-                                 : state.chain.bound_length_mm;
+      const double bound =
+          angle ? state.chain.bound_angle_rad : state.chain.bound_length_mm;
       determined = sigma < options.max_sigma_fraction * bound;
     }
     if (determined) {
@@ -72,7 +72,8 @@ Identifiability AnalyzeIdentifiability(
       relation += " (no effect on any residual)";
     } else {
       Eigen::MatrixXd a(m, accepted.size());
-      for (size_t k = 0; k < accepted.size(); ++k) a.col(k) = jac.col(accepted[k]);
+      for (size_t k = 0; k < accepted.size(); ++k)
+        a.col(k) = jac.col(accepted[k]);
       const Eigen::VectorXd coef =
           a.colPivHouseholderQr().solve(Eigen::VectorXd(jac.col(c)));
       std::vector<int> order(accepted.size());
@@ -105,7 +106,8 @@ Identifiability AnalyzeIdentifiability(
   }
   if (!accepted.empty()) {
     Eigen::MatrixXd a(m, accepted.size());
-    for (size_t k = 0; k < accepted.size(); ++k) a.col(k) = unit_columns[accepted[k]];
+    for (size_t k = 0; k < accepted.size(); ++k)
+      a.col(k) = unit_columns[accepted[k]];
     const Eigen::JacobiSVD<Eigen::MatrixXd> svd(a);
     const Eigen::VectorXd s = svd.singularValues();
     for (int k = 0; k < s.size(); ++k) out.singular_values.push_back(s[k]);

@@ -32,8 +32,8 @@ enum class ParamKind { kRow, kJointError, kDrift, kFrame, kPoint };
 struct ParamInfo {
   std::string name;  // e.g. "j3.a", "tool.d", "frame.rx", "j3.backlash"
   ParamKind kind = ParamKind::kRow;
-  int block = 0;   // row / joint / point index (0 for frame and drift)
-  int index = 0;   // index inside the block
+  int block = 0;       // row / joint / point index (0 for frame and drift)
+  int index = 0;       // index inside the block
   bool angle = false;  // internal radians, shown in degrees
 
   double ToInterface(double internal) const;  // rad -> deg for angles

@@ -40,7 +40,8 @@ Vec3<Jet> TipJet(const Chain& chain, const PoseInput& in, const Jet* q_read) {
   std::vector<std::array<Jet, kRowBlockSize>> rows(chain.rows.size());
   std::vector<const Jet*> row_ptrs;
   for (size_t r = 0; r < chain.rows.size(); ++r) {
-    for (int k = 0; k < kRowBlockSize; ++k) rows[r][k] = Jet(chain.rows[r].p[k]);
+    for (int k = 0; k < kRowBlockSize; ++k)
+      rows[r][k] = Jet(chain.rows[r].p[k]);
     row_ptrs.push_back(rows[r].data());
   }
   Jet q[kMaxJoints];
@@ -175,9 +176,9 @@ SimulatedSession Simulate(const Robot& nominal, const SimulateOptions& opt) {
       continue;
     }
     const double sigma =
-        (p.kind == ParamKind::kRow &&
-         (truth.convention == Convention::kUrdf ? p.index >= 3
-                                                : (p.index == 0 || p.index == 3)))
+        (p.kind == ParamKind::kRow && (truth.convention == Convention::kUrdf
+                                           ? p.index >= 3
+                                           : (p.index == 0 || p.index == 3)))
             ? opt.sigma_angle_deg * kDegToRad
             : opt.sigma_length_mm;
     truth.rows[p.block].p[p.index] += sigma * normal(rng);
@@ -189,7 +190,7 @@ SimulatedSession Simulate(const Robot& nominal, const SimulateOptions& opt) {
   Eigen::Vector3d dir(normal(rng), normal(rng), normal(rng));
   dir = dir.normalized() * opt.frame_distance_mm;
   out.meas_from_base = {axis.x() * angle, axis.y() * angle, axis.z() * angle,
-                        dir.x(), dir.y(), dir.z()};
+                        dir.x(),          dir.y(),          dir.z()};
   if (opt.meas_from_base) out.meas_from_base = *opt.meas_from_base;
 
   std::vector<double> lo, hi;
@@ -225,7 +226,8 @@ SimulatedSession Simulate(const Robot& nominal, const SimulateOptions& opt) {
       const Eigen::Vector3d point = TipInBase(truth, in);
       point_targets.push_back(point);
       int made = 0;
-      for (int attempt = 0; made < opt.poses_per_point && attempt < 200 * opt.poses_per_point;
+      for (int attempt = 0;
+           made < opt.poses_per_point && attempt < 200 * opt.poses_per_point;
            ++attempt) {
         in.q = random_q(1.0);
         if (SolvePositionIk(truth, point, lo, hi, &in)) {
@@ -235,10 +237,10 @@ SimulatedSession Simulate(const Robot& nominal, const SimulateOptions& opt) {
         }
       }
       if (made < opt.poses_per_point) {
-        throw InputError("could not find " + std::to_string(opt.poses_per_point) +
-                         " poses reaching fixed point " + std::to_string(k) +
-                         " within the joint limits (found " +
-                         std::to_string(made) + ")");
+        throw InputError(
+            "could not find " + std::to_string(opt.poses_per_point) +
+            " poses reaching fixed point " + std::to_string(k) +
+            " within the joint limits (found " + std::to_string(made) + ")");
       }
     }
   }
@@ -253,7 +255,8 @@ SimulatedSession Simulate(const Robot& nominal, const SimulateOptions& opt) {
     for (int j = 0; j < n; ++j) {
       o.q.push_back(nominal_chain.InternalToReading(j, poses[i][j]));
     }
-    if (point_of_pose[i] >= 0) o.fixed_point = "p" + std::to_string(point_of_pose[i]);
+    if (point_of_pose[i] >= 0)
+      o.fixed_point = "p" + std::to_string(point_of_pose[i]);
     if (opt.seconds_per_pose > 0) o.t_s = opt.seconds_per_pose * i;
     obs.rows.push_back(o);
   }
@@ -266,7 +269,8 @@ SimulatedSession Simulate(const Robot& nominal, const SimulateOptions& opt) {
       Eigen::Vector3d v(normal(rng), normal(rng), normal(rng));
       v = v.normalized() * e.magnitude;
       truth.drift = {v.x(), v.y(), v.z()};
-      note << "drift v = [" << v.x() << ", " << v.y() << ", " << v.z() << "] mm/h";
+      note << "drift v = [" << v.x() << ", " << v.y() << ", " << v.z()
+           << "] mm/h";
       out.effect_notes.push_back(note.str());
       continue;
     }
@@ -285,9 +289,11 @@ SimulatedSession Simulate(const Robot& nominal, const SimulateOptions& opt) {
       note << "phase " << phase / kDegToRad << " deg";
     } else if (e.cause == "compliance") {
       double max_tau = 0;
-      for (const auto& in : inputs) max_tau = std::max(max_tau, std::abs(in.tau[j]));
-      Require(max_tau > 1e-9, "compliance on joint '" + e.joint +
-                                  "': gravity has no torque about it in these poses");
+      for (const auto& in : inputs)
+        max_tau = std::max(max_tau, std::abs(in.tau[j]));
+      Require(max_tau > 1e-9,
+              "compliance on joint '" + e.joint +
+                  "': gravity has no torque about it in these poses");
       err[kCompliance] = e.magnitude * unit / max_tau;
       note << "per_torque " << err[kCompliance] / unit << " (max |tau| "
            << max_tau << ")";
@@ -323,7 +329,8 @@ SimulatedSession Simulate(const Robot& nominal, const SimulateOptions& opt) {
   if (measure) {
     for (size_t i = 0; i < obs.rows.size(); ++i) {
       const Eigen::Vector3d tip = TipInBase(truth, inputs[i]);
-      Eigen::Vector3d p = ApplyFrame(out.meas_from_base.data(), Vec3<double>(tip));
+      Eigen::Vector3d p =
+          ApplyFrame(out.meas_from_base.data(), Vec3<double>(tip));
       for (int k = 0; k < 3; ++k) p[k] += opt.noise_mm * normal(rng);
       obs.rows[i].has_point = true;
       obs.rows[i].p_in_meas = p;

@@ -37,11 +37,11 @@ Effect ParseEffect(const std::string& text, const Robot& robot);
 struct SimulateOptions {
   enum Mode { kRandom, kFixedPoint };
   Mode mode = kRandom;
-  int poses = 240;            // kRandom: number of poses
-  int fixed_points = 1;       // kFixedPoint: number of points
-  int poses_per_point = 30;   // kFixedPoint: poses per point
-  bool measure_points = true; // write x,y,z (kFixedPoint may omit them)
-  double noise_mm = 0.03;     // per axis, measured points / tip placement
+  int poses = 240;               // kRandom: number of poses
+  int fixed_points = 1;          // kFixedPoint: number of points
+  int poses_per_point = 30;      // kFixedPoint: poses per point
+  bool measure_points = true;    // write x,y,z (kFixedPoint may omit them)
+  double noise_mm = 0.03;        // per axis, measured points / tip placement
   double sigma_length_mm = 0.5;  // true deviations of geometric parameters
   double sigma_angle_deg = 0.2;
   double frame_distance_mm = 1000.0;  // measuring frame origin from the base

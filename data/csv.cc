@@ -53,9 +53,9 @@ std::vector<CsvLine> TokenizeCsv(const std::string& text,
         }
         while (i < line.size() && (line[i] == ' ' || line[i] == '\t')) ++i;
         if (i < line.size() && line[i] != separator) {
-          throw InputError(file, line_no, static_cast<int>(i) + 1,
-                           std::string("expected '") + separator +
-                               "' after quoted field");
+          throw InputError(
+              file, line_no, static_cast<int>(i) + 1,
+              std::string("expected '") + separator + "' after quoted field");
         }
       } else {
         const size_t sep = line.find(separator, i);

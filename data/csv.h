@@ -16,7 +16,7 @@ struct CsvField {
   int column = 1;
 };
 struct CsvLine {
-  int line = 0;      // 1-based line number in the file
+  int line = 0;        // 1-based line number in the file
   int end_column = 1;  // column just past the last character
   std::vector<CsvField> fields;
 };

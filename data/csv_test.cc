@@ -9,7 +9,8 @@ namespace {
 
 TEST(CsvTest, FieldsColumnsQuotesAndComments) {
   const auto lines = TokenizeCsv(
-      "# comment\n\na, b ,\"c,d\",\"e\"\"f\",\n  # indented comment\nx\n", "t.csv");
+      "# comment\n\na, b ,\"c,d\",\"e\"\"f\",\n  # indented comment\nx\n",
+      "t.csv");
   ASSERT_EQ(lines.size(), 2u);
   EXPECT_EQ(lines[0].line, 3);
   ASSERT_EQ(lines[0].fields.size(), 5u);

@@ -49,14 +49,14 @@ inline void Require(bool condition, const std::string& message) {
 }  // namespace kincal
 
 // Internal invariant check that stays on in release builds (not an assert).
-#define KINCAL_CHECK(cond, msg)                                          \
-  do {                                                                   \
-    if (!(cond)) {                                                       \
-      std::ostringstream kincal_check_os;                                \
-      kincal_check_os << __FILE__ << ":" << __LINE__ << ": check failed: " \
-                      << #cond << ": " << msg;                           \
-      throw std::logic_error(kincal_check_os.str());                     \
-    }                                                                    \
+#define KINCAL_CHECK(cond, msg)                                      \
+  do {                                                               \
+    if (!(cond)) {                                                   \
+      std::ostringstream kincal_check_os;                            \
+      kincal_check_os << __FILE__ << ":" << __LINE__                 \
+                      << ": check failed: " << #cond << ": " << msg; \
+      throw std::logic_error(kincal_check_os.str());                 \
+    }                                                                \
   } while (0)
 
 #endif  // KINCAL_DATA_ERROR_H_

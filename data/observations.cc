@@ -61,7 +61,8 @@ Observations ParseObservationsCsv(const std::string& text,
   for (const CsvField& f : header.fields) {
     const std::string& name = f.text;
     if (name.empty()) {
-      throw InputError(file, header.line, f.column, "empty column name in header");
+      throw InputError(file, header.line, f.column,
+                       "empty column name in header");
     }
     if (!seen.insert(name).second) {
       throw InputError(file, header.line, f.column,
@@ -105,8 +106,8 @@ Observations ParseObservationsCsv(const std::string& text,
                        "header has no column for joint '" + j + "'");
     }
   }
-  const int xyz_count = static_cast<int>(seen.count("x") + seen.count("y") +
-                                         seen.count("z"));
+  const int xyz_count =
+      static_cast<int>(seen.count("x") + seen.count("y") + seen.count("z"));
   if (xyz_count != 0 && xyz_count != 3) {
     throw InputError(file, header.line, header.end_column,
                      "header has only some of x, y, z: give all three or none");
@@ -152,7 +153,8 @@ Observations ParseObservationsCsv(const std::string& text,
             throw InputError(file, line.line, f.column,
                              "column '" + col.name +
                                  "': expected a finite number (joint reading), "
-                                 "got '" + f.text + "'");
+                                 "got '" +
+                                 f.text + "'");
           }
           o.q[col.joint] = v;
           break;
@@ -167,7 +169,8 @@ Observations ParseObservationsCsv(const std::string& text,
             throw InputError(file, line.line, f.column,
                              "column '" + col.name +
                                  "': expected a finite number (mm) or empty, "
-                                 "got '" + f.text + "'");
+                                 "got '" +
+                                 f.text + "'");
           }
           o.p_in_meas[col.role - kX] = v;
           ++xyz_given;
@@ -181,7 +184,8 @@ Observations ParseObservationsCsv(const std::string& text,
           if (!ParseFiniteDouble(f.text, &v)) {
             throw InputError(file, line.line, f.column,
                              "column 't': expected a finite number (s) or "
-                             "empty, got '" + f.text + "'");
+                             "empty, got '" +
+                                 f.text + "'");
           }
           o.t_s = v;
           break;

@@ -15,8 +15,8 @@ struct Observation {
   std::string pose;
   std::vector<double> q;
   bool has_point = false;
-  Eigen::Vector3d p_in_meas = Eigen::Vector3d::Zero();  // mm
-  std::string fixed_point;                              // "" = none
+  Eigen::Vector3d p_in_meas = Eigen::Vector3d::Zero();    // mm
+  std::string fixed_point;                                // "" = none
   double t_s = std::numeric_limits<double>::quiet_NaN();  // NaN = unknown
   int line = 0;  // line in the source file (1-based), for messages
 

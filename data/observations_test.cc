@@ -57,7 +57,8 @@ TEST(ObservationsTest, AcceptsCrlfAndBom) {
     crlf += c;
   }
   const Observations a = ParseObservationsCsv(kGood, "o.csv", kJoints);
-  const Observations b = ParseObservationsCsv("\xEF\xBB\xBF" + crlf, "o.csv", kJoints);
+  const Observations b =
+      ParseObservationsCsv("\xEF\xBB\xBF" + crlf, "o.csv", kJoints);
   ASSERT_EQ(a.rows.size(), b.rows.size());
   for (size_t i = 0; i < a.rows.size(); ++i) {
     EXPECT_EQ(a.rows[i].pose, b.rows[i].pose);
@@ -71,8 +72,9 @@ TEST(ObservationsTest, RejectsEveryRuleWithPosition) {
   EXPECT_THAT(ErrorOf(""), HasSubstr("o.csv: empty file"));
   EXPECT_THAT(ErrorOf("# only a comment\n"), HasSubstr("empty file"));
   EXPECT_THAT(ErrorOf(h), HasSubstr("no observation rows"));
-  EXPECT_THAT(ErrorOf(h + "0,1,2,3,4,5,1,2\n"),
-              HasSubstr("o.csv:2:16: expected 9 columns as in the header, got 8"));
+  EXPECT_THAT(
+      ErrorOf(h + "0,1,2,3,4,5,1,2\n"),
+      HasSubstr("o.csv:2:16: expected 9 columns as in the header, got 8"));
   EXPECT_THAT(ErrorOf(h + "0,1,2,3,4,5,1,2,3,9\n"),
               HasSubstr("o.csv:2:19: expected 9 columns"));
   EXPECT_THAT(ErrorOf(h + "0,1,2,x3,4,5,1,2,3\n"),

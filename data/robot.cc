@@ -53,8 +53,10 @@ namespace {
 // Fields every extension cause may carry (interface units, see robot.h).
 const std::map<std::string, std::vector<std::string>>& ExtensionFields() {
   static const std::map<std::string, std::vector<std::string>> fields = {
-      {"backlash", {"width"}},     {"compliance", {"per_torque"}},
-      {"cyclic", {"cos", "sin"}},  {"gain", {"g"}},
+      {"backlash", {"width"}},
+      {"compliance", {"per_torque"}},
+      {"cyclic", {"cos", "sin"}},
+      {"gain", {"g"}},
       {"drift", {"vx", "vy", "vz"}}};
   return fields;
 }
@@ -63,15 +65,18 @@ void ReadGeometry(const YamlReader& r, const YAML::Node& node,
                   Convention convention, const std::string& what,
                   RobotRow* row) {
   if (convention == Convention::kUrdf) {
-    const auto xyz = r.Numbers(r.Required(node, "xyz", what), what + ".xyz", 3, 3);
-    const auto rpy = r.Numbers(r.Required(node, "rpy", what), what + ".rpy", 3, 3);
+    const auto xyz =
+        r.Numbers(r.Required(node, "xyz", what), what + ".xyz", 3, 3);
+    const auto rpy =
+        r.Numbers(r.Required(node, "rpy", what), what + ".rpy", 3, 3);
     row->xyz_mm = Eigen::Vector3d(xyz[0], xyz[1], xyz[2]);
     row->rpy_deg = Eigen::Vector3d(rpy[0], rpy[1], rpy[2]);
     if (row->type != JointType::kFixed) {
       const auto axis =
           r.Numbers(r.Required(node, "axis", what), what + ".axis", 3, 3);
       Eigen::Vector3d a(axis[0], axis[1], axis[2]);
-      if (a.norm() < 1e-9) r.Fail(node["axis"], what + ".axis: must not be zero");
+      if (a.norm() < 1e-9)
+        r.Fail(node["axis"], what + ".axis: must not be zero");
       row->axis = a.normalized();
     }
     return;
@@ -113,7 +118,8 @@ Robot ParseRobotYaml(const std::string& text, const std::string& file) {
     else if (c == "urdf")
       robot.convention = Convention::kUrdf;
     else
-      r.Fail(conv, "convention: expected 'dh', 'mdh' or 'urdf', got '" + c + "'");
+      r.Fail(conv,
+             "convention: expected 'dh', 'mdh' or 'urdf', got '" + c + "'");
   }
   if (root["gravity"]) {
     const auto g = r.Numbers(root["gravity"], "gravity", 3, 3);
@@ -141,21 +147,25 @@ Robot ParseRobotYaml(const std::string& text, const std::string& file) {
       r.Fail(j["name"], what + ".name: '" + row.name + "' is reserved");
     }
     if (!names.insert(row.name).second) {
-      r.Fail(j["name"], what + ".name: duplicate joint name '" + row.name + "'");
+      r.Fail(j["name"],
+             what + ".name: duplicate joint name '" + row.name + "'");
     }
-    const std::string type = r.String(r.Required(j, "type", what), what + ".type");
+    const std::string type =
+        r.String(r.Required(j, "type", what), what + ".type");
     if (type == "revolute")
       row.type = JointType::kRevolute;
     else if (type == "prismatic")
       row.type = JointType::kPrismatic;
     else
-      r.Fail(j["type"], what + ".type: expected 'revolute' or 'prismatic', got '" +
+      r.Fail(j["type"], what +
+                            ".type: expected 'revolute' or 'prismatic', got '" +
                             type + "'");
     ReadGeometry(r, j, robot.convention, what, &row);
     if (j["limits"]) {
       const auto lim = r.Numbers(j["limits"], what + ".limits", 2, 2);
       if (!(lim[0] < lim[1])) {
-        r.Fail(j["limits"], what + ".limits: expected [lower, upper] with lower < upper");
+        r.Fail(j["limits"],
+               what + ".limits: expected [lower, upper] with lower < upper");
       }
       row.lower = lim[0];
       row.upper = lim[1];
@@ -208,8 +218,8 @@ Robot ParseRobotYaml(const std::string& text, const std::string& file) {
         bool known = false;
         for (const auto& f : it->second) known = known || f == key;
         if (!known) {
-          r.Fail(kv.first, what + ": unknown field '" + key + "' for cause " +
-                               x.cause);
+          r.Fail(kv.first,
+                 what + ": unknown field '" + key + "' for cause " + x.cause);
         }
         x.values[key] = r.Number(kv.second, what + "." + key);
       }

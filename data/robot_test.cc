@@ -98,8 +98,9 @@ TEST(RobotYamlTest, RejectsBadInputWithPosition) {
     return s;
   };
   EXPECT_THAT(ErrorOf(""), HasSubstr("empty file"));
-  EXPECT_THAT(ErrorOf("kincal_robot: 2\njoints: []\n"),
-              HasSubstr("r.yaml:1:15: kincal_robot: unsupported format version"));
+  EXPECT_THAT(
+      ErrorOf("kincal_robot: 2\njoints: []\n"),
+      HasSubstr("r.yaml:1:15: kincal_robot: unsupported format version"));
   EXPECT_THAT(ErrorOf(replace("a: 200, theta: 0}", "a: abc, theta: 0}")),
               HasSubstr("r.yaml:7:"));
   EXPECT_THAT(ErrorOf(replace("a: 200, theta: 0}", "a: abc, theta: 0}")),
@@ -118,11 +119,14 @@ TEST(RobotYamlTest, RejectsBadInputWithPosition) {
               HasSubstr("missing required key 'theta'"));
   EXPECT_THAT(ErrorOf(replace("gravity: [0, 0, -1]", "gravity: [0, 0]")),
               HasSubstr("expected 3 numbers, got 2"));
-  EXPECT_THAT(ErrorOf("kincal_robot: 1\njoints: [\n"), HasSubstr("invalid YAML"));
+  EXPECT_THAT(ErrorOf("kincal_robot: 1\njoints: [\n"),
+              HasSubstr("invalid YAML"));
   EXPECT_THAT(ErrorOf(base + "extensions:\n  - {cause: magic, joint: j3}\n"),
               HasSubstr("unknown cause 'magic'"));
-  EXPECT_THAT(ErrorOf(base + "extensions:\n  - {cause: backlash, joint: j9, width: 1}\n"),
-              HasSubstr("no joint named 'j9'"));
+  EXPECT_THAT(
+      ErrorOf(base +
+              "extensions:\n  - {cause: backlash, joint: j9, width: 1}\n"),
+      HasSubstr("no joint named 'j9'"));
 }
 
 TEST(RobotYamlTest, MissingFileIsInputError) {

@@ -16,10 +16,14 @@ const char* kColors[] = {"#1f77b4", "#d62728", "#2ca02c", "#ff7f0e", "#9467bd",
 std::string Escape(const std::string& s) {
   std::string out;
   for (char c : s) {
-    if (c == '<') out += "&lt;";
-    else if (c == '>') out += "&gt;";
-    else if (c == '&') out += "&amp;";
-    else out += c;
+    if (c == '<')
+      out += "&lt;";
+    else if (c == '>')
+      out += "&gt;";
+    else if (c == '&')
+      out += "&amp;";
+    else
+      out += c;
   }
   return out;
 }
@@ -104,9 +108,11 @@ void Draw(const Plot& plot, int y0, std::ostringstream& os) {
     if (s.bars) {
       const double bw = std::max(1.0, 0.8 * w / std::max<size_t>(n, 1));
       for (size_t i = 0; i < n; ++i) {
-        const double top_y = std::min(Y(s.y[i]), Y(0)), bot = std::max(Y(s.y[i]), Y(0));
-        os << "<rect x='" << X(s.x[i]) - bw / 2 << "' y='" << top_y << "' width='"
-           << bw << "' height='" << bot - top_y << "' fill='" << color << "'/>\n";
+        const double top_y = std::min(Y(s.y[i]), Y(0)),
+                     bot = std::max(Y(s.y[i]), Y(0));
+        os << "<rect x='" << X(s.x[i]) - bw / 2 << "' y='" << top_y
+           << "' width='" << bw << "' height='" << bot - top_y << "' fill='"
+           << color << "'/>\n";
       }
     } else if (s.points) {
       for (size_t i = 0; i < n; ++i) {

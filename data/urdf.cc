@@ -18,8 +18,8 @@ constexpr double kRadToDeg = 180.0 / M_PI;
 struct UrdfJoint {
   std::string name, type, parent, child;
   Eigen::Isometry3d origin = Eigen::Isometry3d::Identity();  // metres
-  Eigen::Vector3d axis = Eigen::Vector3d::UnitX();            // URDF default
-  double lower = NAN, upper = NAN;                            // m or rad
+  Eigen::Vector3d axis = Eigen::Vector3d::UnitX();           // URDF default
+  double lower = NAN, upper = NAN;                           // m or rad
   int line = 0;
 };
 
@@ -78,7 +78,8 @@ Robot ParseUrdfChain(const std::string& xml, const std::string& file,
   for (auto* l = robot_el->FirstChildElement("link"); l;
        l = l->NextSiblingElement("link")) {
     const char* name = l->Attribute("name");
-    if (!name) throw InputError(file, l->GetLineNum(), 0, "<link> without name");
+    if (!name)
+      throw InputError(file, l->GetLineNum(), 0, "<link> without name");
     links[name] = true;
   }
   for (auto* j = robot_el->FirstChildElement("joint"); j;
@@ -103,22 +104,27 @@ Robot ParseUrdfChain(const std::string& xml, const std::string& file,
     const auto* child = j->FirstChildElement("child");
     if (!parent || !child || !parent->Attribute("link") ||
         !child->Attribute("link")) {
-      throw InputError(file, uj.line, 0,
-                       "joint '" + uj.name + "': needs <parent link> and <child link>");
+      throw InputError(
+          file, uj.line, 0,
+          "joint '" + uj.name + "': needs <parent link> and <child link>");
     }
     uj.parent = parent->Attribute("link");
     uj.child = child->Attribute("link");
     if (const auto* o = j->FirstChildElement("origin")) {
-      Eigen::Vector3d xyz = Eigen::Vector3d::Zero(), rpy = Eigen::Vector3d::Zero();
+      Eigen::Vector3d xyz = Eigen::Vector3d::Zero(),
+                      rpy = Eigen::Vector3d::Zero();
       if (o->Attribute("xyz"))
-        xyz = ParseTriple(file, o->GetLineNum(), o->Attribute("xyz"), "origin xyz");
+        xyz = ParseTriple(file, o->GetLineNum(), o->Attribute("xyz"),
+                          "origin xyz");
       if (o->Attribute("rpy"))
-        rpy = ParseTriple(file, o->GetLineNum(), o->Attribute("rpy"), "origin rpy");
+        rpy = ParseTriple(file, o->GetLineNum(), o->Attribute("rpy"),
+                          "origin rpy");
       uj.origin.linear() = RpyToMatrix(rpy);
       uj.origin.translation() = xyz;
     }
     if (const auto* a = j->FirstChildElement("axis")) {
-      uj.axis = ParseTriple(file, a->GetLineNum(), a->Attribute("xyz"), "axis xyz");
+      uj.axis =
+          ParseTriple(file, a->GetLineNum(), a->Attribute("xyz"), "axis xyz");
       if (uj.axis.norm() < 1e-12) {
         throw InputError(file, a->GetLineNum(), 0, "axis must not be zero");
       }
@@ -142,9 +148,9 @@ Robot ParseUrdfChain(const std::string& xml, const std::string& file,
     for (const auto& l : links) {
       if (!by_child.count(l.first)) {
         if (!root.empty()) {
-          throw InputError(file, 0, 0, "several root links ('" + root +
-                                           "', '" + l.first +
-                                           "'): name one with --root");
+          throw InputError(file, 0, 0,
+                           "several root links ('" + root + "', '" + l.first +
+                               "'): name one with --root");
         }
         root = l.first;
       }
@@ -158,27 +164,30 @@ Robot ParseUrdfChain(const std::string& xml, const std::string& file,
     tip = root;
     while (children.count(tip)) {
       if (children[tip].size() != 1) {
-        throw InputError(file, 0, 0, "link '" + tip +
-                                         "' branches: name the tip link");
+        throw InputError(file, 0, 0,
+                         "link '" + tip + "' branches: name the tip link");
       }
       tip = children[tip][0];
     }
   }
-  if (!links.count(tip)) throw InputError(file, 0, 0, "no link named '" + tip + "'");
+  if (!links.count(tip))
+    throw InputError(file, 0, 0, "no link named '" + tip + "'");
 
   // Walk back from the tip to the root.
   std::vector<UrdfJoint> path;
   for (std::string link = tip; link != root;) {
     auto it = by_child.find(link);
     if (it == by_child.end()) {
-      throw InputError(file, 0, 0, "link '" + tip + "' is not below '" + root + "'");
+      throw InputError(file, 0, 0,
+                       "link '" + tip + "' is not below '" + root + "'");
     }
     path.insert(path.begin(), it->second);
     link = it->second.parent;
   }
 
   Robot robot;
-  robot.name = robot_el->Attribute("name") ? robot_el->Attribute("name") : "urdf";
+  robot.name =
+      robot_el->Attribute("name") ? robot_el->Attribute("name") : "urdf";
   robot.convention = Convention::kUrdf;
   Eigen::Isometry3d pending = Eigen::Isometry3d::Identity();
   for (const UrdfJoint& uj : path) {
@@ -188,12 +197,14 @@ Robot ParseUrdfChain(const std::string& xml, const std::string& file,
     }
     RobotRow row;
     row.name = uj.name;
-    row.type = uj.type == "prismatic" ? JointType::kPrismatic : JointType::kRevolute;
+    row.type =
+        uj.type == "prismatic" ? JointType::kPrismatic : JointType::kRevolute;
     SetOrigin(pending * uj.origin, &row);
     row.axis = uj.axis;
-    if (uj.type != "continuous" && uj.lower == uj.lower && uj.upper == uj.upper &&
-        uj.lower < uj.upper) {
-      const double scale = row.type == JointType::kPrismatic ? 1000.0 : kRadToDeg;
+    if (uj.type != "continuous" && uj.lower == uj.lower &&
+        uj.upper == uj.upper && uj.lower < uj.upper) {
+      const double scale =
+          row.type == JointType::kPrismatic ? 1000.0 : kRadToDeg;
       row.lower = uj.lower * scale;
       row.upper = uj.upper * scale;
     }
@@ -201,8 +212,9 @@ Robot ParseUrdfChain(const std::string& xml, const std::string& file,
     pending = Eigen::Isometry3d::Identity();
   }
   if (robot.joints.empty()) {
-    throw InputError(file, 0, 0, "no movable joint between '" + root + "' and '" +
-                                     tip + "'");
+    throw InputError(
+        file, 0, 0,
+        "no movable joint between '" + root + "' and '" + tip + "'");
   }
   robot.tool.name = "tool";
   robot.tool.type = JointType::kFixed;

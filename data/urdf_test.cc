@@ -56,8 +56,9 @@ TEST(UrdfTest, RejectsBrokenFiles) {
 
 TEST(UrdfTest, LoadsMukcaPanda) {
   KINCAL_REQUIRE_SHARED_DATA("mukca");
-  const std::string path = testing::SharedDataDir() +
-                           "/mukca/calibrated_urdf/panda_2/panda_calibrated.urdf";
+  const std::string path =
+      testing::SharedDataDir() +
+      "/mukca/calibrated_urdf/panda_2/panda_calibrated.urdf";
   if (!testing::Exists(path)) GTEST_SKIP() << path << " absent";
   const Robot r = ReadUrdfChain(path, "panda_link0", "panda_link8");
   EXPECT_EQ(r.joints.size(), 7u);

@@ -19,7 +19,8 @@ YAML::Node YamlReader::Load(const std::string& text) const {
 
 void YamlReader::Fail(const YAML::Node& at, const std::string& msg) const {
   const YAML::Mark mark = at.Mark();
-  if (mark.line >= 0) throw InputError(file_, mark.line + 1, mark.column + 1, msg);
+  if (mark.line >= 0)
+    throw InputError(file_, mark.line + 1, mark.column + 1, msg);
   throw InputError(file_, 0, 0, msg);
 }
 
@@ -42,9 +43,10 @@ void YamlReader::CheckKeys(const YAML::Node& map,
     for (const char* a : allowed) ok = ok || key == a;
     if (!ok) {
       std::string list;
-      for (const char* a : allowed) list += std::string(list.empty() ? "" : ", ") + a;
-      Fail(kv.first, what + ": unknown key '" + key + "' (expected one of: " +
-                         list + ")");
+      for (const char* a : allowed)
+        list += std::string(list.empty() ? "" : ", ") + a;
+      Fail(kv.first, what + ": unknown key '" + key +
+                         "' (expected one of: " + list + ")");
     }
   }
 }
@@ -100,12 +102,12 @@ std::vector<double> YamlReader::Numbers(const YAML::Node& node,
   ExpectSequence(node, what);
   const int n = static_cast<int>(node.size());
   if (n < min_count || n > max_count) {
-    Fail(node, what + ": expected " +
-                   (min_count == max_count
-                        ? std::to_string(min_count)
-                        : std::to_string(min_count) + " to " +
-                              std::to_string(max_count)) +
-                   " numbers, got " + std::to_string(n));
+    Fail(node,
+         what + ": expected " +
+             (min_count == max_count ? std::to_string(min_count)
+                                     : std::to_string(min_count) + " to " +
+                                           std::to_string(max_count)) +
+             " numbers, got " + std::to_string(n));
   }
   std::vector<double> out;
   for (int i = 0; i < n; ++i) {

@@ -23,9 +23,8 @@ class CliTest : public ::testing::Test {
   static void SetUpTestSuite() {
     dir_ = new std::string(MakeTempDir("cli"));
     const RunResult r = RunKincal(
-        "simulate --robot " + SourceDir() +
-        "/data/robots/bh7.yaml --out " + *dir_ +
-        "/s --poses 120 --noise 0.03 --seed 4 --json");
+        "simulate --robot " + SourceDir() + "/data/robots/bh7.yaml --out " +
+        *dir_ + "/s --poses 120 --noise 0.03 --seed 4 --json");
     ASSERT_EQ(r.exit_code, 0) << r.err;
   }
   static std::string Dir() { return *dir_; }
@@ -106,8 +105,8 @@ TEST_F(CliTest, BadInputExitsTwoAndWritesNothing) {
   for (int k = 0; k < 3; ++k) cell = obs.find(',', cell) + 1;
   obs.replace(cell, obs.find(',', cell) - cell, "nan");
   WriteText(bad_obs, obs);
-  RunResult r = RunKincal("calibrate --robot " + Robot() + " --obs " +
-                          bad_obs + " --out " + out + " --json");
+  RunResult r = RunKincal("calibrate --robot " + Robot() + " --obs " + bad_obs +
+                          " --out " + out + " --json");
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_THAT(r.err, HasSubstr(bad_obs + ":"));
   EXPECT_THAT(r.err, HasSubstr("column 'j3'"));
@@ -130,7 +129,8 @@ TEST_F(CliTest, BadInputExitsTwoAndWritesNothing) {
                 " --no-such-option");
   EXPECT_EQ(r.exit_code, 2);
 
-  r = RunKincal("evaluate --robot " + Robot() + " --obs " + bad_obs + " --json");
+  r = RunKincal("evaluate --robot " + Robot() + " --obs " + bad_obs +
+                " --json");
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_TRUE(r.out.empty());
   EXPECT_FALSE(Exists(out));

@@ -35,7 +35,8 @@ TEST(RenderPipelineTest, ImagesToCalibratedRobot) {
                 "/target.yaml --left '" + img + "/left_*.png' --right '" + img +
                 "/right_*.png' --out " + dir + "/points.csv --obs " + dir +
                 "/s/observations.csv --robot " + dir +
-                "/s/robot.yaml --out-obs " + dir + "/tracked.csv --json --quiet");
+                "/s/robot.yaml --out-obs " + dir +
+                "/tracked.csv --json --quiet");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const auto track = nlohmann::json::parse(r.out);
   const int found = track["found"].get<int>();
@@ -57,12 +58,15 @@ TEST(RenderPipelineTest, ImagesToCalibratedRobot) {
   // about sigma_z / tag size of arc: a few mm at most at ~2 m.
   const double sigma_z = distance * distance * 0.05 / (1800.0 * 120.0);
   const double lever = sim["render"]["tag_size_mm"].get<double>() * 4.0;
-  const double sigma_tip = sigma_z * (1.0 + lever / (2.0 * sim["render"]["tag_size_mm"].get<double>()));
+  const double sigma_tip =
+      sigma_z *
+      (1.0 + lever / (2.0 * sim["render"]["tag_size_mm"].get<double>()));
   double sum_sq = 0;
   int n = 0;
   for (size_t i = 0; i < truth.rows.size(); ++i) {
     if (!tracked.rows[i].has_point) continue;
-    const double e = (tracked.rows[i].p_in_meas - truth.rows[i].p_in_meas).norm();
+    const double e =
+        (tracked.rows[i].p_in_meas - truth.rows[i].p_in_meas).norm();
     EXPECT_LT(e, 6 * sigma_tip + 0.2) << "frame " << i;
     sum_sq += e * e;
     ++n;
@@ -78,7 +82,8 @@ TEST(RenderPipelineTest, ImagesToCalibratedRobot) {
   r = RunKincal("evaluate --robot " + dir + "/s/robot.yaml --obs " + dir +
                 "/tracked.csv --json");
   ASSERT_EQ(r.exit_code, 0) << r.err;
-  const double nominal_rms = nlohmann::json::parse(r.out)["rms_mm"].get<double>();
+  const double nominal_rms =
+      nlohmann::json::parse(r.out)["rms_mm"].get<double>();
   EXPECT_LT(cal["train_rms_mm"].get<double>(), 2 * rms + 0.1);
   EXPECT_LT(cal["train_rms_mm"].get<double>(), 0.5 * nominal_rms);
 }

@@ -520,7 +520,9 @@ Target AprilGrid::AsTarget() const {
   for (int r = 0; r < rows; ++r) {
     for (int c = 0; c < cols; ++c) {
       TargetTag tag;
-      tag.id = first_id + r * cols + c;
+      // Row r counts from the top in the board frame; Kalibr numbers the
+      // rows from the bottom.
+      tag.id = first_id + (rows - 1 - r) * cols + c;
       tag.size_mm = tag_size_mm;
       tag.tool_from_tag.t = Eigen::Vector3d(c * pitch + tag_size_mm / 2,
                                             r * pitch + tag_size_mm / 2, 0);
@@ -562,6 +564,14 @@ std::vector<TexturedPlane> AprilGrid::Planes(
     }
   }
   return planes;
+}
+
+Rigid3 AprilGrid::BoardFromTarget() const {
+  Rigid3 board_from_target;
+  board_from_target.R = Eigen::Vector3d(1, -1, -1).asDiagonal();
+  board_from_target.t = Eigen::Vector3d(
+      0, (rows - 1) * tag_size_mm * (1 + spacing_ratio) + tag_size_mm, 0);
+  return board_from_target;
 }
 
 namespace {

@@ -149,10 +149,14 @@ int RenderSession(const Rig& rig, const Target& target,
                   const std::string& folder);
 
 // A Kalibr-style AprilGrid: cols x rows tags of edge tag_size_mm (black
-// square), spaced by spacing_ratio * tag_size_mm, ids first_id.. row-major
-// from the top-left tag, in the board frame (origin at the top-left corner
-// of the first tag's black square, x along a row, y down the columns, z into
-// the board). As a Target: tags with tool_from_tag = board_from_tag.
+// square), spaced by spacing_ratio * tag_size_mm, printed upright. Ids as
+// Kalibr prints them (and as vision/calib_target.h's aprilgrid model
+// expects): first_id.. row-major from the BOTTOM-left tag, i.e. tag
+// first_id + i * cols + c is in the i-th row counted from the bottom.
+// Board frame (the renderer's, tag-frame-like): origin at the top-left corner
+// of the top-left tag's black square, x along a row, y down the columns, z
+// into the board. Kalibr's target frame is BoardFromTarget() of it. As a
+// Target: tags with tool_from_tag = board_from_tag.
 struct AprilGrid {
   int cols = 6;
   int rows = 6;
@@ -167,6 +171,11 @@ struct AprilGrid {
   // White board (margin of one spacing around the tags), the tags, and the
   // corner squares if asked, with the board at rig_from_board.
   std::vector<TexturedPlane> Planes(const Rigid3& rig_from_board) const;
+  // Kalibr's target frame of the same board (vision/calib_target.h: origin
+  // at the bottom-left corner of tag first_id's black square, x right, y up,
+  // z out of the printed face) in the board frame: rotation of 180 deg about
+  // x. rig_from_target = rig_from_board * BoardFromTarget().
+  Rigid3 BoardFromTarget() const;
 };
 
 // A demonstration scene for tests, the bench and `kincal simulate --render`:

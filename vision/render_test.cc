@@ -172,14 +172,28 @@ TEST(Render, AprilGridAllTagsDetected) {
         renderer.Render(grid.Planes(rig_from_board), {}, o, &rng);
     AprilTagDetector detector;
     const auto dets = detector.Detect(image);
+    const std::vector<TagTruth> truth =
+        ProjectTargetCorners(cam, grid.AsTarget(), rig_from_board);
     CornerStats s;
-    Accumulate(dets, ProjectTargetCorners(cam, grid.AsTarget(), rig_from_board),
-               &s);
+    Accumulate(dets, truth, &s);
     EXPECT_EQ(s.tags_expected, 20) << "corner squares " << squares;
-    // libapriltag segments a tag touching Kalibr's corner squares with them
-    // and loses some tags (16 of 20 here); without the squares it finds all.
+    // libapriltag segments a tag touching Kalibr's corner squares with them:
+    // it loses some tags (4 of 20 here) and may fit a corner of another one
+    // to a corner square (tag 9 here, 5.6 px off, since the ids follow
+    // Kalibr's bottom-left-first numbering); without the squares it finds
+    // all, exactly.
     EXPECT_GE(s.tags_found, squares ? 12 : 20) << "corner squares " << squares;
-    EXPECT_LT(s.Rms(), 0.1) << "corner squares " << squares;
+    if (!squares) {
+      EXPECT_LT(s.Rms(), 0.1);
+      continue;
+    }
+    int accurate = 0;  // tags with all four corners within 0.1 px (15 here)
+    for (const TagTruth& t : truth) {
+      CornerStats one;
+      Accumulate(dets, {t}, &one);
+      accurate += one.tags_found == 1 && one.worst < 0.1;
+    }
+    EXPECT_GE(accurate, 12);
   }
 }
 

@@ -24,7 +24,9 @@ inline bool Exists(const std::string& path) {
 }
 
 // The built kincal binary.
-inline std::string KincalBinary() { return std::string(KINCAL_BIN_DIR) + "/kincal"; }
+inline std::string KincalBinary() {
+  return std::string(KINCAL_BIN_DIR) + "/kincal";
+}
 
 // A fresh temporary folder for one test (removed by the OS, not by the test).
 inline std::string MakeTempDir(const std::string& tag) {
@@ -37,14 +39,14 @@ inline std::string MakeTempDir(const std::string& tag) {
 
 // Skips the current test with a clear message when a shared data folder is
 // absent (as on a user's machine without ../shared).
-#define KINCAL_REQUIRE_SHARED_DATA(subdir)                                 \
-  do {                                                                     \
-    const std::string kincal_dir =                                         \
-        ::kincal::testing::SharedDataDir() + "/" + (subdir);               \
-    if (!::kincal::testing::Exists(kincal_dir)) {                          \
-      GTEST_SKIP() << "shared real data not found at " << kincal_dir       \
-                   << " (set KINCAL_SHARED_DATA to ../shared/data)";       \
-    }                                                                      \
+#define KINCAL_REQUIRE_SHARED_DATA(subdir)                           \
+  do {                                                               \
+    const std::string kincal_dir =                                   \
+        ::kincal::testing::SharedDataDir() + "/" + (subdir);         \
+    if (!::kincal::testing::Exists(kincal_dir)) {                    \
+      GTEST_SKIP() << "shared real data not found at " << kincal_dir \
+                   << " (set KINCAL_SHARED_DATA to ../shared/data)"; \
+    }                                                                \
   } while (0)
 
 #endif  // KINCAL_TESTS_TESTING_PATHS_H_
