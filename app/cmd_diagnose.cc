@@ -226,9 +226,11 @@ void AddDiagnoseCommand(CLI::App& app, Runner* run) {
       ->add_option("--worst", cargs->options.worst_poses,
                    "worst poses examined (step 3)")
       ->capture_default_str();
-  clear->add_flag("--calibrate", cargs->options.calibrate_geometry,
-                  "calibrate the geometry on the same data first (the paper "
-                  "runs the test on its calibrated robot)");
+  clear->add_flag("--calibrate,!--no-calibrate",
+                  cargs->options.calibrate_geometry,
+                  "calibrate the geometry on the same data first (default; "
+                  "the paper runs the test on its calibrated robot); "
+                  "--no-calibrate uses the robot as given");
   clear->add_option("--plot", cargs->plot, "write an SVG of Fig. 4 and Fig. 5");
   clear->add_option("--csv", cargs->csv, "write deviations and curves as CSV");
   clear->add_flag("--json", cargs->json, "print one JSON object");

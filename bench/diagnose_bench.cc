@@ -112,9 +112,15 @@ void FalseAlarms(const Robot& bh7, int runs) {
   }
 }
 
-void Section4(const Robot& bh7, int runs, bool nominal_robot) {
-  std::printf("== Section 4 clearance test (%s geometry, 120 poses, 0.03 mm)\n",
-              nominal_robot ? "nominal" : "calibrated");
+// nominal_robot: give the test the nominal robot, else one calibrated on the
+// same data; calibrate_first: the test's own default (calibrate the
+// geometry first) instead of using the robot as given.
+void Section4(const Robot& bh7, int runs, bool nominal_robot,
+              bool calibrate_first) {
+  std::printf(
+      "== Section 4 clearance test (%s geometry, %s, 120 poses, 0.03 mm)\n",
+      nominal_robot ? "nominal" : "calibrated",
+      calibrate_first ? "default: calibrates first" : "--no-calibrate");
   for (double b : {0.0, 0.05, 0.1, 0.3, 1.0}) {
     int suspect_any = 0, suspect_j3 = 0;
     for (int run = 0; run < runs; ++run) {
@@ -129,7 +135,9 @@ void Section4(const Robot& bh7, int runs, bool nominal_robot) {
       const Robot cal =
           nominal_robot ? s.nominal
                         : Calibrate(s.nominal, s.observations, co).calibrated;
-      const ClearanceResult r = DiagnoseClearance(cal, s.observations, {});
+      ClearanceOptions options;
+      options.calibrate_geometry = calibrate_first;
+      const ClearanceResult r = DiagnoseClearance(cal, s.observations, options);
       if (r.suspect >= 0) ++suspect_any;
       if (r.suspect == 2) ++suspect_j3;
     }
@@ -161,8 +169,9 @@ int main(int argc, char** argv) {
   if (only.empty() || only == "backlash") kincal::SmallestBacklash(bh7, runs);
   if (only.empty() || only == "null") kincal::FalseAlarms(bh7, runs);
   if (only.empty() || only == "section4") {
-    kincal::Section4(bh7, runs, false);
-    kincal::Section4(bh7, runs, true);
+    kincal::Section4(bh7, runs, false, false);
+    kincal::Section4(bh7, runs, true, false);
+    kincal::Section4(bh7, runs, true, true);
   }
   return 0;
 }
