@@ -77,8 +77,18 @@ Chain Chain::FromRobot(const Robot& robot) {
       err[kCompliance] = e.values.at("per_torque") * unit;
     if (e.cause == "gain") err[kGain] = e.values.at("g");
     if (e.cause == "cyclic") {
-      err[kCyclicCos] = e.values.at("cos") * unit;
-      err[kCyclicSin] = e.values.at("sin") * unit;
+      // Harmonic 1: cos, sin; harmonics 2, 3: cos2, sin2, cos3, sin3.
+      for (int h = 1; h <= kMaxHarmonic; ++h) {
+        const std::string suffix = h == 1 ? "" : std::to_string(h);
+        const auto cos_it = e.values.find("cos" + suffix);
+        const auto sin_it = e.values.find("sin" + suffix);
+        if (cos_it != e.values.end()) {
+          err[CyclicCosIndex(h)] = cos_it->second * unit;
+        }
+        if (sin_it != e.values.end()) {
+          err[CyclicCosIndex(h) + 1] = sin_it->second * unit;
+        }
+      }
     }
   }
   return c;
@@ -104,11 +114,19 @@ Robot Chain::ToRobot(const Robot& description) const {
     if (err[kCompliance] != 0.0)
       robot.extensions.push_back(
           {"compliance", name, {{"per_torque", err[kCompliance] / unit}}});
-    if (err[kCyclicCos] != 0.0 || err[kCyclicSin] != 0.0)
-      robot.extensions.push_back(
-          {"cyclic",
-           name,
-           {{"cos", err[kCyclicCos] / unit}, {"sin", err[kCyclicSin] / unit}}});
+    Extension cyclic{"cyclic", name, {}};
+    for (int h = 1; h <= kMaxHarmonic; ++h) {
+      const int k = CyclicCosIndex(h);
+      if (err[k] == 0.0 && err[k + 1] == 0.0) continue;
+      const std::string suffix = h == 1 ? "" : std::to_string(h);
+      cyclic.values["cos" + suffix] = err[k] / unit;
+      cyclic.values["sin" + suffix] = err[k + 1] / unit;
+    }
+    if (!cyclic.values.empty()) {
+      cyclic.values.emplace("cos", 0.0);  // the format requires harmonic 1
+      cyclic.values.emplace("sin", 0.0);
+      robot.extensions.push_back(cyclic);
+    }
     if (err[kGain] != 0.0)
       robot.extensions.push_back({"gain", name, {{"g", err[kGain]}}});
   }

@@ -27,15 +27,26 @@ namespace kincal {
 constexpr int kRowBlockSize = 6;
 // Per-joint error block (model extensions), internal units:
 //   [gain (1), backlash (rad|mm, full width), compliance (rad|mm per mm of
-//    unit-mass torque), cyclic_cos (rad), cyclic_sin (rad)]
-constexpr int kJointErrorBlockSize = 5;
+//    unit-mass torque), cyclic_cos, cyclic_sin (rad, first harmonic of the
+//    read angle), cyclic2_cos, cyclic2_sin (second), cyclic3_cos,
+//    cyclic3_sin (third harmonic)]
+constexpr int kJointErrorBlockSize = 9;
 enum JointErrorIndex {
   kGain = 0,
   kBacklash,
   kCompliance,
   kCyclicCos,
-  kCyclicSin
+  kCyclicSin,
+  kCyclic2Cos,
+  kCyclic2Sin,
+  kCyclic3Cos,
+  kCyclic3Sin
 };
+constexpr int kMaxHarmonic = 3;
+// Index of the cosine term of harmonic h (1..3); the sine term follows it.
+constexpr int CyclicCosIndex(int harmonic) {
+  return kCyclicCos + 2 * (harmonic - 1);
+}
 // Drift block: tip drift in the base frame, mm per hour.
 constexpr int kDriftBlockSize = 3;
 // Measuring frame block (meas_from_base): [rx, ry, rz (angle-axis, rad),
@@ -211,8 +222,9 @@ Mat4<T> RowTransform(Convention convention, const ChainRow& row, const T* p,
 
 // The joint value FK uses for a reading (docs/CONVENTIONS.md):
 //   q = (1 + gain) q_read - s backlash / 2 + compliance tau
-//       + cyclic_cos cos(q_read) + cyclic_sin sin(q_read)
-// `err` may be null (no error model). Cyclic terms apply to revolute joints.
+//       + sum_h cyclic{h}_cos cos(h q_read) + cyclic{h}_sin sin(h q_read)
+// for harmonics h = 1..3. `err` may be null (no error model). Cyclic terms
+// apply to revolute joints.
 template <typename T>
 T ModelJointValue(JointType type, double q_read, double s, double tau,
                   const T* err) {
@@ -220,8 +232,10 @@ T ModelJointValue(JointType type, double q_read, double s, double tau,
   T q = (T(1) + err[kGain]) * q_read - T(0.5 * s) * err[kBacklash] +
         err[kCompliance] * tau;
   if (type == JointType::kRevolute) {
-    q +=
-        err[kCyclicCos] * std::cos(q_read) + err[kCyclicSin] * std::sin(q_read);
+    for (int h = 1; h <= kMaxHarmonic; ++h) {
+      const int k = CyclicCosIndex(h);
+      q += err[k] * std::cos(h * q_read) + err[k + 1] * std::sin(h * q_read);
+    }
   }
   return q;
 }

@@ -8,7 +8,8 @@ namespace kincal {
 namespace {
 constexpr double kRadToDeg = 180.0 / M_PI;
 const char* kJointErrorNames[kJointErrorBlockSize] = {
-    "gain", "backlash", "compliance", "cyclic_cos", "cyclic_sin"};
+    "gain",        "backlash",    "compliance",  "cyclic_cos", "cyclic_sin",
+    "cyclic2_cos", "cyclic2_sin", "cyclic3_cos", "cyclic3_sin"};
 }  // namespace
 
 int ModelState::PointIndex(const std::string& label) const {

@@ -50,7 +50,11 @@ Vec3<Jet> TipJet(const Chain& chain, const PoseInput& in, const Jet* q_read) {
     q[j] = (1.0 + e[kGain]) * q_read[j] - Jet(0.5 * in.s[j] * e[kBacklash]) +
            Jet(e[kCompliance] * in.tau[j]);
     if (chain.rows[j].type == JointType::kRevolute) {
-      q[j] += e[kCyclicCos] * cos(q_read[j]) + e[kCyclicSin] * sin(q_read[j]);
+      for (int h = 1; h <= kMaxHarmonic; ++h) {
+        const int k = CyclicCosIndex(h);
+        q[j] += e[k] * cos(double(h) * q_read[j]) +
+                e[k + 1] * sin(double(h) * q_read[j]);
+      }
     }
   }
   Vec3<Jet> p = TipPosition<Jet>(chain, row_ptrs.data(), q);
@@ -134,13 +138,15 @@ Effect ParseEffect(const std::string& text, const Robot& robot) {
   e.cause = parts[0];
   e.joint = parts[1];
   e.magnitude = value;
-  if (e.cause != "backlash" && e.cause != "compliance" && e.cause != "cyclic" &&
+  const bool cyclic =
+      e.cause == "cyclic" || e.cause == "cyclic2" || e.cause == "cyclic3";
+  if (e.cause != "backlash" && e.cause != "compliance" && !cyclic &&
       e.cause != "gain" && e.cause != "axis_tilt") {
     throw InputError(usage);
   }
   const int j = robot.JointIndex(e.joint);
   if (j < 0) throw InputError(usage + ": no joint named '" + e.joint + "'");
-  if (e.cause == "cyclic" && robot.joints[j].type != JointType::kRevolute) {
+  if (cyclic && robot.joints[j].type != JointType::kRevolute) {
     throw InputError(usage + ": cyclic applies to revolute joints");
   }
   if (e.cause == "axis_tilt") {
@@ -282,10 +288,12 @@ SimulatedSession Simulate(const Robot& nominal, const SimulateOptions& opt) {
       err[kBacklash] = e.magnitude * unit;
     } else if (e.cause == "gain") {
       err[kGain] = e.magnitude;
-    } else if (e.cause == "cyclic") {
+    } else if (e.cause.rfind("cyclic", 0) == 0) {
+      // cyclic = first harmonic; cyclic2, cyclic3 = higher harmonics.
+      const int h = e.cause == "cyclic" ? 1 : e.cause.back() - '0';
       const double phase = 2 * M_PI * uniform(rng);
-      err[kCyclicCos] = e.magnitude * unit * std::cos(phase);
-      err[kCyclicSin] = e.magnitude * unit * std::sin(phase);
+      err[CyclicCosIndex(h)] = e.magnitude * unit * std::cos(phase);
+      err[CyclicCosIndex(h) + 1] = e.magnitude * unit * std::sin(phase);
       note << "phase " << phase / kDegToRad << " deg";
     } else if (e.cause == "compliance") {
       double max_tau = 0;

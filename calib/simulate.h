@@ -22,7 +22,8 @@ namespace kincal {
 
 // An injected effect, magnitude in the spec's units:
 //   backlash (deg|mm, full width), compliance (deg at the largest |torque| of
-//   the poses), cyclic (deg amplitude, random phase), gain (1), axis_tilt
+//   the poses), cyclic (deg amplitude, random phase; cyclic2 / cyclic3 for
+//   the 2nd / 3rd harmonic of the joint angle), gain (1), axis_tilt
 //   (deg, Hayati beta of the row before `joint`), drift (mm per hour, random
 //   direction).
 struct Effect {

@@ -61,6 +61,14 @@ const std::map<std::string, std::vector<std::string>>& ExtensionFields() {
   return fields;
 }
 
+// Fields a cause may carry in addition (higher harmonics of cyclic).
+const std::vector<std::string>& OptionalFields(const std::string& cause) {
+  static const std::vector<std::string> cyclic = {"cos2", "sin2", "cos3",
+                                                  "sin3"};
+  static const std::vector<std::string> none;
+  return cause == "cyclic" ? cyclic : none;
+}
+
 void ReadGeometry(const YamlReader& r, const YAML::Node& node,
                   Convention convention, const std::string& what,
                   RobotRow* row) {
@@ -217,6 +225,7 @@ Robot ParseRobotYaml(const std::string& text, const std::string& file) {
         if (key == "cause" || key == "joint") continue;
         bool known = false;
         for (const auto& f : it->second) known = known || f == key;
+        for (const auto& f : OptionalFields(x.cause)) known = known || f == key;
         if (!known) {
           r.Fail(kv.first,
                  what + ": unknown field '" + key + "' for cause " + x.cause);

@@ -41,7 +41,8 @@ struct RobotRow {
 // `values` holds the cause's fields in interface units, e.g.
 //   backlash: {width}            deg or mm (full clearance width)
 //   compliance: {per_torque}     deg per (mm x unit mass) of gravity torque
-//   cyclic: {cos, sin}           deg, first harmonic of the read joint angle
+//   cyclic: {cos, sin}           deg, first harmonic of the read joint angle,
+//           optional {cos2, sin2, cos3, sin3} for the 2nd and 3rd harmonics
 //   gain: {g}                    dimensionless, q = (1 + g) q_read
 //   drift: {vx, vy, vz}          mm per hour, tip drift in the base frame
 // axis_tilt is not an extension entry: it is the row's `beta`.

@@ -374,9 +374,10 @@ Candidate MakeCandidate(const Chain& chain, const std::string& cause,
     c.params = {JointErrorParam(chain, joint, kBacklash)};
   } else if (cause == "compliance") {
     c.params = {JointErrorParam(chain, joint, kCompliance)};
-  } else if (cause == "cyclic") {
-    c.params = {JointErrorParam(chain, joint, kCyclicCos),
-                JointErrorParam(chain, joint, kCyclicSin)};
+  } else if (CyclicHarmonic(cause) > 0) {
+    const int k = CyclicCosIndex(CyclicHarmonic(cause));
+    c.params = {JointErrorParam(chain, joint, k),
+                JointErrorParam(chain, joint, k + 1)};
   } else if (cause == "gain") {
     c.params = {JointErrorParam(chain, joint, kGain)};
   } else if (cause == "axis_tilt") {
@@ -415,6 +416,18 @@ void DiagnoseOptions::Check() const {
   }
 }
 
+int CyclicHarmonic(const std::string& cause) {
+  if (cause == "cyclic") return 1;
+  for (int h = 2; h <= kMaxHarmonic; ++h) {
+    if (cause == CyclicCause(h)) return h;
+  }
+  return 0;
+}
+
+std::string CyclicCause(int harmonic) {
+  return harmonic == 1 ? "cyclic" : "cyclic" + std::to_string(harmonic);
+}
+
 std::string Candidate::Label(const Chain& chain) const {
   return joint < 0 ? cause : cause + ":" + chain.rows[joint].name;
 }
@@ -447,8 +460,13 @@ std::vector<Candidate> CatalogueCandidates(
         tau_max - tau_min > 1e-6 * std::max(1.0, std::abs(tau_max))) {
       out.push_back(MakeCandidate(chain, "compliance", j));
     }
-    if (wanted("cyclic") && revolute)
-      out.push_back(MakeCandidate(chain, "cyclic", j));
+    if (wanted("cyclic") && revolute) {
+      // First harmonic (the spec's cyclic), then the higher ones, which pay
+      // where a transmission error is not a pure eccentricity.
+      for (int h = 1; h <= kMaxHarmonic; ++h) {
+        out.push_back(MakeCandidate(chain, CyclicCause(h), j));
+      }
+    }
     if (wanted("gain")) out.push_back(MakeCandidate(chain, "gain", j));
     if (wanted("axis_tilt") && j >= 1 &&
         std::find(parallel.begin(), parallel.end(), j - 1) != parallel.end()) {
@@ -511,8 +529,9 @@ Magnitude CandidateMagnitude(const Candidate& c, const ModelState& state,
     m.value = v[0] * kRadToDeg;
     grad[0] = kRadToDeg;
   } else {  // cyclic (deg amplitude) and drift (mm/h norm)
-    const double unit = c.cause == "cyclic" ? kRadToDeg : 1.0;
-    m.unit = c.cause == "cyclic" ? "deg" : "mm/h";
+    const bool cyclic = CyclicHarmonic(c.cause) > 0;
+    const double unit = cyclic ? kRadToDeg : 1.0;
+    m.unit = cyclic ? "deg" : "mm/h";
     const double norm = v.norm();
     m.value = norm * unit;
     if (norm > 0) grad = v / norm * unit;
@@ -521,7 +540,7 @@ Magnitude CandidateMagnitude(const Candidate& c, const ModelState& state,
   m.sigma = var >= 0 ? std::sqrt(var) : kNaN;
   m.ci_low = m.value - kZ95 * m.sigma;
   m.ci_high = m.value + kZ95 * m.sigma;
-  if (c.cause == "cyclic" || c.cause == "drift")
+  if (CyclicHarmonic(c.cause) > 0 || c.cause == "drift")
     m.ci_low = std::max(0.0, m.ci_low);
   return m;
 }
@@ -847,6 +866,16 @@ namespace {
 nlohmann::json Num(double v) {
   return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr);
 }
+// Internal causes cyclic2 / cyclic3 are the spec's cyclic at a higher
+// harmonic: reported as cause "cyclic" with "harmonic" 2 or 3.
+std::string SpecCause(const std::string& cause) {
+  return CyclicHarmonic(cause) > 0 ? "cyclic" : cause;
+}
+nlohmann::json HarmonicOrNull(const std::string& cause) {
+  const int h = CyclicHarmonic(cause);
+  return h > 0 ? nlohmann::json(h) : nlohmann::json(nullptr);
+}
+
 nlohmann::json JointOrNull(const std::string& joint) {
   return joint.empty() ? nlohmann::json(nullptr) : nlohmann::json(joint);
 }
@@ -858,14 +887,16 @@ nlohmann::json DiagnosisJson(const DiagnosisResult& r,
   for (const Finding& f : r.findings) {
     nlohmann::json eq = nlohmann::json::array();
     for (const Equivalent& e : f.equivalent) {
-      eq.push_back({{"cause", e.cause},
+      eq.push_back({{"cause", SpecCause(e.cause)},
+                    {"harmonic", HarmonicOrNull(e.cause)},
                     {"joint", JointOrNull(e.joint)},
                     {"magnitude", Num(e.magnitude)},
                     {"unit", e.unit},
                     {"train_rms_mm", Num(e.train_rms_mm)},
                     {"heldout_rms_mm", Num(e.heldout_rms_mm)}});
     }
-    findings.push_back({{"cause", f.cause},
+    findings.push_back({{"cause", SpecCause(f.cause)},
+                        {"harmonic", HarmonicOrNull(f.cause)},
                         {"joint", JointOrNull(f.joint)},
                         {"magnitude", Num(f.magnitude)},
                         {"unit", f.unit},
@@ -881,7 +912,8 @@ nlohmann::json DiagnosisJson(const DiagnosisResult& r,
   for (const auto& step : r.steps) {
     nlohmann::json table = nlohmann::json::array();
     for (const CandidateScore& c : step) {
-      table.push_back({{"cause", c.cause},
+      table.push_back({{"cause", SpecCause(c.cause)},
+                       {"harmonic", HarmonicOrNull(c.cause)},
                        {"joint", JointOrNull(c.joint)},
                        {"identifiable", c.identifiable},
                        {"parameters", c.k},

@@ -63,6 +63,12 @@ struct DiagnoseOptions {
 };
 
 // One catalogue candidate: a cause on a joint (joint -1 for drift).
+// Cyclic candidates carry their harmonic in the cause name: "cyclic" (first,
+// the spec's cause), "cyclic2", "cyclic3". CyclicHarmonic returns 1..3 for
+// them and 0 for any other cause.
+int CyclicHarmonic(const std::string& cause);
+std::string CyclicCause(int harmonic);
+
 struct Candidate {
   std::string cause;
   int joint = -1;

@@ -97,6 +97,25 @@ TEST(DiagnoseModelTest, FindsAxisTiltCyclicCompliance) {
   }
 }
 
+// More harmonics where they pay: a pure second harmonic is named as such
+// (cyclic at harmonic 2 in the JSON), not as a first-harmonic cyclic.
+TEST(DiagnoseModelTest, FindsSecondHarmonic) {
+  const SimulatedSession s = Sim("cyclic2:j3:0.05", 16);
+  const DiagnosisResult r = DiagnoseModel(s.nominal, s.observations, {});
+  ExpectFinding(r, "cyclic2", "j3", 0.05);
+  const nlohmann::json j = DiagnosisJson(r, {});
+  EXPECT_EQ(j["findings"][0]["cause"], "cyclic");
+  EXPECT_EQ(j["findings"][0]["harmonic"], 2);
+  // The extended model keeps the harmonic (cos2/sin2 in robot.yaml).
+  const Robot extended =
+      ParseRobotYaml(FormatRobotYaml(r.extended), "extended.yaml");
+  bool has_second = false;
+  for (const Extension& e : extended.extensions) {
+    has_second = has_second || (e.cause == "cyclic" && e.values.count("cos2"));
+  }
+  EXPECT_TRUE(has_second);
+}
+
 TEST(DiagnoseModelTest, UnexplainedWhenResidualsExceedStatedNoise) {
   // A 0.1 mm noise with the stated noise 0.02 mm: nothing in the catalogue
   // explains the extra scatter, which must be reported as unexplained.
