@@ -2,8 +2,6 @@
 // chessboard or an AprilGrid; writes rig.yaml. A thin layer over
 // vision/calib_target.h (detection) and camcal/calibrate_cameras.h.
 
-#include <glob.h>
-
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -16,6 +14,7 @@
 #include "camcal/calibrate_cameras.h"
 #include "camcal/rig.h"
 #include "data/error.h"
+#include "data/glob.h"
 #include "vision/calib_target.h"
 
 namespace kincal::app {
@@ -28,23 +27,6 @@ struct CamcalArgs {
   double loss_scale_px = 3.0;
   bool json = false;
 };
-
-// Files matching `pattern`, sorted by name; InputError when there are none.
-std::vector<std::string> Glob(const std::string& pattern, const char* option) {
-  glob_t g{};
-  const int rc = ::glob(pattern.c_str(), 0, nullptr, &g);
-  std::vector<std::string> files;
-  if (rc == 0) {
-    for (size_t i = 0; i < g.gl_pathc; ++i) files.emplace_back(g.gl_pathv[i]);
-  }
-  ::globfree(&g);
-  if (files.empty()) {
-    throw InputError(std::string(option) + " '" + pattern +
-                     "': no files match");
-  }
-  std::sort(files.begin(), files.end());
-  return files;
-}
 
 cv::Mat ReadGray(const std::string& path) {
   cv::Mat img = cv::imread(path, cv::IMREAD_GRAYSCALE);
@@ -87,9 +69,9 @@ int RunCamcal(const CamcalArgs& args) {
   options.Check();
 
   std::vector<std::vector<std::string>> files;
-  files.push_back(Glob(args.left, "--left"));
+  files.push_back(GlobSortedOrThrow(args.left, "--left"));
   if (!args.right.empty()) {
-    files.push_back(Glob(args.right, "--right"));
+    files.push_back(GlobSortedOrThrow(args.right, "--right"));
     if (files[1].size() != files[0].size()) {
       throw InputError("--left matches " + std::to_string(files[0].size()) +
                        " images but --right matches " +

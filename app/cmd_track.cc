@@ -1,8 +1,6 @@
 // kincal track: the needle tip in the rig frame for every stereo frame pair,
 // from the AprilTags of the tool target (../shared/spec/formats.md).
 
-#include <glob.h>
-
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -16,6 +14,7 @@
 #include "data/atomic_file.h"
 #include "data/csv.h"
 #include "data/error.h"
+#include "data/glob.h"
 #include "data/observations.h"
 #include "data/provenance.h"
 #include "data/urdf.h"
@@ -42,23 +41,6 @@ struct TrackArgs {
   double decimate = 2.0;
   bool quiet = false;
 };
-
-// Files matching `pattern`, sorted by name; InputError when none.
-std::vector<std::string> Glob(const std::string& pattern,
-                              const std::string& option) {
-  glob_t g{};
-  const int rc = ::glob(pattern.c_str(), 0, nullptr, &g);
-  std::vector<std::string> files;
-  if (rc == 0) {
-    for (size_t i = 0; i < g.gl_pathc; ++i) files.push_back(g.gl_pathv[i]);
-  }
-  ::globfree(&g);
-  if (files.empty()) {
-    throw InputError(option + " '" + pattern + "': no file matches");
-  }
-  std::sort(files.begin(), files.end());
-  return files;
-}
 
 cv::Mat ReadGray(const std::string& path, const CameraIntrinsics& cam) {
   const cv::Mat im = cv::imread(path, cv::IMREAD_GRAYSCALE);
@@ -89,8 +71,9 @@ int RunTrack(const TrackArgs& args) {
     throw InputError(args.rig + ": track needs a stereo rig (2 cameras), got " +
                      std::to_string(rig.cameras.size()));
   }
-  const std::vector<std::string> left = Glob(args.left, "--left");
-  const std::vector<std::string> right = Glob(args.right, "--right");
+  const std::vector<std::string> left = GlobSortedOrThrow(args.left, "--left");
+  const std::vector<std::string> right =
+      GlobSortedOrThrow(args.right, "--right");
   if (left.size() != right.size()) {
     throw InputError("--left matches " + std::to_string(left.size()) +
                      " images but --right matches " +

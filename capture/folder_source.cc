@@ -1,7 +1,6 @@
 // Replay of an image sequence: files matching a glob (or all images in a
 // folder), sorted by name, exactly as `kincal track --left GLOB` reads them.
 
-#include <glob.h>
 #include <sys/stat.h>
 
 #include <algorithm>
@@ -11,6 +10,7 @@
 #include <vector>
 
 #include "capture/frame_source.h"
+#include "data/glob.h"
 
 namespace kincal::capture {
 namespace {
@@ -37,19 +37,13 @@ class FolderSource : public FrameSource {
     const bool is_dir =
         ::stat(pattern_.c_str(), &st) == 0 && S_ISDIR(st.st_mode);
     if (is_dir) pattern = pattern_ + "/*";
-    glob_t g{};
-    if (::glob(pattern.c_str(), 0, nullptr, &g) == 0) {
-      for (size_t i = 0; i < g.gl_pathc; ++i) {
-        const std::string f = g.gl_pathv[i];
-        if (!is_dir || IsImageName(f)) files_.push_back(f);
-      }
+    for (const std::string& f : GlobSorted(pattern)) {  // as kincal track
+      if (!is_dir || IsImageName(f)) files_.push_back(f);
     }
-    ::globfree(&g);
     if (files_.empty()) {
       return Status::Error(Status::Kind::kNotFound,
                            "folder source '" + pattern + "': no file matches");
     }
-    std::sort(files_.begin(), files_.end());  // byte order, as kincal track
     open_ = true;
     return Status::Ok();
   }

@@ -1,6 +1,5 @@
 #include "capture/recorder.h"
 
-#include <glob.h>
 #include <gtest/gtest.h>
 #include <unistd.h>
 #include <yaml-cpp/yaml.h>
@@ -11,6 +10,7 @@
 
 #include "data/atomic_file.h"
 #include "data/csv.h"
+#include "data/glob.h"
 #include "data/provenance.h"
 #include "tests/testing/paths.h"
 
@@ -19,17 +19,6 @@ namespace {
 
 using ::kincal::testing::Exists;
 using ::kincal::testing::MakeTempDir;
-
-std::vector<std::string> Glob(const std::string& pattern) {
-  glob_t g{};
-  std::vector<std::string> out;
-  if (::glob(pattern.c_str(), 0, nullptr, &g) == 0) {
-    for (size_t i = 0; i < g.gl_pathc; ++i) out.push_back(g.gl_pathv[i]);
-  }
-  ::globfree(&g);
-  std::sort(out.begin(), out.end());
-  return out;
-}
 
 // A pair with distinct random-looking content per frame and side.
 StereoFrame Pair(int i) {
@@ -81,8 +70,8 @@ TEST(RecorderTest, WritesASessionThatTrackReadsAndIsLossless) {
   ASSERT_TRUE(rec.Finalize(summary).ok());
 
   // Images: same names on both sides, sorted = frame order, bit-exact.
-  const auto left = Glob(dir + "/left/*.png");
-  const auto right = Glob(dir + "/right/*.png");
+  const auto left = GlobSorted(dir + "/left/*.png");
+  const auto right = GlobSorted(dir + "/right/*.png");
   ASSERT_EQ(left.size(), 3u);
   ASSERT_EQ(right.size(), 3u);
   EXPECT_EQ(left[0], dir + "/left/000000.png");
@@ -95,7 +84,7 @@ TEST(RecorderTest, WritesASessionThatTrackReadsAndIsLossless) {
     EXPECT_EQ(cv::norm(l, pairs[i].left.image, cv::NORM_INF), 0);
     EXPECT_EQ(cv::norm(r, pairs[i].right.image, cv::NORM_INF), 0);
   }
-  EXPECT_TRUE(Glob(dir + "/*/*.part").empty());
+  EXPECT_TRUE(GlobSorted(dir + "/*/*.part").empty());
   EXPECT_FALSE(Exists(dir + "/frames.csv.part"));
 
   // frames.csv: provenance comment, header, one row per pair.
@@ -173,8 +162,8 @@ TEST(RecorderTest, WriteFailureMidSessionLeavesNoHalfPair) {
   const Status s = rec.Write(Pair(1));
   EXPECT_EQ(s.kind(), Status::Kind::kIoError);
   EXPECT_EQ(rec.frames(), 1);
-  EXPECT_EQ(Glob(dir + "/left/*.png").size(), 1u);
-  EXPECT_TRUE(Glob(dir + "/left/*.part").empty());
+  EXPECT_EQ(GlobSorted(dir + "/left/*.png").size(), 1u);
+  EXPECT_TRUE(GlobSorted(dir + "/left/*.part").empty());
   SessionSummary summary;
   summary.complete = false;
   summary.stop_reason = "write failed";

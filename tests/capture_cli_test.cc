@@ -2,7 +2,6 @@
 // build/bin/kincal capture into a session, check the session layout, and
 // that `kincal track` reads it directly; bad input exits 2 writing nothing.
 
-#include <glob.h>
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -15,6 +14,7 @@
 #include <vector>
 
 #include "data/atomic_file.h"
+#include "data/glob.h"
 #include "tests/testing/paths.h"
 #include "tests/testing/run.h"
 
@@ -25,17 +25,6 @@ using testing::RunKincal;
 using testing::RunResult;
 
 using testing::Exists;
-
-std::vector<std::string> Glob(const std::string& pattern) {
-  glob_t g{};
-  std::vector<std::string> out;
-  if (::glob(pattern.c_str(), 0, nullptr, &g) == 0) {
-    for (size_t i = 0; i < g.gl_pathc; ++i) out.push_back(g.gl_pathv[i]);
-  }
-  ::globfree(&g);
-  std::sort(out.begin(), out.end());  // as kincal track does
-  return out;
-}
 
 constexpr int kFrames = 5;
 constexpr int kWidth = 40;
@@ -74,8 +63,8 @@ TEST(CaptureCli, ReplaysFoldersIntoASessionThatTrackReads) {
             std::string::npos);
 
   // left/*.png and right/*.png sort into the same frame order and pair.
-  const auto left = Glob(out + "/left/*.png");
-  const auto right = Glob(out + "/right/*.png");
+  const auto left = GlobSorted(out + "/left/*.png");
+  const auto right = GlobSorted(out + "/right/*.png");
   ASSERT_EQ(left.size(), static_cast<size_t>(kFrames));
   ASSERT_EQ(right.size(), static_cast<size_t>(kFrames));
   for (int i = 0; i < kFrames; ++i) {
@@ -144,8 +133,8 @@ TEST(CaptureCli, FramesLimitStopsEarly) {
       "/cam_r_*.png' --out " + work + "/s --frames 3 --json");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_EQ(nlohmann::json::parse(r.out)["stop_reason"], "frames");
-  EXPECT_EQ(Glob(work + "/s/left/*.png").size(), 3u);
-  EXPECT_EQ(Glob(work + "/s/right/*.png").size(), 3u);
+  EXPECT_EQ(GlobSorted(work + "/s/left/*.png").size(), 3u);
+  EXPECT_EQ(GlobSorted(work + "/s/right/*.png").size(), 3u);
 }
 
 TEST(CaptureCli, UnequalReplayLengthsRecordOnlyPairs) {
@@ -160,8 +149,8 @@ TEST(CaptureCli, UnequalReplayLengthsRecordOnlyPairs) {
   EXPECT_EQ(j["frames"], kFrames - 1);
   EXPECT_EQ(j["length_mismatch"], true);
   EXPECT_NE(r.err.find("different lengths"), std::string::npos);
-  EXPECT_EQ(Glob(work + "/s/left/*.png").size(),
-            Glob(work + "/s/right/*.png").size());
+  EXPECT_EQ(GlobSorted(work + "/s/left/*.png").size(),
+            GlobSorted(work + "/s/right/*.png").size());
 }
 
 // Bad input: exit 2, a clear message, and no session folder.
