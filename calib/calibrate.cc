@@ -4,7 +4,6 @@
 #include <chrono>
 #include <map>
 #include <random>
-#include <set>
 
 #include "calib/paper_method.h"
 #include "data/error.h"
@@ -67,12 +66,6 @@ std::vector<double> Norms(const ModelState& state,
   std::vector<double> out;
   for (const Measurement& m : ms) out.push_back(Residual(state, m).norm());
   return out;
-}
-
-int DistinctPoses(const std::vector<Measurement>& ms) {
-  std::set<std::vector<double>> seen;
-  for (const Measurement& m : ms) seen.insert(m.input.q);
-  return static_cast<int>(seen.size());
 }
 
 }  // namespace
@@ -146,11 +139,7 @@ CalibrateResult Calibrate(const Robot& nominal, const Observations& obs,
   }
   result.identifiability = AnalyzeIdentifiability(
       train, state, candidates, options.identifiability, distances);
-  int robot_params = 0;
-  for (const ParamInfo& p : result.identifiability.identifiable) {
-    if (p.kind != ParamKind::kFrame && p.kind != ParamKind::kPoint)
-      ++robot_params;
-  }
+  const int robot_params = result.identifiability.RobotParameterCount();
   if (options.fit_geometry && robot_params == 0) {
     throw InputError(obs.source, 0, 0,
                      "the data determine no robot parameter (" +

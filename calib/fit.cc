@@ -6,6 +6,7 @@
 #include <chrono>
 #include <map>
 #include <memory>
+#include <set>
 
 #include "data/error.h"
 
@@ -412,6 +413,12 @@ void InitializeFrameAndPoints(const std::vector<Measurement>& measurements,
                            meas_from_base(0, 3),
                            meas_from_base(1, 3),
                            meas_from_base(2, 3)};
+}
+
+int DistinctPoses(const std::vector<Measurement>& measurements) {
+  std::set<std::vector<double>> seen;
+  for (const Measurement& m : measurements) seen.insert(m.input.q);
+  return static_cast<int>(seen.size());
 }
 
 ErrorStats ComputeErrorStats(const std::vector<double>& e) {

@@ -101,6 +101,10 @@ Eigen::MatrixXd ResidualJacobian(
 void InitializeFrameAndPoints(const std::vector<Measurement>& measurements,
                               ModelState* state);
 
+// Number of distinct joint-reading vectors among the measurements (repeated
+// poses count once): what bounds how much the data can determine.
+int DistinctPoses(const std::vector<Measurement>& measurements);
+
 struct ErrorStats {
   int n = 0;
   double rms_mm = 0, mean_mm = 0, max_mm = 0, std_mm = 0;

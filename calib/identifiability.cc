@@ -13,6 +13,14 @@ std::vector<std::string> Identifiability::IdentifiableNames() const {
   return names;
 }
 
+int Identifiability::RobotParameterCount() const {
+  int n = 0;
+  for (const auto& p : identifiable) {
+    n += p.kind != ParamKind::kFrame && p.kind != ParamKind::kPoint ? 1 : 0;
+  }
+  return n;
+}
+
 std::vector<std::string> Identifiability::UnidentifiableNames() const {
   std::vector<std::string> names;
   for (const auto& p : unidentifiable) names.push_back(p.name);

@@ -56,6 +56,8 @@ struct Identifiability {
   double condition = 0.0;
 
   std::vector<std::string> IdentifiableNames() const;
+  // Identifiable parameters of the robot itself (not frame.*, point.*).
+  int RobotParameterCount() const;
   std::vector<std::string> UnidentifiableNames() const;
 };
 

@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cmath>
 #include <numeric>
-#include <set>
 #include <sstream>
 
 #include "calib/calibrate.h"
@@ -100,14 +99,13 @@ ClearanceResult DiagnoseClearance(const Robot& robot, const Observations& obs,
   for (const Measurement& m : all) {
     if (m.kind == Measurement::kMeasured) ms.push_back(m);
   }
-  std::set<std::vector<double>> distinct;
-  for (const Measurement& m : ms) distinct.insert(m.input.q);
-  if (distinct.size() < 3) {
+  const int distinct = DistinctPoses(ms);
+  if (distinct < 3) {
     throw InputError(obs.source, 0, 0,
                      "the clearance test needs measured tip points (x, y, z) "
                      "at >= 3 distinct poses to estimate the measuring frame; "
                      "found " +
-                         std::to_string(distinct.size()));
+                         std::to_string(distinct));
   }
   // The measuring frame first, robot held as given.
   InitializeFrameAndPoints(ms, &state);

@@ -299,17 +299,12 @@ void FitBase(const std::vector<Measurement>& fit_on, const std::string& source,
   for (const ParamInfo& p : GeometryParams(state.chain))
     candidates.push_back(p);
   const Identifiability id = AnalyzeIdentifiability(fit_on, state, candidates);
-  int robot_params = 0;
-  for (const ParamInfo& p : id.identifiable) {
-    if (p.kind != ParamKind::kFrame && p.kind != ParamKind::kPoint)
-      ++robot_params;
-  }
-  std::set<std::vector<double>> distinct;
-  for (const Measurement& m : fit_on) distinct.insert(m.input.q);
+  const int robot_params = id.RobotParameterCount();
+  const int distinct = DistinctPoses(fit_on);
   if (robot_params == 0) {
     throw InputError(source, 0, 0,
                      "the data determine no robot parameter (" +
-                         std::to_string(distinct.size()) +
+                         std::to_string(distinct) +
                          " distinct poses): use more poses that differ in "
                          "every joint");
   }
@@ -348,15 +343,14 @@ std::vector<Measurement> Measurements(const Chain& nominal,
                      "no row has a measured tip (x, y, z): the diagnosis "
                      "needs measured points");
   }
-  std::set<std::vector<double>> distinct;
-  for (const Measurement& m : measured) distinct.insert(m.input.q);
-  if (distinct.size() < 2) {
+  const int distinct = DistinctPoses(measured);
+  if (distinct < 2) {
     throw InputError(obs.source, 0, 0,
                      "all " + std::to_string(measured.size()) +
                          " measured rows have the same joint readings: one "
                          "pose determines no robot parameter");
   }
-  if (distinct.size() < 3) {
+  if (distinct < 3) {
     throw InputError(obs.source, 0, 0,
                      "only 2 distinct poses: the measuring frame alone needs "
                      "3 non-collinear tip points; more poses are needed to "
