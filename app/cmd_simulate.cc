@@ -8,12 +8,12 @@
 #include "app/app_util.h"
 #include "app/command.h"
 #include "calib/model_state.h"
-#include "calib/simulate.h"
+#include "synth/simulate.h"
 #include "data/atomic_file.h"
 #include "data/error.h"
 #include "data/provenance.h"
 #include "data/urdf.h"
-#include "vision/render.h"
+#include "synth/render.h"
 
 namespace kincal::app {
 namespace {

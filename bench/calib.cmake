@@ -1,2 +1,2 @@
 kincal_bench(calib_bench SOURCES ${CMAKE_CURRENT_LIST_DIR}/calib_bench.cc
-             DEPS kincal_calib)
+             DEPS kincal_synth kincal_calib)

@@ -7,7 +7,7 @@
 #include <cstdio>
 
 #include "calib/calibrate.h"
-#include "calib/simulate.h"
+#include "synth/simulate.h"
 #include "data/robot.h"
 
 namespace kincal {

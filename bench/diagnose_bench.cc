@@ -17,7 +17,7 @@
 #include <vector>
 
 #include "calib/calibrate.h"
-#include "calib/simulate.h"
+#include "synth/simulate.h"
 #include "data/robot.h"
 #include "diagnose/clearance.h"
 #include "diagnose/model_diagnosis.h"

@@ -1,2 +1,2 @@
 kincal_bench(paper_bench SOURCES ${CMAKE_CURRENT_LIST_DIR}/paper_bench.cc
-             DEPS kincal_calib kincal_data)
+             DEPS kincal_synth kincal_calib kincal_data)

@@ -11,7 +11,7 @@
 #include <map>
 
 #include "calib/calibrate.h"
-#include "calib/simulate.h"
+#include "synth/simulate.h"
 #include "data/import_ipa.h"
 #include "data/robot.h"
 

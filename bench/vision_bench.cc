@@ -14,7 +14,7 @@
 #include <thread>
 #include <vector>
 
-#include "vision/render.h"
+#include "synth/render.h"
 #include "vision/tool_pose.h"
 #include "vision/tracker.h"
 

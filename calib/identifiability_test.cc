@@ -10,7 +10,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
-#include "calib/simulate.h"
+#include "synth/simulate.h"
 #include "data/robot.h"
 #include "tests/testing/paths.h"
 

@@ -6,7 +6,7 @@
 #include <cmath>
 
 #include "calib/calibrate.h"
-#include "calib/simulate.h"
+#include "synth/simulate.h"
 #include "data/error.h"
 #include "data/robot.h"
 #include "tests/testing/paths.h"

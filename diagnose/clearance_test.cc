@@ -3,7 +3,7 @@
 #include <gtest/gtest.h>
 
 #include "calib/calibrate.h"
-#include "calib/simulate.h"
+#include "synth/simulate.h"
 #include "data/error.h"
 #include "tests/testing/paths.h"
 

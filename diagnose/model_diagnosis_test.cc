@@ -8,7 +8,7 @@
 #include <numeric>
 #include <random>
 
-#include "calib/simulate.h"
+#include "synth/simulate.h"
 #include "data/error.h"
 #include "tests/testing/paths.h"
 

@@ -7,7 +7,8 @@ PKGS=(
   libopencv-dev libapriltag-dev libceres-dev libeigen3-dev
   libv4l-dev libaravis-dev libusb-1.0-0-dev
   libyaml-cpp-dev nlohmann-json3-dev libcli11-dev
-  libtinyxml2-dev
+  libtinyxml2-dev liburdfdom-dev liburdfdom-tools
+  chromium clang libclang-rt-14-dev
   libgtest-dev libgmock-dev libbenchmark-dev
 )
 missing=()

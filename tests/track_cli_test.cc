@@ -13,7 +13,7 @@
 #include "data/atomic_file.h"
 #include "tests/testing/paths.h"
 #include "tests/testing/run.h"
-#include "vision/render.h"
+#include "synth/render.h"
 
 namespace kincal {
 namespace {

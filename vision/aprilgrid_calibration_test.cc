@@ -19,7 +19,7 @@
 #include "tests/testing/paths.h"
 #include "tests/testing/run.h"
 #include "vision/calib_target.h"
-#include "vision/render.h"
+#include "synth/render.h"
 
 namespace kincal {
 namespace {

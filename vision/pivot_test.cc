@@ -5,7 +5,7 @@
 #include <random>
 
 #include "data/error.h"
-#include "vision/render.h"
+#include "synth/render.h"
 #include "vision/tool_pose.h"
 
 namespace kincal {

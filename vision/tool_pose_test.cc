@@ -5,7 +5,7 @@
 #include <cmath>
 #include <cstdio>
 
-#include "vision/render.h"
+#include "synth/render.h"
 #include "vision/triangulate.h"
 
 namespace kincal {

@@ -2,7 +2,7 @@
 
 #include <gtest/gtest.h>
 
-#include "vision/render.h"
+#include "synth/render.h"
 
 namespace kincal {
 namespace {

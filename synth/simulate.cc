@@ -1,4 +1,4 @@
-#include "calib/simulate.h"
+#include "synth/simulate.h"
 
 #include <ceres/jet.h>
 

@@ -1,5 +1,5 @@
-#ifndef KINCAL_CALIB_SIMULATE_H_
-#define KINCAL_CALIB_SIMULATE_H_
+#ifndef KINCAL_SYNTH_SIMULATE_H_
+#define KINCAL_SYNTH_SIMULATE_H_
 
 // Seeded synthetic sessions for any robot: the true robot is the nominal one
 // plus random geometric deviations and optional injected effects from the
@@ -85,4 +85,4 @@ bool SolvePositionIk(const Chain& chain, const Eigen::Vector3d& target_in_base,
 
 }  // namespace kincal
 
-#endif  // KINCAL_CALIB_SIMULATE_H_
+#endif  // KINCAL_SYNTH_SIMULATE_H_

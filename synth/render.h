@@ -1,5 +1,5 @@
-#ifndef KINCAL_VISION_RENDER_H_
-#define KINCAL_VISION_RENDER_H_
+#ifndef KINCAL_SYNTH_RENDER_H_
+#define KINCAL_SYNTH_RENDER_H_
 
 // Synthetic stereo images of the tool target (and of AprilGrid boards) seen
 // through the rig's camera models, with their ground truth.
@@ -191,4 +191,4 @@ Rigid3 ExampleToolPose(int i);
 
 }  // namespace kincal
 
-#endif  // KINCAL_VISION_RENDER_H_
+#endif  // KINCAL_SYNTH_RENDER_H_

@@ -1,4 +1,4 @@
-#include "vision/render.h"
+#include "synth/render.h"
 
 #include <gtest/gtest.h>
 
