@@ -146,7 +146,7 @@ Robot ParseRobotYaml(const std::string& text, const std::string& file) {
     r.ExpectMap(j, what);
     r.CheckKeys(j,
                 {"name", "type", "d", "alpha", "a", "theta", "beta", "xyz",
-                 "rpy", "axis", "limits"},
+                 "rpy", "axis", "limits", "mass", "com"},
                 what);
     RobotRow row;
     row.name = r.String(r.Required(j, "name", what), what + ".name");
@@ -177,6 +177,21 @@ Robot ParseRobotYaml(const std::string& text, const std::string& file) {
       }
       row.lower = lim[0];
       row.upper = lim[1];
+    }
+    if (j["mass"]) {
+      row.mass_kg = r.Number(j["mass"], what + ".mass");
+      if (!(row.mass_kg >= 0.0 && row.mass_kg <= 1e4)) {
+        r.Fail(j["mass"], what + ".mass: expected a link mass in kg, 0..10000");
+      }
+    }
+    if (j["com"]) {
+      if (!j["mass"]) r.Fail(j["com"], what + ".com: given without mass");
+      const auto c = r.Numbers(j["com"], what + ".com", 3, 3);
+      row.com_mm = Eigen::Vector3d(c[0], c[1], c[2]);
+      if (!(row.com_mm.norm() <= 1e5)) {
+        r.Fail(j["com"], what + ".com: expected a centre of mass in mm, "
+                                "within 100 m of the link frame");
+      }
     }
     robot.joints.push_back(row);
   }
@@ -283,6 +298,9 @@ std::string FormatRobotYaml(const Robot& robot,
     if (j.HasLimits()) {
       os << ", limits: [" << FormatDouble(j.lower) << ", "
          << FormatDouble(j.upper) << "]";
+    }
+    if (j.HasMass()) {
+      os << ", mass: " << FormatDouble(j.mass_kg) << ", com: " << Vec(j.com_mm);
     }
     os << "}\n";
   }

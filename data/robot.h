@@ -35,6 +35,13 @@ struct RobotRow {
   double lower = std::numeric_limits<double>::quiet_NaN();
   double upper = std::numeric_limits<double>::quiet_NaN();
   bool HasLimits() const { return lower == lower && upper == upper; }
+  // Inertial data of the link this row's joint moves (the link whose frame
+  // the row ends in), for gravity models: robot.yaml `mass` (kg) and `com`
+  // (mm, in the frame after this row), or a URDF link's <inertial>.
+  // mass_kg is NaN when the file gives none.
+  double mass_kg = std::numeric_limits<double>::quiet_NaN();
+  Eigen::Vector3d com_mm = Eigen::Vector3d::Zero();
+  bool HasMass() const { return mass_kg == mass_kg; }
 };
 
 // A model extension identified by the diagnosis (`extensions:` in robot.yaml).

@@ -89,6 +89,29 @@ TEST(RobotYamlTest, WriteThenReadIsIdentity) {
   EXPECT_EQ(back.extensions[0].values.at("width"), 0.42);
 }
 
+TEST(RobotYamlTest, LinkMassAndCentreOfMassRoundTrip) {
+  std::string text = kSpecExample;
+  const std::string row = "a: 200, theta: 0}";
+  text.replace(text.find(row), row.size(),
+               "a: 200, theta: 0, mass: 7.5, com: [-100, 0, 12.5]}");
+  const Robot r = ParseRobotYaml(text, "m.yaml");
+  EXPECT_FALSE(r.joints[0].HasMass());
+  ASSERT_TRUE(r.joints[1].HasMass());
+  EXPECT_DOUBLE_EQ(r.joints[1].mass_kg, 7.5);
+  EXPECT_DOUBLE_EQ(r.joints[1].com_mm.x(), -100.0);
+  EXPECT_DOUBLE_EQ(r.joints[1].com_mm.z(), 12.5);
+  const Robot back = ParseRobotYaml(FormatRobotYaml(r), "back.yaml");
+  EXPECT_DOUBLE_EQ(back.joints[1].mass_kg, 7.5);
+  EXPECT_DOUBLE_EQ(back.joints[1].com_mm.x(), -100.0);
+  EXPECT_FALSE(back.joints[2].HasMass());
+  std::string bad = kSpecExample;
+  bad.replace(bad.find(row), row.size(), "a: 200, theta: 0, mass: -1}");
+  EXPECT_THAT(ErrorOf(bad), HasSubstr("mass"));
+  bad = kSpecExample;
+  bad.replace(bad.find(row), row.size(), "a: 200, theta: 0, com: [1, 2, 3]}");
+  EXPECT_THAT(ErrorOf(bad), HasSubstr("without mass"));
+}
+
 TEST(RobotYamlTest, RejectsBadInputWithPosition) {
   // Each case: text, expected message fragment (with line:column).
   const std::string base = kSpecExample;
