@@ -6,6 +6,7 @@
 // horizontal reference lines (e.g. the seed's eta = 1 mm). Used for the
 // sensitivity curves (Fig. 2/3) and the clearance test (Fig. 4/5/6).
 
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -16,6 +17,13 @@ struct PlotSeries {
   std::vector<double> x, y;
   bool points = false;  // markers instead of a line
   bool bars = false;    // vertical bars from 0 (per-pose charts)
+  // Optional per-point colour value (markers coloured on a blue-to-red
+  // scale, with a colour bar labelled `color_label`); empty = series colour.
+  std::vector<double> color = {};
+  std::string color_label = "";
+  // Optional per-point arrows (x, y) -> (x + dx, y + dy) in data units
+  // (3D error vectors projected on a plane); empty = none.
+  std::vector<double> dx = {}, dy = {};
 };
 
 struct PlotLine {  // horizontal reference line
@@ -28,13 +36,29 @@ struct Plot {
   std::vector<PlotSeries> series;
   std::vector<PlotLine> lines;
   int width = 800, height = 500;
+  // Fixed y range (NaN = from the data). Data outside is clipped to the
+  // frame, e.g. to show a minimum near zero beside curves that reach far up.
+  double y_min = std::numeric_limits<double>::quiet_NaN();
+  double y_max = std::numeric_limits<double>::quiet_NaN();
+  // Same x and y scale (workspace views).
+  bool equal_axes = false;
 };
 
-// SVG text of the plot (provenance as an XML comment).
+// A standalone SVG file of the plot: XML declaration, then the command line
+// and version in a <desc> element (not in a comment: a command line holds
+// "--", which XML forbids inside comments). Well-formed XML.
 std::string FormatSvgPlot(const Plot& plot);
 
-// Several plots stacked vertically in one SVG.
+// Several plots stacked vertically in one SVG file.
 std::string FormatSvgPlots(const std::vector<Plot>& plots);
+
+// The plot as an <svg> element to inline into HTML (no XML declaration, no
+// provenance; viewBox set so it scales with the page). `id` names the
+// element and prefixes its clip path (unique per page).
+std::string FormatInlineSvg(const Plot& plot, const std::string& id);
+
+// Text escaped for XML / HTML character data and attribute values.
+std::string XmlEscape(const std::string& text);
 
 }  // namespace kincal
 

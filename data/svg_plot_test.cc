@@ -1,6 +1,13 @@
 #include "data/svg_plot.h"
 
 #include <gtest/gtest.h>
+#include <tinyxml2.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+
+#include "data/provenance.h"
 
 namespace kincal {
 namespace {
@@ -25,6 +32,67 @@ TEST(SvgPlotTest, EmptyAndDegenerateDataStillValid) {
   const std::string svg = FormatSvgPlots({p, Plot{}});
   EXPECT_EQ(svg.find("nan"), std::string::npos);
   EXPECT_EQ(svg.find("inf"), std::string::npos);
+}
+
+// tinyxml2's strict parse: fails on "--" inside a comment, unbalanced tags,
+// unescaped '<' or '&'.
+void ExpectWellFormed(const std::string& xml) {
+  tinyxml2::XMLDocument doc;
+  EXPECT_EQ(doc.Parse(xml.c_str(), xml.size()), tinyxml2::XML_SUCCESS)
+      << doc.ErrorStr() << "\n"
+      << xml.substr(0, 400);
+}
+
+TEST(SvgPlotTest, WellFormedWithDoubleHyphensAndMarkupInCommandLine) {
+  const std::string saved = CommandLine();
+  SetCommandLine(
+      "kincal diagnose clearance --robot 'a&b<c>.yaml' --gamma 3 --plot x.svg "
+      "-- ---");
+  Plot p;
+  p.title = "a < b & c -- \"quoted\" 'single'";
+  p.x_label = "offset (deg | mm) --";
+  p.series.push_back({"j3 <deg>", {-3, 0, 3}, {25, 0.1, 25}});
+  const std::string svg = FormatSvgPlots({p, p});
+  SetCommandLine(saved);
+  ExpectWellFormed(svg);
+  // No comment holds "--" (the XML rule that broke rsvg-convert and browsers).
+  for (size_t at = svg.find("<!--"); at != std::string::npos;
+       at = svg.find("<!--", at + 4)) {
+    const size_t end = svg.find("-->", at + 4);
+    ASSERT_NE(end, std::string::npos);
+    EXPECT_EQ(svg.substr(at + 4, end - at - 4).find("--"), std::string::npos);
+  }
+  // Provenance still recorded.
+  EXPECT_NE(svg.find("--gamma 3"), std::string::npos);
+  // Strict outside checker when installed.
+  if (std::system("command -v xmllint >/dev/null 2>&1") == 0) {
+    const std::string path = ::testing::TempDir() + "kincal_svg_check.svg";
+    std::ofstream(path) << svg;
+    EXPECT_EQ(std::system(("xmllint --noout " + path).c_str()), 0);
+    std::remove(path.c_str());
+  }
+}
+
+TEST(SvgPlotTest, FixedRangeClipsAndInlineSvgIsWellFormed) {
+  Plot p;
+  p.title = "sweep";
+  p.series.push_back({"j3", {-3, -1, 0, 1, 3}, {25, 2, 0.05, 2, 25}});
+  p.y_min = 0;
+  p.y_max = 1;
+  PlotSeries scatter{"coloured", {0, 1, 2}, {0.2, 0.5, 0.9}, true};
+  scatter.color = {0.1, 0.5, 3.0};
+  scatter.color_label = "|e| (mm)";
+  scatter.dx = {0.1, 0.1, -0.1};
+  scatter.dy = {0.0, 0.1, 0.1};
+  p.series.push_back(scatter);
+  const std::string svg = FormatInlineSvg(p, "fig1");
+  ExpectWellFormed(svg);
+  EXPECT_EQ(svg.find("<?xml"), std::string::npos);
+  EXPECT_NE(svg.find("clip-path='url(#fig1clip0)'"), std::string::npos);
+  EXPECT_NE(svg.find("|e| (mm)"), std::string::npos);
+  // Tick labels follow the fixed range, not the data's 25.
+  EXPECT_EQ(svg.find(">25<"), std::string::npos);
+  EXPECT_NE(svg.find(">0.2<"), std::string::npos);
 }
 
 }  // namespace

@@ -272,6 +272,16 @@ std::string ClearanceSvg(const ClearanceResult& r) {
   curves.x_label = "reading offset (deg | mm)";
   curves.y_label = "eps (mm)";
   if (!r.sweeps.empty()) {
+    // The ends of a +-gamma sweep reach tens of mm and would flatten the
+    // minimum near zero the test is about: show 0 .. 3x the pose's error
+    // (curves leaving the frame are clipped).
+    const double before = r.sweeps[0].error_mm;
+    if (before > 0) {
+      curves.y_min = 0.0;
+      curves.y_max = 3.0 * before;
+      curves.y_label = "eps (mm), clipped at 3x the pose's error";
+      curves.lines.push_back({before, "error before"});
+    }
     for (const SweepCurve& c : r.sweeps[0].joints) {
       PlotSeries s;
       s.label = r.joint_names[c.joint] + " (" + r.joint_units[c.joint] + ")";

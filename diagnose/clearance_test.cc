@@ -3,8 +3,8 @@
 #include <gtest/gtest.h>
 
 #include "calib/calibrate.h"
-#include "synth/simulate.h"
 #include "data/error.h"
+#include "synth/simulate.h"
 #include "tests/testing/paths.h"
 
 namespace kincal {
@@ -99,7 +99,12 @@ TEST(ClearanceTest, SweepAtZeroOffsetReproducesTheDeviation) {
   EXPECT_TRUE(j.contains("suspect"));
   const std::string csv = ClearanceCsv(r);
   EXPECT_NE(csv.find("kind,pose,joint,offset,error_mm"), std::string::npos);
-  EXPECT_NE(ClearanceSvg(r).find("<svg"), std::string::npos);
+  const std::string svg = ClearanceSvg(r);
+  EXPECT_NE(svg.find("<svg"), std::string::npos);
+  // The sweep plot's y axis ends at 3x the worst pose's error (the minimum
+  // near zero stays visible), not at the sweep ends' tens of mm.
+  EXPECT_NE(svg.find("clipped at 3x"), std::string::npos);
+  EXPECT_NE(svg.find("error before"), std::string::npos);
 }
 
 TEST(ClearanceTest, TooFewPosesIsBadInput) {
