@@ -35,6 +35,7 @@ int main(int argc, char** argv) {
   kincal::app::AddImportCommand(app, &run);
   kincal::app::AddCaptureCommand(app, &run);
   kincal::app::AddExportCommand(app, &run);
+  kincal::app::AddReportCommand(app, &run);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {

@@ -67,6 +67,12 @@ void Draw(const Plot& plot, int y0, const std::string& id,
       xmax = std::max(xmax, s.x[i]);
       ymin = std::min(ymin, s.y[i]);
       ymax = std::max(ymax, s.y[i]);
+      if (s.cell_w > 0 && s.cell_h > 0) {
+        xmin = std::min(xmin, s.x[i] - s.cell_w / 2);
+        xmax = std::max(xmax, s.x[i] + s.cell_w / 2);
+        ymin = std::min(ymin, s.y[i] - s.cell_h / 2);
+        ymax = std::max(ymax, s.y[i] + s.cell_h / 2);
+      }
       if (i < s.dx.size() && i < s.dy.size() && std::isfinite(s.dx[i]) &&
           std::isfinite(s.dy[i])) {
         xmin = std::min(xmin, s.x[i] + s.dx[i]);
@@ -146,7 +152,8 @@ void Draw(const Plot& plot, int y0, const std::string& id,
   }
   for (size_t k = 0; k < plot.series.size(); ++k) {
     const PlotSeries& s = plot.series[k];
-    const std::string color = kColors[k % 10];
+    const std::string color =
+        kColors[(s.color_index >= 0 ? s.color_index : k) % 10];
     const size_t n = std::min(s.x.size(), s.y.size());
     const bool arrows = !s.dx.empty() && !s.dy.empty();
     if (s.bars) {
@@ -165,6 +172,16 @@ void Draw(const Plot& plot, int y0, const std::string& id,
         const std::string c =
             i < s.color.size() ? ColorScale((s.color[i] - cmin) / (cmax - cmin))
                                : color;
+        if (s.cell_w > 0 && s.cell_h > 0) {
+          const double x0 = X(s.x[i] - s.cell_w / 2),
+                       x1 = X(s.x[i] + s.cell_w / 2);
+          const double y1 = Y(s.y[i] - s.cell_h / 2),
+                       y0c = Y(s.y[i] + s.cell_h / 2);
+          os << "<rect x='" << Px(x0) << "' y='" << Px(y0c) << "' width='"
+             << Px(x1 - x0) << "' height='" << Px(y1 - y0c) << "' fill='" << c
+             << "'/>\n";
+          continue;
+        }
         if (arrows && i < s.dx.size() && i < s.dy.size()) {
           os << "<line x1='" << Px(X(s.x[i])) << "' y1='" << Px(Y(s.y[i]))
              << "' x2='" << Px(X(s.x[i] + s.dx[i])) << "' y2='"

@@ -24,6 +24,12 @@ struct PlotSeries {
   // Optional per-point arrows (x, y) -> (x + dx, y + dy) in data units
   // (3D error vectors projected on a plane); empty = none.
   std::vector<double> dx = {}, dy = {};
+  // Palette index of the series' colour (-1: its position in the plot), e.g.
+  // to draw a trend line in the colour of the markers it summarises.
+  int color_index = -1;
+  // Heat-map cells: when > 0, each point is drawn as a filled rectangle of
+  // this size (data units) centred on it, coloured by `color`.
+  double cell_w = 0.0, cell_h = 0.0;
 };
 
 struct PlotLine {  // horizontal reference line
