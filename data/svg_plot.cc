@@ -86,6 +86,8 @@ void Draw(const Plot& plot, int y0, const std::string& id,
       }
     }
     if (s.bars) ymin = std::min(ymin, 0.0);
+    if (std::isfinite(s.color_lo)) cmin = s.color_lo;
+    if (std::isfinite(s.color_hi)) cmax = s.color_hi;
   }
   for (const auto& l : plot.lines) {
     ymin = std::min(ymin, l.y);

@@ -30,6 +30,10 @@ struct PlotSeries {
   // Heat-map cells: when > 0, each point is drawn as a filled rectangle of
   // this size (data units) centred on it, coloured by `color`.
   double cell_w = 0.0, cell_h = 0.0;
+  // Fixed ends of the colour scale (NaN: the data's range), so that two
+  // plots can share one scale.
+  double color_lo = std::numeric_limits<double>::quiet_NaN();
+  double color_hi = std::numeric_limits<double>::quiet_NaN();
 };
 
 struct PlotLine {  // horizontal reference line

@@ -1,0 +1,183 @@
+// kincal report end to end: sections follow the inputs, the page is one
+// self-contained file, and headless Chromium opens it without console
+// errors with every figure drawn (a screenshot is kept in the build folder:
+// build/report_demo.png). Skips the browser part when chromium is absent.
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <regex>
+
+#include "data/atomic_file.h"
+#include "tests/testing/paths.h"
+#include "tests/testing/run.h"
+
+namespace kincal {
+namespace {
+
+using ::testing::Contains;
+using testing::Exists;
+using ::testing::HasSubstr;
+using ::testing::Not;
+using testing::RunKincal;
+using testing::RunShell;
+
+const char kChromium[] = "/usr/bin/chromium";
+
+std::string ChromiumFlags(const std::string& profile) {
+  return std::string(kChromium) +
+         " --headless --no-sandbox --disable-gpu --disable-quic "
+         "--no-first-run --disable-background-networking "
+         "--disable-component-update --disable-sync --user-data-dir=" +
+         profile + " ";
+}
+
+std::vector<std::string> Sections(const nlohmann::json& j) {
+  return j["sections"].get<std::vector<std::string>>();
+}
+
+// Opens the page in headless Chromium: console errors, figures drawn, and a
+// screenshot at `png`.
+void CheckInBrowser(const std::string& html, int figures,
+                    const std::string& png) {
+  if (!Exists(kChromium)) {
+    GTEST_SKIP() << kChromium << " not installed: browser check skipped "
+                 << "(apt-get install chromium)";
+  }
+  const std::string dir = testing::MakeTempDir("chromium");
+  const auto dom = RunShell(ChromiumFlags(dir + "/p1") +
+                            "--enable-logging=stderr --v=0 "
+                            "--virtual-time-budget=5000 --dump-dom file://" +
+                            html);
+  ASSERT_EQ(dom.exit_code, 0) << dom.err;
+  // Every figure drew: the page's own check after layout (bounding box and
+  // marks of every inline SVG) writes data-figures="drawn/total".
+  const std::string want = "data-figures=\"" + std::to_string(figures) + "/" +
+                           std::to_string(figures) + "\"";
+  EXPECT_THAT(dom.out, HasSubstr(want));
+  EXPECT_THAT(dom.out, HasSubstr("data-drawn=\"yes\""));
+  // No console errors or uncaught exceptions from the page.
+  std::istringstream err(dom.err);
+  std::string line;
+  while (std::getline(err, line)) {
+    if (line.find("CONSOLE") != std::string::npos ||
+        line.find("Uncaught") != std::string::npos) {
+      ADD_FAILURE() << "browser console: " << line;
+    }
+  }
+  const auto shot = RunShell(ChromiumFlags(dir + "/p2") +
+                             "--window-size=1200,2400 --screenshot=" + png +
+                             " file://" + html);
+  EXPECT_EQ(shot.exit_code, 0) << shot.err;
+  ASSERT_TRUE(Exists(png));
+  EXPECT_GT(ReadFile(png).size(), 50000u);  // not a blank page
+}
+
+TEST(ReportCliTest, DemoSessionFullReportOpensInBrowser) {
+  const std::string dir = testing::MakeTempDir("report");
+  const std::string s = testing::SourceDir() + "/data/sessions/bh7_demo";
+  auto d = RunKincal("diagnose model --robot " + s + "/robot.yaml --obs " + s +
+                     "/observations.csv --out " + dir + "/ext.yaml --json > " +
+                     dir + "/diag.json");
+  ASSERT_EQ(d.exit_code, 0) << d.err;
+  // A rig and tracked points (as camcal and track write them).
+  std::ofstream(dir + "/rig.yaml")
+      << "kincal_rig: 1\ncameras:\n"
+         "  - {name: left, width: 1280, height: 1024, fx: 1800, fy: 1800, "
+         "cx: 639.5, cy: 511.5, distortion: [], cam_from_rig: {R: "
+         "[1,0,0,0,1,0,0,0,1], t: [0,0,0]}}\n"
+         "  - {name: right, width: 1280, height: 1024, fx: 1810, fy: 1810, "
+         "cx: 640, cy: 512, distortion: [0.01, 0, 0, 0], cam_from_rig: {R: "
+         "[1,0,0,0,1,0,0,0,1], t: [-120,0,0]}}\n";
+  std::ofstream(dir + "/points.csv")
+      << "# written by kincal 0.1.0: kincal track ...\n"
+         "frame,x,y,z,reproj_px,tags\n0,1,2,900,0.21,3\n1,,,,,0\n"
+         "2,1.5,2,901,0.25,2\n3,1.7,2.1,902,0.3,3\n4,2,2,903,0.18,3\n";
+  const std::string html = dir + "/report.html";
+  const auto r = RunKincal("report --robot " + s + "/robot.yaml --obs " + s +
+                           "/observations.csv --calibrated " + dir +
+                           "/ext.yaml --diagnosis " + dir +
+                           "/diag.json --rig " + dir + "/rig.yaml --session " +
+                           dir + "/points.csv --out " + html + " --json");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["out"], html);
+  EXPECT_TRUE(j["seconds"].is_number());
+  const auto sec = Sections(j);
+  for (const char* want :
+       {"verdict", "diagnosis", "residuals", "structure", "workspace",
+        "sensitivity", "clearance", "identifiability", "parameters", "camera",
+        "tracking", "provenance"}) {
+    EXPECT_THAT(sec, Contains(want));
+  }
+  EXPECT_EQ(sec.front(), "verdict");
+  const std::string page = ReadFile(html);
+  // Verdict in words: the backlash hidden in the demo data, named.
+  EXPECT_THAT(page, HasSubstr("backlash in j3"));
+  // Self-contained: no external resource (the SVG namespace is a name).
+  const std::string no_ns =
+      std::regex_replace(page, std::regex("http://www.w3.org/2000/svg"), "");
+  EXPECT_THAT(no_ns, Not(HasSubstr("http://")));
+  EXPECT_THAT(no_ns, Not(HasSubstr("https://")));
+  EXPECT_THAT(page, Not(HasSubstr("src=")));
+  EXPECT_THAT(page, HasSubstr("kincal simulate"));  // provenance of the obs
+  CheckInBrowser(html, j["figures"].get<int>(),
+                 std::string(KINCAL_BUILD_DIR) + "/report_demo.png");
+}
+
+TEST(ReportCliTest, SectionsAppearOnlyWithTheirInputs) {
+  const std::string dir = testing::MakeTempDir("report_min");
+  const auto r =
+      RunKincal("report --robot " + testing::SourceDir() +
+                "/data/robots/bh7.yaml --out " + dir + "/r.html --json");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto sec = Sections(nlohmann::json::parse(r.out));
+  EXPECT_EQ(sec, (std::vector<std::string>{"verdict", "provenance"}));
+}
+
+TEST(ReportCliTest, BadInputExitsTwoAndWritesNothing) {
+  const std::string dir = testing::MakeTempDir("report_bad");
+  std::ofstream(dir + "/diag.json") << "{\"verdict\": 3";
+  const std::string robot = testing::SourceDir() + "/data/robots/bh7.yaml";
+  auto r = RunKincal("report --robot " + robot + " --diagnosis " + dir +
+                     "/diag.json --out " + dir + "/r.html");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_THAT(r.err, HasSubstr("diag.json"));
+  EXPECT_FALSE(Exists(dir + "/r.html"));
+  r = RunKincal("report --out " + dir + "/r.html");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_FALSE(Exists(dir + "/r.html"));
+  std::ofstream(dir + "/bad.csv") << "pose,j1\n0,1\n";
+  r = RunKincal("report --robot " + robot + " --obs " + dir +
+                "/bad.csv --out " + dir + "/r.html");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_THAT(r.err, HasSubstr("bad.csv"));
+  EXPECT_FALSE(Exists(dir + "/r.html"));
+}
+
+// The UR10 series C report (real laser-tracker data) shows the residual
+// structure over shoulder_pan x shoulder_lift that the diagnosis left
+// unexplained.
+TEST(ReportCliTest, Ur10SeriesCShowsPanLiftStructure) {
+  KINCAL_REQUIRE_SHARED_DATA("ipa-robot-accuracy/Series_C");
+  const std::string dir = testing::MakeTempDir("report_ur10");
+  auto r = RunKincal("import ipa-ur10 --in " + testing::SharedDataDir() +
+                     "/ipa-robot-accuracy/Series_C/measurements_random_poses"
+                     ".csv --robot " +
+                     testing::SourceDir() + "/data/robots/ur10.yaml --out " +
+                     dir + "/obs.csv --every 2");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  r = RunKincal("report --robot " + testing::SourceDir() +
+                "/data/robots/ur10.yaml --obs " + dir + "/obs.csv --out " +
+                dir + "/ur10.html --json");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_THAT(Sections(nlohmann::json::parse(r.out)), Contains("structure"));
+  EXPECT_THAT(ReadFile(dir + "/ur10.html"),
+              HasSubstr("Residual structure over shoulder_pan_joint x "
+                        "shoulder_lift_joint"));
+}
+
+}  // namespace
+}  // namespace kincal
