@@ -14,6 +14,7 @@
 #include <sstream>
 
 #include "app/command.h"
+#include "capture/async_recorder.h"
 #include "capture/frame_source.h"
 #include "capture/recorder.h"
 #include "capture/stereo_grabber.h"
@@ -31,6 +32,8 @@ struct CaptureArgs {
   double tolerance_ms = 10;
   int png_compression = 1;
   int max_failures = 3;
+  int queue_pairs = 32;
+  int writers = 2;
   bool list = false;
   bool json = false;
 };
@@ -170,6 +173,8 @@ int RunCapture(const CaptureArgs& args) {
   if (args.frames > 0) info.settings["frames"] = std::to_string(args.frames);
   if (args.seconds > 0) info.settings["seconds"] = std::to_string(args.seconds);
   info.settings["png_compression"] = std::to_string(args.png_compression);
+  info.settings["queue_pairs"] = std::to_string(args.queue_pairs);
+  info.settings["writers"] = std::to_string(args.writers);
 
   capture::SessionRecorder::Options rec_options;
   rec_options.png_compression = args.png_compression;
@@ -182,6 +187,13 @@ int RunCapture(const CaptureArgs& args) {
   if (live && args.frames == 0 && args.seconds == 0 && !args.json) {
     std::cerr << "kincal capture: recording until Ctrl-C\n";
   }
+
+  capture::AsyncRecorderOptions async_options;
+  async_options.queue_pairs = args.queue_pairs;
+  async_options.writer_threads = args.writers;
+  async_options.drop_when_full = live;  // a recording can wait
+  capture::AsyncRecorder writer(&recorder, async_options);
+  int64_t accepted = 0;
 
   InterruptGuard guard;
   const auto start = std::chrono::steady_clock::now();
@@ -196,7 +208,7 @@ int RunCapture(const CaptureArgs& args) {
   int64_t transient_failures = 0;
   capture::StereoFrame pair;
   for (;;) {
-    if (args.frames > 0 && recorder.frames() >= args.frames) {
+    if (args.frames > 0 && accepted >= args.frames) {
       stop_reason = "frames";
       break;
     }
@@ -226,25 +238,37 @@ int RunCapture(const CaptureArgs& args) {
       break;
     }
     consecutive_failures = 0;
-    s = recorder.Write(pair);
-    if (!s.ok()) {
-      failure = "write: " + s.ToString();
+    // Never waits for the disk: a full queue drops the pair (counted).
+    if (writer.Submit(std::move(pair))) {
+      ++accepted;
+    } else if (writer.failed()) {
       break;
     }
+    pair = capture::StereoFrame();
   }
   const double seconds = elapsed();
   grabber.Close();
+  s = writer.Stop();  // drains the queue
+  if (!s.ok() && failure.empty()) failure = "write: " + s.ToString();
+  const int64_t dropped_pairs = writer.dropped_pairs();
 
   capture::SessionSummary summary;
   summary.complete = failure.empty();
   summary.stop_reason = failure.empty() ? stop_reason : failure;
   summary.dropped_left = grabber.dropped_left();
   summary.dropped_right = grabber.dropped_right();
+  summary.dropped_pairs = dropped_pairs;
   summary.length_mismatch = grabber.length_mismatch();
   summary.seconds = seconds;
   const Status fin = recorder.Finalize(summary);
   if (!fin.ok() && failure.empty()) failure = "finalize: " + fin.ToString();
 
+  if (dropped_pairs > 0) {
+    std::cerr << "kincal capture: warning: " << dropped_pairs
+              << " stereo pairs dropped because the disk/encoder was slower "
+                 "than the cameras (lower --png-compression, add --writers, "
+                 "or a faster disk)\n";
+  }
   if (grabber.length_mismatch()) {
     std::cerr << "kincal capture: warning: left and right recordings have "
                  "different lengths; recorded the "
@@ -262,6 +286,8 @@ int RunCapture(const CaptureArgs& args) {
     j["pairing"] = info.pairing;
     j["dropped_left"] = grabber.dropped_left();
     j["dropped_right"] = grabber.dropped_right();
+    j["dropped_pairs"] = dropped_pairs;
+    j["max_queue_depth"] = writer.max_queue_depth();
     j["length_mismatch"] = grabber.length_mismatch();
     j["transient_failures"] = transient_failures;
     j["stop_reason"] = summary.stop_reason;
@@ -270,14 +296,16 @@ int RunCapture(const CaptureArgs& args) {
   } else {
     std::printf(
         "recorded %lld stereo pairs in %.2f s (%.1f pairs/s) to %s\n"
-        "pairing: %s, dropped left %lld, right %lld; stopped: %s\n"
+        "pairing: %s, dropped left %lld, right %lld, pairs (disk too slow) "
+        "%lld; stopped: %s\n"
         "track it: kincal track --rig RIG.yaml --target TARGET.yaml "
         "--left '%s/left/*.png' --right '%s/right/*.png' --out points.csv\n",
         static_cast<long long>(recorder.frames()), seconds,
         seconds > 0 ? recorder.frames() / seconds : 0.0, args.out.c_str(),
         info.pairing.c_str(), static_cast<long long>(grabber.dropped_left()),
         static_cast<long long>(grabber.dropped_right()),
-        summary.stop_reason.c_str(), args.out.c_str(), args.out.c_str());
+        static_cast<long long>(dropped_pairs), summary.stop_reason.c_str(),
+        args.out.c_str(), args.out.c_str());
   }
   if (!failure.empty()) {
     std::cerr << "kincal: failure: capture: " << failure << " (the "
@@ -321,6 +349,13 @@ void AddCaptureCommand(CLI::App& app, Runner* run) {
                   "live cameras: consecutive timeouts/corrupt frames "
                   "tolerated (default 3)")
       ->check(CLI::Range(0, 1000));
+  sub->add_option("--queue", args->queue_pairs,
+                  "pairs waiting for the writers; when full, new pairs are "
+                  "dropped and counted (default 32)")
+      ->check(CLI::Range(1, 10000));
+  sub->add_option("--writers", args->writers,
+                  "writer threads encoding PNGs (default 2)")
+      ->check(CLI::Range(1, 64));
   sub->add_flag("--json", args->json, "print one JSON object");
   sub->callback([run, args] { *run = [args] { return RunCapture(*args); }; });
 }
