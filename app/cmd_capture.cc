@@ -8,17 +8,22 @@
 #include <atomic>
 #include <cerrno>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <iostream>
 #include <memory>
+#include <opencv2/imgproc.hpp>
+#include <optional>
 #include <sstream>
 
 #include "app/command.h"
 #include "capture/async_recorder.h"
 #include "capture/frame_source.h"
+#include "capture/joint_log.h"
 #include "capture/recorder.h"
 #include "capture/stereo_grabber.h"
 #include "data/error.h"
+#include "data/robot.h"
 
 namespace kincal::app {
 namespace {
@@ -33,6 +38,9 @@ struct CaptureArgs {
   int png_compression = 1;
   int max_failures = 3;
   int queue_pairs = 32;
+  std::string joints, robot;
+  double joints_offset = NAN;  // NaN: estimate
+  double max_joint_speed = 1.0;
   int writers = 2;
   bool list = false;
   bool json = false;
@@ -139,6 +147,16 @@ int RunCapture(const CaptureArgs& args) {
           "capture: cannot pair a camera with a recording (--left " +
               args.left + ", --right " + args.right +
               "): use two cameras or two recordings");
+  std::optional<capture::JointLog> joint_log;
+  if (!args.joints.empty()) {
+    std::vector<std::string> names;
+    if (!args.robot.empty()) names = ReadRobotYaml(args.robot).JointNames();
+    joint_log = capture::ReadJointLog(args.joints,
+                                      args.robot.empty() ? nullptr : &names);
+  } else {
+    Require(args.robot.empty() && std::isnan(args.joints_offset),
+            "capture: --robot and --joints-offset go with --joints");
+  }
   Require(IsAbsentOrEmptyDir(args.out),
           "capture: --out " + args.out +
               " exists and is not empty; kincal never overwrites a session, "
@@ -194,6 +212,8 @@ int RunCapture(const CaptureArgs& args) {
   async_options.drop_when_full = live;  // a recording can wait
   capture::AsyncRecorder writer(&recorder, async_options);
   int64_t accepted = 0;
+  std::vector<double> frame_times, image_motion;
+  cv::Mat previous_small;
 
   InterruptGuard guard;
   const auto start = std::chrono::steady_clock::now();
@@ -238,9 +258,28 @@ int RunCapture(const CaptureArgs& args) {
       break;
     }
     consecutive_failures = 0;
+    // Image motion (for the joint log's clock offset): mean absolute
+    // change of the left image, about 160 px wide, since the previous pair.
+    double motion = 0, t_left = pair.left.timestamp_s;
+    if (joint_log) {
+      cv::Mat small;
+      const double scale =
+          std::min(1.0, 160.0 / std::max(1, pair.left.image.cols));
+      cv::resize(pair.left.image, small, cv::Size(), scale, scale,
+                 cv::INTER_AREA);
+      if (small.channels() == 3) cv::cvtColor(small, small, cv::COLOR_BGR2GRAY);
+      if (!previous_small.empty()) {
+        cv::Mat diff;
+        cv::absdiff(small, previous_small, diff);
+        motion = cv::mean(diff)[0];
+      }
+      previous_small = small;
+    }
     // Never waits for the disk: a full queue drops the pair (counted).
     if (writer.Submit(std::move(pair))) {
       ++accepted;
+      frame_times.push_back(t_left);
+      image_motion.push_back(motion);
     } else if (writer.failed()) {
       break;
     }
@@ -260,6 +299,46 @@ int RunCapture(const CaptureArgs& args) {
   summary.dropped_pairs = dropped_pairs;
   summary.length_mismatch = grabber.length_mismatch();
   summary.seconds = seconds;
+  // Joint readings by time, merged before finalizing. A log that cannot be
+  // merged is bad input: the session is kept without joint columns.
+  std::string joint_error;
+  nlohmann::json joints_json;
+  if (joint_log && recorder.frames() > 0) {
+    frame_times.resize(recorder.frames());
+    image_motion.resize(recorder.frames());
+    if (!image_motion.empty())
+      image_motion[0] = image_motion.size() > 1 ? image_motion[1] : 0.0;
+    capture::JointMergeOptions merge_options;
+    if (!std::isnan(args.joints_offset)) {
+      merge_options.offset_s = args.joints_offset;
+    }
+    merge_options.max_speed = args.max_joint_speed;
+    try {
+      const capture::JointMerge merge = capture::MergeJointLog(
+          *joint_log, frame_times, image_motion, merge_options);
+      s = recorder.SetJointColumns(merge.names, merge.joints);
+      if (!s.ok()) throw InputError("capture: " + s.message());
+      char offset[64];
+      std::snprintf(offset, sizeof(offset), "%.6f", merge.offset_s);
+      recorder.SetSetting("joints_log", args.joints);
+      recorder.SetSetting("joints_offset_s", offset);
+      recorder.SetSetting("joints_offset",
+                          merge.estimated ? "estimated" : "given");
+      recorder.SetSetting("max_joint_speed",
+                          std::to_string(args.max_joint_speed));
+      joints_json = {
+          {"log", args.joints},
+          {"offset_s", merge.offset_s},
+          {"offset_estimated", merge.estimated},
+          {"agreement", merge.estimated ? nlohmann::json(merge.agreement)
+                                        : nlohmann::json()},
+          {"stops_matched", merge.stops_matched},
+          {"frames_with_reading", merge.with_reading},
+          {"frames_too_fast", merge.too_fast}};
+    } catch (const InputError& e) {
+      joint_error = e.what();
+    }
+  }
   const Status fin = recorder.Finalize(summary);
   if (!fin.ok() && failure.empty()) failure = "finalize: " + fin.ToString();
 
@@ -292,6 +371,7 @@ int RunCapture(const CaptureArgs& args) {
     j["transient_failures"] = transient_failures;
     j["stop_reason"] = summary.stop_reason;
     j["complete"] = failure.empty();
+    if (!joints_json.is_null()) j["joints"] = joints_json;
     PrintJson(j);
   } else {
     std::printf(
@@ -306,6 +386,12 @@ int RunCapture(const CaptureArgs& args) {
         static_cast<long long>(grabber.dropped_right()),
         static_cast<long long>(dropped_pairs), summary.stop_reason.c_str(),
         args.out.c_str(), args.out.c_str());
+  }
+  if (!joint_error.empty()) {
+    throw InputError(joint_error + " (the " +
+                     std::to_string(recorder.frames()) +
+                     " recorded pairs are kept in " + args.out +
+                     ", without joint readings)");
   }
   if (!failure.empty()) {
     std::cerr << "kincal: failure: capture: " << failure << " (the "
@@ -349,6 +435,18 @@ void AddCaptureCommand(CLI::App& app, Runner* run) {
                   "live cameras: consecutive timeouts/corrupt frames "
                   "tolerated (default 3)")
       ->check(CLI::Range(0, 1000));
+  sub->add_option("--joints", args->joints,
+                  "controller joint log joints.csv (t, one column per joint) "
+                  "merged into frames.csv by time");
+  sub->add_option("--robot", args->robot,
+                  "robot.yaml: the log's joint columns must be its joints");
+  sub->add_option("--joints-offset", args->joints_offset,
+                  "clock offset, s: t_frame = t_log + offset (default: "
+                  "estimated from when the robot stops)");
+  sub->add_option("--max-joint-speed", args->max_joint_speed,
+                  "frames taken while a joint moves faster (deg/s or mm/s) "
+                  "get no reading (default 1)")
+      ->check(CLI::PositiveNumber);
   sub->add_option("--queue", args->queue_pairs,
                   "pairs waiting for the writers; when full, new pairs are "
                   "dropped and counted (default 32)")

@@ -284,6 +284,50 @@ Status SessionRecorder::CommitRow(const StereoFrame& pair,
   return Status::Ok();
 }
 
+Status SessionRecorder::SetJointColumns(
+    const std::vector<std::string>& names,
+    const std::vector<std::vector<double>>& values) {
+  if (!info_.joint_names.empty()) {
+    return Status::Error(Status::Kind::kUnsupported,
+                         "the session already has joint columns");
+  }
+  if (values.size() != rows_.size()) {
+    return Status::Error(Status::Kind::kUnsupported,
+                         std::to_string(values.size()) + " joint rows for " +
+                             std::to_string(rows_.size()) + " frames");
+  }
+  std::set<std::string> seen = {"frame", "t_left", "t_right", "seq_left",
+                                "seq_right"};
+  for (const std::string& n : names) {
+    if (n.empty() || !seen.insert(n).second) {
+      return Status::Error(
+          Status::Kind::kUnsupported,
+          "joint column '" + n + "' is empty or repeats another column");
+    }
+  }
+  for (size_t r = 0; r < rows_.size(); ++r) {
+    if (values[r].size() != names.size()) {
+      return Status::Error(
+          Status::Kind::kUnsupported,
+          "frame " + std::to_string(r) + ": wrong number of joint values");
+    }
+    std::string& row = rows_[r];
+    row.pop_back();  // "\n"
+    for (double v : values[r]) {
+      row += ",";
+      if (v == v) {
+        std::ostringstream os;
+        os.precision(10);
+        os << v;
+        row += os.str();
+      }
+    }
+    row += "\n";
+  }
+  info_.joint_names = names;
+  return Status::Ok();
+}
+
 Status SessionRecorder::Finalize(const SessionSummary& summary) {
   if (!open_) {
     return Status::Error(Status::Kind::kIoError, "recorder not open");

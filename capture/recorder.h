@@ -85,6 +85,16 @@ class SessionRecorder {
                          uint64_t* bytes) const;
   Status CommitRow(const StereoFrame& pair, const std::vector<double>& joints,
                    uint64_t bytes);
+  // Joint readings merged after recording (capture --joints): adds the
+  // columns `names` with one row of values per recorded frame (NaN = no
+  // reading) to the frames.csv that Finalize writes. Only for a session
+  // opened without joint columns.
+  Status SetJointColumns(const std::vector<std::string>& names,
+                         const std::vector<std::vector<double>>& values);
+  // Adds or replaces a `settings` entry of session.yaml.
+  void SetSetting(const std::string& key, const std::string& value) {
+    info_.settings[key] = value;
+  }
   // Removes frame `frame`'s images (written but never committed).
   void RemovePairImages(int64_t frame) const;
   // Writes frames.csv and session.yaml (atomically) and removes the journal.
