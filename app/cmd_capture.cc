@@ -27,6 +27,7 @@
 #include "capture/stereo_grabber.h"
 #include "data/atomic_file.h"
 #include "data/error.h"
+#include "data/provenance.h"
 #include "data/robot.h"
 
 namespace kincal::app {
@@ -279,6 +280,9 @@ int RunStepAndShoot(const CaptureArgs& args, capture::FrameSource* left,
   for (const std::string& n : names) stream_csv += "," + n;
   stream_csv += "\n";
   bool any_stream = false;
+  std::string obs_csv = "# " + CommandLine() + "\npose";
+  for (const std::string& n : names) obs_csv += "," + n;
+  obs_csv += "\n";
   for (;;) {
     if (g_interrupted) {
       stop_reason = "interrupted";
@@ -364,6 +368,13 @@ int RunStepAndShoot(const CaptureArgs& args, capture::FrameSource* left,
     }
     ++poses;
     last_pose = m.pose;
+    obs_csv += std::to_string(m.pose);
+    for (double v : q) {
+      char buf[64];
+      std::snprintf(buf, sizeof(buf), ",%.10g", v);
+      obs_csv += buf;
+    }
+    obs_csv += "\n";
     s = link.WriteLine("DONE " + std::to_string(m.pose) + " " +
                        std::to_string(shots.size()));
     if (!s.ok()) {
@@ -377,6 +388,13 @@ int RunStepAndShoot(const CaptureArgs& args, capture::FrameSource* left,
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start)
           .count();
   grabber.Close();
+  // observations.csv beside frames.csv: one row per recorded pose (pose =
+  // the robot's pose number), for `kincal track --obs ... --out-obs`.
+  try {
+    WriteFileAtomic(args.out + "/observations.csv", obs_csv);
+  } catch (const std::exception& e) {
+    if (failure.empty()) failure = e.what();
+  }
   if (any_stream) {
     try {
       WriteFileAtomic(args.out + "/joints.csv", stream_csv);
