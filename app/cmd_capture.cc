@@ -23,7 +23,7 @@
 #include "capture/frame_source.h"
 #include "capture/joint_log.h"
 #include "capture/recorder.h"
-#include "capture/robot_link.h"
+#include "capture/step_and_shoot.h"
 #include "capture/stereo_grabber.h"
 #include "data/atomic_file.h"
 #include "data/error.h"
@@ -138,56 +138,27 @@ int RunList(const CaptureArgs& args) {
   return 0;
 }
 
-// The mean of K pairs (8-bit, rounded): less image noise per settled pose.
-capture::StereoFrame AveragePairs(const std::vector<capture::StereoFrame>& v) {
-  capture::StereoFrame out = v.back();
-  for (int side = 0; side < 2; ++side) {
-    cv::Mat sum;
-    double t = 0;
-    for (const capture::StereoFrame& p : v) {
-      const capture::Frame& f = side == 0 ? p.left : p.right;
-      cv::Mat f32;
-      f.image.convertTo(f32, CV_32F);
-      if (sum.empty()) {
-        sum = f32;
-      } else {
-        sum += f32;
-      }
-      t += f.timestamp_s;
-    }
-    capture::Frame& o = side == 0 ? out.left : out.right;
-    sum.convertTo(o.image, CV_8U, 1.0 / v.size());
-    o.timestamp_s = t / v.size();
-  }
-  return out;
-}
-
-// Step-and-shoot with a live robot link (capture/robot_link.h): the robot
-// says HELLO with its joint names, then SETTLED <pose> <q...> at every
-// pose; kincal grabs --shots pairs taken after the message arrived,
-// averages them, records one pair with the readings and answers DONE.
+// Step and shoot with a live robot link (capture/step_and_shoot.h).
 int RunStepAndShoot(const CaptureArgs& args, capture::FrameSource* left,
                     capture::FrameSource* right, bool live) {
   Require(!args.robot.empty(),
           "capture: --robot-listen needs --robot robot.yaml (joint names)");
   Require(args.joints.empty(),
-          "capture: --joints and --robot-listen exclude "
-          "each other");
-  const Robot robot = ReadRobotYaml(args.robot);
-  const std::vector<std::string> names = robot.JointNames();
-  capture::RobotLink link;
-  Status s = link.Listen(args.robot_listen);
-  if (!s.ok()) {
-    if (s.kind() == Status::Kind::kUnsupported) {
-      throw InputError("capture: --robot-listen: " + s.message());
-    }
-    std::cerr << "kincal: failure: capture: " << s.ToString() << std::endl;
-    return 1;
-  }
-  capture::StereoGrabberOptions options;
-  options.tolerance_s = args.tolerance_ms * 1e-3;
-  capture::StereoGrabber grabber(left, right, options);
-  s = grabber.Open();
+          "capture: --joints and --robot-listen exclude each other");
+  capture::StepAndShootOptions options;
+  options.joint_names = ReadRobotYaml(args.robot).JointNames();
+  options.robot_file = args.robot;
+  options.listen = args.robot_listen;
+  options.shots = args.shots;
+  options.timeout_s = args.robot_timeout;
+  options.out = args.out;
+  options.recorder.png_compression = args.png_compression;
+  options.announce = !args.json;
+  options.interrupted = &g_interrupted;
+  capture::StereoGrabberOptions grab_options;
+  grab_options.tolerance_s = args.tolerance_ms * 1e-3;
+  capture::StereoGrabber grabber(left, right, grab_options);
+  Status s = grabber.Open();
   if (!s.ok()) {
     if (!live && s.kind() == Status::Kind::kNotFound) {
       throw InputError("capture: " + s.message());
@@ -195,55 +166,7 @@ int RunStepAndShoot(const CaptureArgs& args, capture::FrameSource* left,
     std::cerr << "kincal: failure: capture: " << s.ToString() << std::endl;
     return 1;
   }
-  if (!args.json) {
-    std::cerr << "kincal capture: waiting for the robot on port " << link.port()
-              << "\n";
-  }
-  s = link.Accept(args.robot_timeout);
-  if (!s.ok()) {
-    std::cerr << "kincal: failure: capture: " << s.ToString() << std::endl;
-    return 1;
-  }
-  // HELLO: validated before anything is written.
-  std::string line;
-  s = link.ReadLine(args.robot_timeout, &line);
-  if (!s.ok()) {
-    std::cerr << "kincal: failure: capture: " << s.ToString()
-              << " (before HELLO; nothing written)" << std::endl;
-    return 1;
-  }
-  capture::RobotMessage hello;
-  std::string error;
-  if (!capture::ParseRobotMessage(line, -1, &hello, &error) ||
-      hello.kind != capture::RobotMessage::kHello) {
-    if (error.empty()) error = "expected HELLO first, got '" + line + "'";
-    link.WriteLine("ERROR " + error);
-    throw InputError("capture: robot link, line 1: " + error +
-                     " (nothing written)");
-  }
-  std::vector<int> order;  // HELLO position -> robot joint index
-  for (const std::string& n : hello.joints) {
-    const int j = robot.JointIndex(n);
-    if (j < 0 || std::find(order.begin(), order.end(), j) != order.end()) {
-      std::string known;
-      for (const std::string& k : names) known += " " + k;
-      error = "unknown or repeated joint '" + n + "' (" + args.robot +
-              " has:" + known + ")";
-      link.WriteLine("ERROR " + error);
-      throw InputError("capture: robot link HELLO: " + error +
-                       " (nothing written)");
-    }
-    order.push_back(j);
-  }
-  if (order.size() != names.size()) {
-    error = "HELLO names " + std::to_string(order.size()) + " joints, " +
-            args.robot + " has " + std::to_string(names.size());
-    link.WriteLine("ERROR " + error);
-    throw InputError("capture: robot link HELLO: " + error +
-                     " (nothing written)");
-  }
-
-  capture::SessionInfo info;
+  capture::SessionInfo& info = options.info;
   info.left_uri = args.left;
   info.right_uri = args.right;
   info.left_description = left->Describe();
@@ -253,190 +176,40 @@ int RunStepAndShoot(const CaptureArgs& args, capture::FrameSource* left,
   info.tolerance_s =
       grabber.pairing() == capture::StereoGrabber::Pairing::kLockStep
           ? 0.0
-          : options.tolerance_s;
+          : grab_options.tolerance_s;
   info.time_base = capture::TimeBaseName(left->time_base());
-  info.joint_names = names;
-  info.settings["mode"] = "step_and_shoot";
-  info.settings["shots_per_pose"] = std::to_string(args.shots);
-  info.settings["robot"] = hello.name;
   info.settings["png_compression"] = std::to_string(args.png_compression);
-  capture::SessionRecorder::Options rec_options;
-  rec_options.png_compression = args.png_compression;
-  capture::SessionRecorder recorder(rec_options);
-  s = recorder.Open(args.out, info);
-  if (!s.ok()) {
-    link.WriteLine("ERROR cannot create the session");
-    std::cerr << "kincal: failure: capture: " << s.ToString() << std::endl;
-    return 1;
-  }
-  link.WriteLine("OK kincal 1");
 
   InterruptGuard guard;
-  const auto start = std::chrono::steady_clock::now();
-  std::string stop_reason, failure, bad_input;
-  long poses = 0, last_pose = -1;
-  int line_number = 1;
-  std::string stream_csv = "t";
-  for (const std::string& n : names) stream_csv += "," + n;
-  stream_csv += "\n";
-  bool any_stream = false;
-  std::string obs_csv = "# " + CommandLine() + "\npose";
-  for (const std::string& n : names) obs_csv += "," + n;
-  obs_csv += "\n";
-  for (;;) {
-    if (g_interrupted) {
-      stop_reason = "interrupted";
-      break;
-    }
-    // Short reads so Ctrl-C is seen; the total wait is --robot-timeout.
-    double waited = 0;
-    do {
-      s = link.ReadLine(0.25, &line);
-      waited += 0.25;
-    } while (s.kind() == Status::Kind::kTimeout && !g_interrupted &&
-             waited < args.robot_timeout);
-    if (g_interrupted) continue;
-    if (s.kind() == Status::Kind::kTimeout) {
-      failure = "no message from the robot for " +
-                std::to_string(static_cast<int>(args.robot_timeout)) + " s";
-      break;
-    }
-    if (!s.ok()) {
-      failure = "robot link lost after " + std::to_string(poses) +
-                " poses (last pose " + std::to_string(last_pose) +
-                ") without BYE: " + s.message();
-      break;
-    }
-    ++line_number;
-    capture::RobotMessage m;
-    if (!capture::ParseRobotMessage(line, static_cast<int>(names.size()), &m,
-                                    &error)) {
-      bad_input = "robot link, line " + std::to_string(line_number) + " '" +
-                  line + "': " + error;
-      link.WriteLine("ERROR " + error);
-      break;
-    }
-    if (m.kind == capture::RobotMessage::kBye) {
-      stop_reason = "robot_bye";
-      break;
-    }
-    if (m.kind == capture::RobotMessage::kHello) {
-      bad_input = "robot link, line " + std::to_string(line_number) +
-                  ": a second HELLO";
-      link.WriteLine("ERROR a second HELLO");
-      break;
-    }
-    std::vector<double> q(names.size());
-    for (size_t k = 0; k < order.size(); ++k) q[order[k]] = m.values[k];
-    if (m.kind == capture::RobotMessage::kJoints) {
-      char buf[64];
-      std::snprintf(buf, sizeof(buf), "%.6f", m.t);
-      stream_csv += buf;
-      for (double v : q) {
-        std::snprintf(buf, sizeof(buf), ",%.10g", v);
-        stream_csv += buf;
-      }
-      stream_csv += "\n";
-      any_stream = true;
-      continue;
-    }
-    // SETTLED: K pairs taken after the message arrived.
-    timespec now{};
-    ::clock_gettime(CLOCK_MONOTONIC, &now);
-    const double settled_at = now.tv_sec + 1e-9 * now.tv_nsec;
-    std::vector<capture::StereoFrame> shots;
-    while (static_cast<int>(shots.size()) < args.shots) {
-      capture::StereoFrame pair;
-      s = grabber.Grab(&pair);
-      if (!s.ok()) break;
-      if (live && std::max(pair.left.timestamp_s, pair.right.timestamp_s) <
-                      settled_at) {
-        continue;  // taken before the robot had settled
-      }
-      shots.push_back(std::move(pair));
-    }
-    if (!s.ok()) {
-      failure = "grab at pose " + std::to_string(m.pose) + ": " + s.ToString();
-      link.WriteLine("ERROR camera: " + s.message());
-      break;
-    }
-    s = recorder.Write(AveragePairs(shots), q);
-    if (!s.ok()) {
-      failure = "write: " + s.ToString();
-      link.WriteLine("ERROR recording: " + s.message());
-      break;
-    }
-    ++poses;
-    last_pose = m.pose;
-    obs_csv += std::to_string(m.pose);
-    for (double v : q) {
-      char buf[64];
-      std::snprintf(buf, sizeof(buf), ",%.10g", v);
-      obs_csv += buf;
-    }
-    obs_csv += "\n";
-    s = link.WriteLine("DONE " + std::to_string(m.pose) + " " +
-                       std::to_string(shots.size()));
-    if (!s.ok()) {
-      failure = "robot link lost after pose " + std::to_string(m.pose) + ": " +
-                s.message();
-      break;
-    }
-  }
-  link.Close();
-  const double seconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start)
-          .count();
+  const capture::StepAndShootResult r =
+      capture::RunStepAndShoot(&grabber, live, options);
   grabber.Close();
-  // observations.csv beside frames.csv: one row per recorded pose (pose =
-  // the robot's pose number), for `kincal track --obs ... --out-obs`.
-  try {
-    WriteFileAtomic(args.out + "/observations.csv", obs_csv);
-  } catch (const std::exception& e) {
-    if (failure.empty()) failure = e.what();
-  }
-  if (any_stream) {
-    try {
-      WriteFileAtomic(args.out + "/joints.csv", stream_csv);
-    } catch (const std::exception& e) {
-      if (failure.empty()) failure = e.what();
+  if (r.session_created) {
+    if (args.json) {
+      nlohmann::json j;
+      j["out"] = args.out;
+      j["mode"] = "step_and_shoot";
+      j["frames"] = r.frames;
+      j["poses"] = r.poses;
+      j["shots_per_pose"] = args.shots;
+      j["robot"] = r.robot_name;
+      j["joint_stream"] = r.joint_stream;
+      j["seconds"] = r.seconds;
+      j["stop_reason"] = r.stop_reason;
+      j["complete"] = r.complete;
+      PrintJson(j);
+    } else {
+      std::printf(
+          "recorded %ld settled poses (%d pairs averaged each) to %s; "
+          "stopped: %s\n",
+          r.poses, args.shots, args.out.c_str(), r.stop_reason.c_str());
     }
   }
-  capture::SessionSummary summary;
-  summary.complete = failure.empty() && bad_input.empty();
-  summary.stop_reason = !failure.empty()     ? failure
-                        : !bad_input.empty() ? bad_input
-                                             : stop_reason;
-  summary.dropped_left = grabber.dropped_left();
-  summary.dropped_right = grabber.dropped_right();
-  summary.seconds = seconds;
-  const Status fin = recorder.Finalize(summary);
-  if (!fin.ok() && failure.empty()) failure = "finalize: " + fin.ToString();
-  if (args.json) {
-    nlohmann::json j;
-    j["out"] = args.out;
-    j["mode"] = "step_and_shoot";
-    j["frames"] = recorder.frames();
-    j["poses"] = poses;
-    j["shots_per_pose"] = args.shots;
-    j["robot"] = hello.name;
-    j["joint_stream_rows"] = any_stream;
-    j["seconds"] = seconds;
-    j["stop_reason"] = summary.stop_reason;
-    j["complete"] = summary.complete;
-    PrintJson(j);
-  } else {
-    std::printf(
-        "recorded %ld settled poses (%d pairs averaged each) to %s; "
-        "stopped: %s\n",
-        poses, args.shots, args.out.c_str(), summary.stop_reason.c_str());
+  if (r.outcome == capture::StepAndShootResult::kBadInput) {
+    throw InputError("capture: " + r.message);
   }
-  const std::string kept = " (the " + std::to_string(recorder.frames()) +
-                           " poses recorded so far are kept in " + args.out +
-                           ")";
-  if (!bad_input.empty()) throw InputError("capture: " + bad_input + kept);
-  if (!failure.empty()) {
-    std::cerr << "kincal: failure: capture: " << failure << kept << std::endl;
+  if (r.outcome == capture::StepAndShootResult::kFailure) {
+    std::cerr << "kincal: failure: capture: " << r.message << std::endl;
     return 1;
   }
   return 0;
