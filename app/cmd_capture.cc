@@ -22,7 +22,9 @@
 #include "capture/async_recorder.h"
 #include "capture/frame_source.h"
 #include "capture/joint_log.h"
+#include "capture/joint_stream.h"
 #include "capture/recorder.h"
+#include "capture/robot_link.h"
 #include "capture/step_and_shoot.h"
 #include "capture/stereo_grabber.h"
 #include "data/atomic_file.h"
@@ -49,6 +51,7 @@ struct CaptureArgs {
   std::string robot_listen;  // step-and-shoot
   int shots = 5;
   double robot_timeout = 600;
+  bool stream = false;  // --robot-listen with continuous recording
   int writers = 2;
   bool list = false;
   bool json = false;
@@ -249,9 +252,13 @@ int RunCapture(const CaptureArgs& args) {
               " exists and is not empty; kincal never overwrites a session, "
               "choose a new folder");
   const bool live = left->IsLive();
-  if (!args.robot_listen.empty()) {
+  if (!args.robot_listen.empty() && !args.stream) {
     return RunStepAndShoot(args, left.get(), right.get(), live);
   }
+  Require(!args.stream || (!args.robot_listen.empty() && !args.robot.empty() &&
+                           args.joints.empty() && live),
+          "capture: --stream needs --robot-listen, --robot, live cameras (the "
+          "stream is put on the host clock) and no --joints");
 
   capture::StereoGrabberOptions options;
   options.tolerance_s = args.tolerance_ms * 1e-3;
@@ -266,6 +273,40 @@ int RunCapture(const CaptureArgs& args) {
     return 1;
   }
 
+  // Live joint stream: the robot connects and says HELLO before anything
+  // is written (an unknown joint is bad input with nothing on disk).
+  capture::RobotLink link;
+  std::unique_ptr<capture::JointStreamReceiver> stream;
+  if (args.stream) {
+    const std::vector<std::string> names =
+        ReadRobotYaml(args.robot).JointNames();
+    s = link.Listen(args.robot_listen);
+    if (s.kind() == Status::Kind::kUnsupported) {
+      throw InputError("capture: --robot-listen: " + s.message());
+    }
+    if (!args.json && s.ok()) {
+      std::cerr << "kincal capture: waiting for the robot on port "
+                << link.port() << "\n";
+    }
+    if (s.ok()) s = link.Accept(args.robot_timeout);
+    std::vector<int> order;
+    std::string robot_name;
+    if (s.ok()) {
+      s = capture::ReceiveHello(&link, names, args.robot, args.robot_timeout,
+                                &order, &robot_name);
+    }
+    if (s.kind() == Status::Kind::kUnsupported) {
+      throw InputError("capture: " + s.message() + " (nothing written)");
+    }
+    if (!s.ok()) {
+      std::cerr << "kincal: failure: capture: " << s.ToString()
+                << " (nothing written)" << std::endl;
+      return 1;
+    }
+    stream =
+        std::make_unique<capture::JointStreamReceiver>(&link, order, names);
+  }
+
   capture::SessionInfo info;
   info.left_uri = args.left;
   info.right_uri = args.right;
@@ -278,6 +319,7 @@ int RunCapture(const CaptureArgs& args) {
           ? 0.0
           : options.tolerance_s;
   info.time_base = capture::TimeBaseName(left->time_base());
+  if (stream) info.settings["mode"] = "joint_stream";
   if (args.frames > 0) info.settings["frames"] = std::to_string(args.frames);
   if (args.seconds > 0) info.settings["seconds"] = std::to_string(args.seconds);
   info.settings["png_compression"] = std::to_string(args.png_compression);
@@ -293,7 +335,12 @@ int RunCapture(const CaptureArgs& args) {
     return 1;
   }
   if (live && args.frames == 0 && args.seconds == 0 && !args.json) {
-    std::cerr << "kincal capture: recording until Ctrl-C\n";
+    std::cerr << "kincal capture: recording until Ctrl-C"
+              << (stream ? " or the robot's BYE" : "") << "\n";
+  }
+  if (stream) {
+    link.WriteLine("OK kincal 1");
+    stream->Start();
   }
 
   capture::AsyncRecorderOptions async_options;
@@ -324,6 +371,10 @@ int RunCapture(const CaptureArgs& args) {
     }
     if (args.seconds > 0 && elapsed() >= args.seconds) {
       stop_reason = "seconds";
+      break;
+    }
+    if (stream && stream->finished()) {
+      stop_reason = "robot_bye";
       break;
     }
     if (g_interrupted) {
@@ -380,10 +431,23 @@ int RunCapture(const CaptureArgs& args) {
   s = writer.Stop();  // drains the queue
   if (!s.ok() && failure.empty()) failure = "write: " + s.ToString();
   const int64_t dropped_pairs = writer.dropped_pairs();
+  std::string stream_bad_input;
+  if (stream) {
+    stream->Stop();
+    link.Close();
+    const Status st = stream->status();
+    if (st.kind() == Status::Kind::kUnsupported) {
+      stream_bad_input = st.message();
+    } else if (!st.ok() && failure.empty()) {
+      failure = st.message();
+    }
+  }
 
   capture::SessionSummary summary;
-  summary.complete = failure.empty();
-  summary.stop_reason = failure.empty() ? stop_reason : failure;
+  summary.complete = failure.empty() && stream_bad_input.empty();
+  summary.stop_reason = !failure.empty()            ? failure
+                        : !stream_bad_input.empty() ? stream_bad_input
+                                                    : stop_reason;
   summary.dropped_left = grabber.dropped_left();
   summary.dropped_right = grabber.dropped_right();
   summary.dropped_pairs = dropped_pairs;
@@ -427,6 +491,31 @@ int RunCapture(const CaptureArgs& args) {
           {"frames_too_fast", merge.too_fast}};
     } catch (const InputError& e) {
       joint_error = e.what();
+    }
+  }
+  // The live stream: readings on the controller clock, put on the host
+  // clock by the fastest sample; frames outside it get no reading.
+  if (stream && recorder.frames() > 0) {
+    frame_times.resize(recorder.frames());
+    try {
+      const capture::JointLog log = stream->Log();
+      capture::JointMergeOptions merge_options;
+      merge_options.offset_s = stream->OffsetToHost();
+      merge_options.max_speed = args.max_joint_speed;
+      merge_options.uncovered_ok = true;
+      const capture::JointMerge merge =
+          capture::MergeJointLog(log, frame_times, {}, merge_options);
+      s = recorder.SetJointColumns(merge.names, merge.joints);
+      if (!s.ok()) throw InputError("capture: " + s.message());
+      recorder.SetSetting("joints_offset_s", std::to_string(merge.offset_s));
+      recorder.SetSetting("joints_offset", "stream (fastest sample)");
+      joints_json = {{"source", "stream"},
+                     {"samples", log.t.size()},
+                     {"offset_s", merge.offset_s},
+                     {"frames_with_reading", merge.with_reading},
+                     {"frames_too_fast", merge.too_fast}};
+    } catch (const InputError& e) {
+      if (failure.empty() && stream_bad_input.empty()) joint_error = e.what();
     }
   }
   const Status fin = recorder.Finalize(summary);
@@ -476,6 +565,11 @@ int RunCapture(const CaptureArgs& args) {
         static_cast<long long>(grabber.dropped_right()),
         static_cast<long long>(dropped_pairs), summary.stop_reason.c_str(),
         args.out.c_str(), args.out.c_str());
+  }
+  if (!stream_bad_input.empty()) {
+    throw InputError("capture: " + stream_bad_input + " (the " +
+                     std::to_string(recorder.frames()) +
+                     " recorded pairs are kept in " + args.out + ")");
   }
   if (!joint_error.empty()) {
     throw InputError(joint_error + " (the " +
@@ -541,6 +635,9 @@ void AddCaptureCommand(CLI::App& app, Runner* run) {
                   "step-and-shoot: wait for the robot on HOST:PORT (line "
                   "protocol in docs/LAB.md) and record one averaged pair per "
                   "settled pose, with the robot's readings");
+  sub->add_flag("--stream", args->stream,
+                "with --robot-listen: record continuously and fill the "
+                "joint columns from the robot's J lines (until BYE)");
   sub->add_option("--shots", args->shots,
                   "pairs grabbed and averaged per settled pose (default 5)")
       ->check(CLI::Range(1, 1000));

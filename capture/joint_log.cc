@@ -312,8 +312,8 @@ JointMerge MergeJointLog(const JointLog& log,
     merge.stops_matched = matched;
   }
   // Coverage with the chosen offset.
-  if (first - merge.offset_s < log.t.front() - 1e-9 ||
-      last - merge.offset_s > log.t.back() + 1e-9) {
+  if (!options.uncovered_ok && (first - merge.offset_s < log.t.front() - 1e-9 ||
+                                last - merge.offset_s > log.t.back() + 1e-9)) {
     throw InputError(log.source, 0, 0,
                      "the joint log does not cover the session: it spans " +
                          Num(log.t.front() + merge.offset_s) + " .. " +
@@ -325,9 +325,13 @@ JointMerge MergeJointLog(const JointLog& log,
   const double nan = std::numeric_limits<double>::quiet_NaN();
   for (double tf : frame_times) {
     const double x = tf - merge.offset_s;
+    std::vector<double> q(log.names.size(), nan);
+    if (x < log.t.front() || x > log.t.back()) {  // uncovered_ok only
+      merge.joints.push_back(q);
+      continue;
+    }
     const size_t i = Segment(log.t, x);
     const double w = (x - log.t[i]) / (log.t[i + 1] - log.t[i]);
-    std::vector<double> q(log.names.size(), nan);
     if (SpeedAt(log, speeds, x) > options.max_speed) {
       ++merge.too_fast;
     } else {

@@ -47,6 +47,9 @@ struct JointMergeOptions {
   std::optional<double> offset_s;  // t_frame = t_log + offset
   double max_speed = 1.0;          // deg/s | mm/s: faster -> no reading
   double still_speed = 0.2;        // deg/s | mm/s: slower = robot still
+  // Frames outside the log get no reading instead of an error (a live
+  // stream that ended early).
+  bool uncovered_ok = false;
 };
 
 struct JointMerge {

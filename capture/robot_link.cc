@@ -7,6 +7,7 @@
 #include <sys/socket.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <chrono>
 #include <cstring>
@@ -93,6 +94,45 @@ bool ParseRobotMessage(const std::string& line, int num_joints,
   }
   *message = std::move(m);
   return true;
+}
+
+Status ReceiveHello(RobotLink* link, const std::vector<std::string>& names,
+                    const std::string& robot_file, double timeout_s,
+                    std::vector<int>* order, std::string* robot_name) {
+  std::string line, error;
+  Status s = link->ReadLine(timeout_s, &line);
+  if (!s.ok()) {
+    return Status::Error(s.kind(), s.message() + " (before HELLO)");
+  }
+  auto bad = [&](const std::string& what) {
+    link->WriteLine("ERROR " + what);
+    return Status::Error(Status::Kind::kUnsupported,
+                         "robot link HELLO: " + what);
+  };
+  RobotMessage hello;
+  if (!ParseRobotMessage(line, -1, &hello, &error) ||
+      hello.kind != RobotMessage::kHello) {
+    return bad(error.empty() ? "expected HELLO first, got '" + line + "'"
+                             : error);
+  }
+  *robot_name = hello.name;
+  order->clear();
+  for (const std::string& n : hello.joints) {
+    const auto it = std::find(names.begin(), names.end(), n);
+    const int j = it == names.end() ? -1 : static_cast<int>(it - names.begin());
+    if (j < 0 || std::find(order->begin(), order->end(), j) != order->end()) {
+      std::string known;
+      for (const std::string& k : names) known += " " + k;
+      return bad("unknown or repeated joint '" + n + "' (" + robot_file +
+                 " has:" + known + ")");
+    }
+    order->push_back(j);
+  }
+  if (order->size() != names.size()) {
+    return bad("HELLO names " + std::to_string(order->size()) + " joints, " +
+               robot_file + " has " + std::to_string(names.size()));
+  }
+  return Status::Ok();
 }
 
 RobotLink::~RobotLink() {

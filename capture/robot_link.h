@@ -44,6 +44,17 @@ struct RobotMessage {
 bool ParseRobotMessage(const std::string& line, int num_joints,
                        RobotMessage* message, std::string* error);
 
+class RobotLink;
+
+// Reads the robot's first line and checks it is a HELLO naming exactly the
+// joints `names` (any order). On success `order` maps HELLO positions to
+// indices in `names`. A bad HELLO is answered with ERROR and returned as
+// kUnsupported (bad input); link faults keep their kind. `robot_file` is
+// used in messages.
+Status ReceiveHello(RobotLink* link, const std::vector<std::string>& names,
+                    const std::string& robot_file, double timeout_s,
+                    std::vector<int>* order, std::string* robot_name);
+
 // One TCP listening socket and, after Accept, one connection. Not
 // thread-safe. Every call returns a Status (kTimeout, kEndOfStream when the
 // peer closed, kIoError), never throws.

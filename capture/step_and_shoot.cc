@@ -81,49 +81,21 @@ StepAndShootResult RunStepAndShoot(StereoGrabber* grabber, bool live,
   s = link.Accept(options.timeout_s);
   if (!s.ok()) return fail(StepAndShootResult::kFailure, s.ToString());
   // HELLO: validated before anything is written.
-  std::string line, error;
-  s = link.ReadLine(options.timeout_s, &line);
-  if (!s.ok()) {
-    return fail(StepAndShootResult::kFailure,
-                s.ToString() + " (before HELLO; nothing written)");
-  }
-  RobotMessage hello;
-  if (!ParseRobotMessage(line, -1, &hello, &error) ||
-      hello.kind != RobotMessage::kHello) {
-    if (error.empty()) error = "expected HELLO first, got '" + line + "'";
-    link.WriteLine("ERROR " + error);
-    return fail(StepAndShootResult::kBadInput,
-                "robot link, line 1: " + error + " (nothing written)");
-  }
-  result.robot_name = hello.name;
   std::vector<int> order;  // HELLO position -> robot joint index
-  for (const std::string& n : hello.joints) {
-    const auto it = std::find(names.begin(), names.end(), n);
-    const int j = it == names.end() ? -1 : static_cast<int>(it - names.begin());
-    if (j < 0 || std::find(order.begin(), order.end(), j) != order.end()) {
-      std::string known;
-      for (const std::string& k : names) known += " " + k;
-      error = "unknown or repeated joint '" + n + "' (" + options.robot_file +
-              " has:" + known + ")";
-      link.WriteLine("ERROR " + error);
-      return fail(StepAndShootResult::kBadInput,
-                  "robot link HELLO: " + error + " (nothing written)");
-    }
-    order.push_back(j);
-  }
-  if (order.size() != names.size()) {
-    error = "HELLO names " + std::to_string(order.size()) + " joints, " +
-            options.robot_file + " has " + std::to_string(names.size());
-    link.WriteLine("ERROR " + error);
-    return fail(StepAndShootResult::kBadInput,
-                "robot link HELLO: " + error + " (nothing written)");
+  s = ReceiveHello(&link, names, options.robot_file, options.timeout_s, &order,
+                   &result.robot_name);
+  if (!s.ok()) {
+    return fail(s.kind() == Status::Kind::kUnsupported
+                    ? StepAndShootResult::kBadInput
+                    : StepAndShootResult::kFailure,
+                s.message() + " (nothing written)");
   }
 
   SessionInfo info = options.info;
   info.joint_names = names;
   info.settings["mode"] = "step_and_shoot";
   info.settings["shots_per_pose"] = std::to_string(options.shots);
-  info.settings["robot"] = hello.name;
+  info.settings["robot"] = result.robot_name;
   SessionRecorder recorder(options.recorder);
   s = recorder.Open(options.out, info);
   if (!s.ok()) {
@@ -134,7 +106,7 @@ StepAndShootResult RunStepAndShoot(StereoGrabber* grabber, bool live,
   link.WriteLine("OK kincal 1");
 
   const auto start = std::chrono::steady_clock::now();
-  std::string failure, bad_input;
+  std::string line, error, failure, bad_input;
   long last_pose = -1;
   int line_number = 1;
   std::string stream_csv = "t", obs_csv = "# " + CommandLine() + "\npose";

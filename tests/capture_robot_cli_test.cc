@@ -9,10 +9,12 @@
 #include <gtest/gtest.h>
 #include <netinet/in.h>
 #include <sys/socket.h>
+#include <time.h>
 #include <unistd.h>
 #include <yaml-cpp/yaml.h>
 
 #include <chrono>
+#include <cstring>
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <string>
@@ -194,6 +196,102 @@ TEST(CaptureRobotCli, MalformedLineIsBadInputAndKeepsWhatWasRecorded) {
   EXPECT_NE(r.err.find("line 3"), std::string::npos) << r.err;
   EXPECT_EQ(robot.replies.back().rfind("ERROR", 0), 0u);
   EXPECT_EQ(Frames(s.out).size(), 2u);
+}
+
+double HostNow() {
+  timespec ts{};
+  ::clock_gettime(CLOCK_MONOTONIC, &ts);
+  return ts.tv_sec + 1e-9 * ts.tv_nsec;
+}
+
+// A controller streaming J lines at 100 Hz on its own clock (host + 500 s):
+// j1 = 2 deg/s * host time (moves slowly), j2 = 7 (still); then BYE, or a
+// dropped link.
+void StreamingRobot(int port, double seconds, bool bye,
+                    std::vector<std::string>* replies) {
+  int fd = -1;
+  for (int i = 0; i < 200 && fd < 0; ++i) {
+    const int f = ::socket(AF_INET, SOCK_STREAM, 0);
+    sockaddr_in a{};
+    a.sin_family = AF_INET;
+    a.sin_port = htons(port);
+    a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+    if (::connect(f, reinterpret_cast<sockaddr*>(&a), sizeof(a)) == 0) {
+      fd = f;
+    } else {
+      ::close(f);
+      std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    }
+  }
+  if (fd < 0) return;
+  const std::string hello = "HELLO streamer j2 j1\n";
+  ::send(fd, hello.data(), hello.size(), MSG_NOSIGNAL);
+  std::string reply;
+  char c;
+  while (::recv(fd, &c, 1, 0) == 1 && c != '\n') reply.push_back(c);
+  replies->push_back(reply);
+  const double end = HostNow() + seconds;
+  while (HostNow() < end) {
+    const double t = HostNow();
+    char line[128];
+    std::snprintf(line, sizeof(line), "J %.6f 7 %.6f\n", t + 500.0, 2 * t);
+    ::send(fd, line, std::strlen(line), MSG_NOSIGNAL);
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  if (bye) ::send(fd, "BYE\n", 4, MSG_NOSIGNAL);
+  ::close(fd);
+}
+
+RunResult CaptureStream(const Rig& s, double seconds, bool bye,
+                        std::vector<std::string>* replies) {
+  std::thread t([&] { StreamingRobot(s.port, seconds, bye, replies); });
+  const RunResult r = RunKincal(
+      "capture --left 'fake:l?width=320&height=240&fps=30' --right "
+      "'fake:r?width=320&height=240&fps=30' --out " +
+      s.out + " --robot " + s.robot +
+      " --robot-listen 127.0.0.1:" + std::to_string(s.port) +
+      " --stream --max-joint-speed 5 --robot-timeout 20 --json");
+  t.join();
+  return r;
+}
+
+TEST(CaptureRobotCli, LiveJointStreamFillsEveryFrameByTime) {
+  const Rig s = Make("robot_stream");
+  std::vector<std::string> replies;
+  const RunResult r = CaptureStream(s, 2.0, true, &replies);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  ASSERT_FALSE(replies.empty());
+  EXPECT_EQ(replies[0], "OK kincal 1");
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["stop_reason"], "robot_bye");
+  EXPECT_NEAR(j["joints"]["offset_s"].get<double>(), -500.0, 0.01);
+  const auto lines = Frames(s.out);
+  ASSERT_GT(lines.size(), 30u);
+  ASSERT_EQ(lines[0].fields.size(), 7u);
+  int with = 0;
+  for (size_t k = 1; k < lines.size(); ++k) {
+    const auto& f = lines[k].fields;
+    if (f[5].text.empty()) continue;  // before the first / after the last J
+    ++with;
+    const double t_left = std::stod(f[1].text);
+    // 2 deg/s: 0.02 deg = 10 ms of clock error (loopback latency ~0.1 ms).
+    EXPECT_NEAR(std::stod(f[5].text), 2 * t_left, 0.02) << k;
+    EXPECT_DOUBLE_EQ(std::stod(f[6].text), 7.0);
+  }
+  EXPECT_GE(with, static_cast<int>(lines.size()) - 4);
+}
+
+TEST(CaptureRobotCli, LiveJointStreamDroppingKeepsTheSession) {
+  const Rig s = Make("robot_stream_drop");
+  std::vector<std::string> replies;
+  const RunResult r = CaptureStream(s, 1.0, false, &replies);
+  EXPECT_EQ(r.exit_code, 1) << r.err;
+  EXPECT_NE(r.err.find("robot link lost"), std::string::npos) << r.err;
+  const auto lines = Frames(s.out);
+  EXPECT_GT(lines.size(), 10u);
+  EXPECT_EQ(lines[0].fields.size(), 7u);  // readings kept for what came
+  EXPECT_EQ(YAML::LoadFile(s.out + "/session.yaml")["status"].as<std::string>(),
+            "failed");
 }
 
 }  // namespace
