@@ -4,20 +4,33 @@
 
 #include <dirent.h>
 #include <signal.h>
+#include <time.h>
 
+#include <algorithm>
 #include <atomic>
 #include <cerrno>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <iostream>
 #include <memory>
+#include <opencv2/imgproc.hpp>
+#include <optional>
 #include <sstream>
 
 #include "app/command.h"
+#include "capture/async_recorder.h"
 #include "capture/frame_source.h"
+#include "capture/joint_log.h"
+#include "capture/joint_stream.h"
 #include "capture/recorder.h"
+#include "capture/robot_link.h"
+#include "capture/step_and_shoot.h"
 #include "capture/stereo_grabber.h"
+#include "data/atomic_file.h"
 #include "data/error.h"
+#include "data/provenance.h"
+#include "data/robot.h"
 
 namespace kincal::app {
 namespace {
@@ -31,6 +44,15 @@ struct CaptureArgs {
   double tolerance_ms = 10;
   int png_compression = 1;
   int max_failures = 3;
+  int queue_pairs = 32;
+  std::string joints, robot;
+  double joints_offset = NAN;  // NaN: estimate
+  double max_joint_speed = 1.0;
+  std::string robot_listen;  // step-and-shoot
+  int shots = 5;
+  double robot_timeout = 600;
+  bool stream = false;  // --robot-listen with continuous recording
+  int writers = 2;
   bool list = false;
   bool json = false;
 };
@@ -119,6 +141,83 @@ int RunList(const CaptureArgs& args) {
   return 0;
 }
 
+// Step and shoot with a live robot link (capture/step_and_shoot.h).
+int RunStepAndShoot(const CaptureArgs& args, capture::FrameSource* left,
+                    capture::FrameSource* right, bool live) {
+  Require(!args.robot.empty(),
+          "capture: --robot-listen needs --robot robot.yaml (joint names)");
+  Require(args.joints.empty(),
+          "capture: --joints and --robot-listen exclude each other");
+  capture::StepAndShootOptions options;
+  options.joint_names = ReadRobotYaml(args.robot).JointNames();
+  options.robot_file = args.robot;
+  options.listen = args.robot_listen;
+  options.shots = args.shots;
+  options.timeout_s = args.robot_timeout;
+  options.out = args.out;
+  options.recorder.png_compression = args.png_compression;
+  options.announce = !args.json;
+  options.interrupted = &g_interrupted;
+  capture::StereoGrabberOptions grab_options;
+  grab_options.tolerance_s = args.tolerance_ms * 1e-3;
+  capture::StereoGrabber grabber(left, right, grab_options);
+  Status s = grabber.Open();
+  if (!s.ok()) {
+    if (!live && s.kind() == Status::Kind::kNotFound) {
+      throw InputError("capture: " + s.message());
+    }
+    std::cerr << "kincal: failure: capture: " << s.ToString() << std::endl;
+    return 1;
+  }
+  capture::SessionInfo& info = options.info;
+  info.left_uri = args.left;
+  info.right_uri = args.right;
+  info.left_description = left->Describe();
+  info.right_description = right->Describe();
+  info.live = live;
+  info.pairing = capture::PairingName(grabber.pairing());
+  info.tolerance_s =
+      grabber.pairing() == capture::StereoGrabber::Pairing::kLockStep
+          ? 0.0
+          : grab_options.tolerance_s;
+  info.time_base = capture::TimeBaseName(left->time_base());
+  info.settings["png_compression"] = std::to_string(args.png_compression);
+
+  InterruptGuard guard;
+  const capture::StepAndShootResult r =
+      capture::RunStepAndShoot(&grabber, live, options);
+  grabber.Close();
+  if (r.session_created) {
+    if (args.json) {
+      nlohmann::json j;
+      j["out"] = args.out;
+      j["mode"] = "step_and_shoot";
+      j["frames"] = r.frames;
+      j["poses"] = r.poses;
+      j["shots_per_pose"] = args.shots;
+      j["robot"] = r.robot_name;
+      j["joint_stream"] = r.joint_stream;
+      j["seconds"] = r.seconds;
+      j["stop_reason"] = r.stop_reason;
+      j["complete"] = r.complete;
+      PrintJson(j);
+    } else {
+      std::printf(
+          "recorded %ld settled poses (%d pairs averaged each) to %s; "
+          "stopped: %s\n",
+          r.poses, args.shots, args.out.c_str(), r.stop_reason.c_str());
+    }
+  }
+  if (r.outcome == capture::StepAndShootResult::kBadInput) {
+    throw InputError("capture: " + r.message);
+  }
+  if (r.outcome == capture::StepAndShootResult::kFailure) {
+    std::cerr << "kincal: failure: capture: " << r.message << std::endl;
+    return 1;
+  }
+  return 0;
+}
+
 int RunCapture(const CaptureArgs& args) {
   if (args.list) return RunList(args);
   Require(!args.left.empty() && !args.right.empty() && !args.out.empty(),
@@ -136,11 +235,30 @@ int RunCapture(const CaptureArgs& args) {
           "capture: cannot pair a camera with a recording (--left " +
               args.left + ", --right " + args.right +
               "): use two cameras or two recordings");
+  std::optional<capture::JointLog> joint_log;
+  if (!args.joints.empty()) {
+    std::vector<std::string> names;
+    if (!args.robot.empty()) names = ReadRobotYaml(args.robot).JointNames();
+    joint_log = capture::ReadJointLog(args.joints,
+                                      args.robot.empty() ? nullptr : &names);
+  } else {
+    Require((args.robot.empty() || !args.robot_listen.empty()) &&
+                std::isnan(args.joints_offset),
+            "capture: --robot goes with --joints or --robot-listen, "
+            "--joints-offset with --joints");
+  }
   Require(IsAbsentOrEmptyDir(args.out),
           "capture: --out " + args.out +
               " exists and is not empty; kincal never overwrites a session, "
               "choose a new folder");
   const bool live = left->IsLive();
+  if (!args.robot_listen.empty() && !args.stream) {
+    return RunStepAndShoot(args, left.get(), right.get(), live);
+  }
+  Require(!args.stream || (!args.robot_listen.empty() && !args.robot.empty() &&
+                           args.joints.empty() && live),
+          "capture: --stream needs --robot-listen, --robot, live cameras (the "
+          "stream is put on the host clock) and no --joints");
 
   capture::StereoGrabberOptions options;
   options.tolerance_s = args.tolerance_ms * 1e-3;
@@ -155,6 +273,40 @@ int RunCapture(const CaptureArgs& args) {
     return 1;
   }
 
+  // Live joint stream: the robot connects and says HELLO before anything
+  // is written (an unknown joint is bad input with nothing on disk).
+  capture::RobotLink link;
+  std::unique_ptr<capture::JointStreamReceiver> stream;
+  if (args.stream) {
+    const std::vector<std::string> names =
+        ReadRobotYaml(args.robot).JointNames();
+    s = link.Listen(args.robot_listen);
+    if (s.kind() == Status::Kind::kUnsupported) {
+      throw InputError("capture: --robot-listen: " + s.message());
+    }
+    if (!args.json && s.ok()) {
+      std::cerr << "kincal capture: waiting for the robot on port "
+                << link.port() << "\n";
+    }
+    if (s.ok()) s = link.Accept(args.robot_timeout);
+    std::vector<int> order;
+    std::string robot_name;
+    if (s.ok()) {
+      s = capture::ReceiveHello(&link, names, args.robot, args.robot_timeout,
+                                &order, &robot_name);
+    }
+    if (s.kind() == Status::Kind::kUnsupported) {
+      throw InputError("capture: " + s.message() + " (nothing written)");
+    }
+    if (!s.ok()) {
+      std::cerr << "kincal: failure: capture: " << s.ToString()
+                << " (nothing written)" << std::endl;
+      return 1;
+    }
+    stream =
+        std::make_unique<capture::JointStreamReceiver>(&link, order, names);
+  }
+
   capture::SessionInfo info;
   info.left_uri = args.left;
   info.right_uri = args.right;
@@ -167,9 +319,12 @@ int RunCapture(const CaptureArgs& args) {
           ? 0.0
           : options.tolerance_s;
   info.time_base = capture::TimeBaseName(left->time_base());
+  if (stream) info.settings["mode"] = "joint_stream";
   if (args.frames > 0) info.settings["frames"] = std::to_string(args.frames);
   if (args.seconds > 0) info.settings["seconds"] = std::to_string(args.seconds);
   info.settings["png_compression"] = std::to_string(args.png_compression);
+  info.settings["queue_pairs"] = std::to_string(args.queue_pairs);
+  info.settings["writers"] = std::to_string(args.writers);
 
   capture::SessionRecorder::Options rec_options;
   rec_options.png_compression = args.png_compression;
@@ -180,8 +335,22 @@ int RunCapture(const CaptureArgs& args) {
     return 1;
   }
   if (live && args.frames == 0 && args.seconds == 0 && !args.json) {
-    std::cerr << "kincal capture: recording until Ctrl-C\n";
+    std::cerr << "kincal capture: recording until Ctrl-C"
+              << (stream ? " or the robot's BYE" : "") << "\n";
   }
+  if (stream) {
+    link.WriteLine("OK kincal 1");
+    stream->Start();
+  }
+
+  capture::AsyncRecorderOptions async_options;
+  async_options.queue_pairs = args.queue_pairs;
+  async_options.writer_threads = args.writers;
+  async_options.drop_when_full = live;  // a recording can wait
+  capture::AsyncRecorder writer(&recorder, async_options);
+  int64_t accepted = 0;
+  std::vector<double> frame_times, image_motion;
+  cv::Mat previous_small;
 
   InterruptGuard guard;
   const auto start = std::chrono::steady_clock::now();
@@ -196,12 +365,16 @@ int RunCapture(const CaptureArgs& args) {
   int64_t transient_failures = 0;
   capture::StereoFrame pair;
   for (;;) {
-    if (args.frames > 0 && recorder.frames() >= args.frames) {
+    if (args.frames > 0 && accepted >= args.frames) {
       stop_reason = "frames";
       break;
     }
     if (args.seconds > 0 && elapsed() >= args.seconds) {
       stop_reason = "seconds";
+      break;
+    }
+    if (stream && stream->finished()) {
+      stop_reason = "robot_bye";
       break;
     }
     if (g_interrupted) {
@@ -226,25 +399,134 @@ int RunCapture(const CaptureArgs& args) {
       break;
     }
     consecutive_failures = 0;
-    s = recorder.Write(pair);
-    if (!s.ok()) {
-      failure = "write: " + s.ToString();
+    // Image motion (for the joint log's clock offset): mean absolute
+    // change of the left image, about 160 px wide, since the previous pair.
+    double motion = 0, t_left = pair.left.timestamp_s;
+    if (joint_log) {
+      cv::Mat small;
+      const double scale =
+          std::min(1.0, 160.0 / std::max(1, pair.left.image.cols));
+      cv::resize(pair.left.image, small, cv::Size(), scale, scale,
+                 cv::INTER_AREA);
+      if (small.channels() == 3) cv::cvtColor(small, small, cv::COLOR_BGR2GRAY);
+      if (!previous_small.empty()) {
+        cv::Mat diff;
+        cv::absdiff(small, previous_small, diff);
+        motion = cv::mean(diff)[0];
+      }
+      previous_small = small;
+    }
+    // Never waits for the disk: a full queue drops the pair (counted).
+    if (writer.Submit(std::move(pair))) {
+      ++accepted;
+      frame_times.push_back(t_left);
+      image_motion.push_back(motion);
+    } else if (writer.failed()) {
       break;
     }
+    pair = capture::StereoFrame();
   }
   const double seconds = elapsed();
   grabber.Close();
+  s = writer.Stop();  // drains the queue
+  if (!s.ok() && failure.empty()) failure = "write: " + s.ToString();
+  const int64_t dropped_pairs = writer.dropped_pairs();
+  std::string stream_bad_input;
+  if (stream) {
+    stream->Stop();
+    link.Close();
+    const Status st = stream->status();
+    if (st.kind() == Status::Kind::kUnsupported) {
+      stream_bad_input = st.message();
+    } else if (!st.ok() && failure.empty()) {
+      failure = st.message();
+    }
+  }
 
   capture::SessionSummary summary;
-  summary.complete = failure.empty();
-  summary.stop_reason = failure.empty() ? stop_reason : failure;
+  summary.complete = failure.empty() && stream_bad_input.empty();
+  summary.stop_reason = !failure.empty()            ? failure
+                        : !stream_bad_input.empty() ? stream_bad_input
+                                                    : stop_reason;
   summary.dropped_left = grabber.dropped_left();
   summary.dropped_right = grabber.dropped_right();
+  summary.dropped_pairs = dropped_pairs;
   summary.length_mismatch = grabber.length_mismatch();
   summary.seconds = seconds;
+  // Joint readings by time, merged before finalizing. A log that cannot be
+  // merged is bad input: the session is kept without joint columns.
+  std::string joint_error;
+  nlohmann::json joints_json;
+  if (joint_log && recorder.frames() > 0) {
+    frame_times.resize(recorder.frames());
+    image_motion.resize(recorder.frames());
+    if (!image_motion.empty())
+      image_motion[0] = image_motion.size() > 1 ? image_motion[1] : 0.0;
+    capture::JointMergeOptions merge_options;
+    if (!std::isnan(args.joints_offset)) {
+      merge_options.offset_s = args.joints_offset;
+    }
+    merge_options.max_speed = args.max_joint_speed;
+    try {
+      const capture::JointMerge merge = capture::MergeJointLog(
+          *joint_log, frame_times, image_motion, merge_options);
+      s = recorder.SetJointColumns(merge.names, merge.joints);
+      if (!s.ok()) throw InputError("capture: " + s.message());
+      char offset[64];
+      std::snprintf(offset, sizeof(offset), "%.6f", merge.offset_s);
+      recorder.SetSetting("joints_log", args.joints);
+      recorder.SetSetting("joints_offset_s", offset);
+      recorder.SetSetting("joints_offset",
+                          merge.estimated ? "estimated" : "given");
+      recorder.SetSetting("max_joint_speed",
+                          std::to_string(args.max_joint_speed));
+      joints_json = {
+          {"log", args.joints},
+          {"offset_s", merge.offset_s},
+          {"offset_estimated", merge.estimated},
+          {"agreement", merge.estimated ? nlohmann::json(merge.agreement)
+                                        : nlohmann::json()},
+          {"stops_matched", merge.stops_matched},
+          {"frames_with_reading", merge.with_reading},
+          {"frames_too_fast", merge.too_fast}};
+    } catch (const InputError& e) {
+      joint_error = e.what();
+    }
+  }
+  // The live stream: readings on the controller clock, put on the host
+  // clock by the fastest sample; frames outside it get no reading.
+  if (stream && recorder.frames() > 0) {
+    frame_times.resize(recorder.frames());
+    try {
+      const capture::JointLog log = stream->Log();
+      capture::JointMergeOptions merge_options;
+      merge_options.offset_s = stream->OffsetToHost();
+      merge_options.max_speed = args.max_joint_speed;
+      merge_options.uncovered_ok = true;
+      const capture::JointMerge merge =
+          capture::MergeJointLog(log, frame_times, {}, merge_options);
+      s = recorder.SetJointColumns(merge.names, merge.joints);
+      if (!s.ok()) throw InputError("capture: " + s.message());
+      recorder.SetSetting("joints_offset_s", std::to_string(merge.offset_s));
+      recorder.SetSetting("joints_offset", "stream (fastest sample)");
+      joints_json = {{"source", "stream"},
+                     {"samples", log.t.size()},
+                     {"offset_s", merge.offset_s},
+                     {"frames_with_reading", merge.with_reading},
+                     {"frames_too_fast", merge.too_fast}};
+    } catch (const InputError& e) {
+      if (failure.empty() && stream_bad_input.empty()) joint_error = e.what();
+    }
+  }
   const Status fin = recorder.Finalize(summary);
   if (!fin.ok() && failure.empty()) failure = "finalize: " + fin.ToString();
 
+  if (dropped_pairs > 0) {
+    std::cerr << "kincal capture: warning: " << dropped_pairs
+              << " stereo pairs dropped because the disk/encoder was slower "
+                 "than the cameras (lower --png-compression, add --writers, "
+                 "or a faster disk)\n";
+  }
   if (grabber.length_mismatch()) {
     std::cerr << "kincal capture: warning: left and right recordings have "
                  "different lengths; recorded the "
@@ -262,22 +544,38 @@ int RunCapture(const CaptureArgs& args) {
     j["pairing"] = info.pairing;
     j["dropped_left"] = grabber.dropped_left();
     j["dropped_right"] = grabber.dropped_right();
+    j["dropped_pairs"] = dropped_pairs;
+    j["max_queue_depth"] = writer.max_queue_depth();
     j["length_mismatch"] = grabber.length_mismatch();
     j["transient_failures"] = transient_failures;
     j["stop_reason"] = summary.stop_reason;
     j["complete"] = failure.empty();
+    if (!joints_json.is_null()) j["joints"] = joints_json;
     PrintJson(j);
   } else {
     std::printf(
         "recorded %lld stereo pairs in %.2f s (%.1f pairs/s) to %s\n"
-        "pairing: %s, dropped left %lld, right %lld; stopped: %s\n"
+        "pairing: %s, dropped left %lld, right %lld, pairs (disk too slow) "
+        "%lld; stopped: %s\n"
         "track it: kincal track --rig RIG.yaml --target TARGET.yaml "
         "--left '%s/left/*.png' --right '%s/right/*.png' --out points.csv\n",
         static_cast<long long>(recorder.frames()), seconds,
         seconds > 0 ? recorder.frames() / seconds : 0.0, args.out.c_str(),
         info.pairing.c_str(), static_cast<long long>(grabber.dropped_left()),
         static_cast<long long>(grabber.dropped_right()),
-        summary.stop_reason.c_str(), args.out.c_str(), args.out.c_str());
+        static_cast<long long>(dropped_pairs), summary.stop_reason.c_str(),
+        args.out.c_str(), args.out.c_str());
+  }
+  if (!stream_bad_input.empty()) {
+    throw InputError("capture: " + stream_bad_input + " (the " +
+                     std::to_string(recorder.frames()) +
+                     " recorded pairs are kept in " + args.out + ")");
+  }
+  if (!joint_error.empty()) {
+    throw InputError(joint_error + " (the " +
+                     std::to_string(recorder.frames()) +
+                     " recorded pairs are kept in " + args.out +
+                     ", without joint readings)");
   }
   if (!failure.empty()) {
     std::cerr << "kincal: failure: capture: " << failure << " (the "
@@ -321,6 +619,38 @@ void AddCaptureCommand(CLI::App& app, Runner* run) {
                   "live cameras: consecutive timeouts/corrupt frames "
                   "tolerated (default 3)")
       ->check(CLI::Range(0, 1000));
+  sub->add_option("--joints", args->joints,
+                  "controller joint log joints.csv (t, one column per joint) "
+                  "merged into frames.csv by time");
+  sub->add_option("--robot", args->robot,
+                  "robot.yaml: the log's joint columns must be its joints");
+  sub->add_option("--joints-offset", args->joints_offset,
+                  "clock offset, s: t_frame = t_log + offset (default: "
+                  "estimated from when the robot stops)");
+  sub->add_option("--max-joint-speed", args->max_joint_speed,
+                  "frames taken while a joint moves faster (deg/s or mm/s) "
+                  "get no reading (default 1)")
+      ->check(CLI::PositiveNumber);
+  sub->add_option("--robot-listen", args->robot_listen,
+                  "step-and-shoot: wait for the robot on HOST:PORT (line "
+                  "protocol in docs/LAB.md) and record one averaged pair per "
+                  "settled pose, with the robot's readings");
+  sub->add_flag("--stream", args->stream,
+                "with --robot-listen: record continuously and fill the "
+                "joint columns from the robot's J lines (until BYE)");
+  sub->add_option("--shots", args->shots,
+                  "pairs grabbed and averaged per settled pose (default 5)")
+      ->check(CLI::Range(1, 1000));
+  sub->add_option("--robot-timeout", args->robot_timeout,
+                  "seconds to wait for the robot (connect, each message)")
+      ->check(CLI::PositiveNumber);
+  sub->add_option("--queue", args->queue_pairs,
+                  "pairs waiting for the writers; when full, new pairs are "
+                  "dropped and counted (default 32)")
+      ->check(CLI::Range(1, 10000));
+  sub->add_option("--writers", args->writers,
+                  "writer threads encoding PNGs (default 2)")
+      ->check(CLI::Range(1, 64));
   sub->add_flag("--json", args->json, "print one JSON object");
   sub->callback([run, args] { *run = [args] { return RunCapture(*args); }; });
 }

@@ -36,6 +36,7 @@ int main(int argc, char** argv) {
   kincal::app::AddCaptureCommand(app, &run);
   kincal::app::AddExportCommand(app, &run);
   kincal::app::AddReportCommand(app, &run);
+  kincal::app::AddPlanCommand(app, &run);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {

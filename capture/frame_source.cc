@@ -18,6 +18,7 @@ const std::map<std::string, std::set<std::string>>& AllowedKeys() {
        {"exposure_us", "gain", "fps", "format", "buffers", "timeout_ms"}},
       {"folder", {"fps"}},
       {"video", {}},
+      {"fake", {"width", "height", "fps"}},
   };
   return *keys;
 }
@@ -121,18 +122,18 @@ SourceUri ParseSourceUri(const std::string& text) {
   const size_t colon = text.find(':');
   if (colon == std::string::npos || colon == 0) {
     Fail(text,
-         "expected scheme:path with scheme v4l2, aravis, folder or video "
+         "expected scheme:path with scheme v4l2, aravis, folder, video or fake "
          "(e.g. v4l2:/dev/video0, folder:/data/left*.png)");
   }
   uri.scheme = text.substr(0, colon);
   auto allowed = AllowedKeys().find(uri.scheme);
   if (allowed == AllowedKeys().end()) {
     Fail(text, "unknown scheme '" + uri.scheme +
-                   "'; expected v4l2, aravis, folder or video");
+                   "'; expected v4l2, aravis, folder, video or fake");
   }
   std::string rest = text.substr(colon + 1);
   std::string query;
-  if (uri.scheme == "v4l2" || uri.scheme == "aravis") {
+  if (uri.scheme == "v4l2" || uri.scheme == "aravis" || uri.scheme == "fake") {
     const size_t q = rest.find('?');
     if (q != std::string::npos) {
       query = rest.substr(q + 1);
@@ -208,6 +209,10 @@ SourceUri ParseSourceUri(const std::string& text) {
     uri.GetInt("timeout_ms", 2000, 1, 600000);
   } else if (uri.scheme == "folder") {
     uri.GetDouble("fps", 30, 0.001, 1e6);
+  } else if (uri.scheme == "fake") {
+    uri.GetInt("width", 640, 16, 16384);
+    uri.GetInt("height", 480, 16, 16384);
+    uri.GetDouble("fps", 30, 0.1, 1000);
   }
   return uri;
 }
@@ -228,6 +233,7 @@ std::unique_ptr<FrameSource> MakeFrameSource(const SourceUri& uri) {
   }
   if (uri.scheme == "folder") return MakeFolderSource(uri);
   if (uri.scheme == "video") return MakeVideoSource(uri);
+  if (uri.scheme == "fake") return MakeFakeSource(uri);
   Fail(uri.text, "unknown scheme '" + uri.scheme + "'");
 }
 

@@ -92,6 +92,9 @@ std::unique_ptr<FrameSource> MakeV4l2Source(const SourceUri& uri);
 std::unique_ptr<FrameSource> MakeAravisSource(const SourceUri& uri);
 std::unique_ptr<FrameSource> MakeFolderSource(const SourceUri& uri);
 std::unique_ptr<FrameSource> MakeVideoSource(const SourceUri& uri);
+// fake:<name>?width=&height=&fps= (capture/fake_source.cc): a synthetic live
+// camera for tests, benchmarks and the lab procedure without hardware.
+std::unique_ptr<FrameSource> MakeFakeSource(const SourceUri& uri);
 
 // A camera found on this machine.
 struct CameraInfo {

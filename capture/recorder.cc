@@ -13,8 +13,8 @@
 #include <opencv2/imgcodecs.hpp>
 #include <set>
 #include <sstream>
-#include <thread>
 
+#include "capture/png_encode.h"
 #include "data/atomic_file.h"
 #include "data/csv.h"
 #include "data/error.h"
@@ -94,21 +94,11 @@ Status WriteBytes(const std::string& path, const void* data, size_t size) {
 
 Status WritePngAtomic(const std::string& path, const cv::Mat& image,
                       int compression, size_t* bytes) {
-  std::vector<uchar> png;
-  bool encoded = false;
-  try {
-    encoded = !image.empty() &&
-              cv::imencode(".png", image, png,
-                           {cv::IMWRITE_PNG_COMPRESSION, compression});
-  } catch (const cv::Exception& e) {
+  std::vector<uint8_t> png;
+  std::string error;
+  if (!EncodePng(image, compression, &png, &error)) {
     return Status::Error(Status::Kind::kUnsupported,
-                         path + ": cannot encode PNG: " + e.what());
-  }
-  if (!encoded) {
-    return Status::Error(Status::Kind::kUnsupported,
-                         path +
-                             ": cannot encode an empty or non-8/16-bit "
-                             "image as PNG");
+                         path + ": cannot encode PNG: " + error);
   }
   const std::string part = path + ".part";
   Status s = WriteBytes(part, png.data(), png.size());
@@ -208,61 +198,133 @@ Status SessionRecorder::Open(const std::string& dir, const SessionInfo& info) {
 
 Status SessionRecorder::Write(const StereoFrame& pair,
                               const std::vector<double>& joints) {
+  Status s = CheckWrite(frames_, joints);
+  if (!s.ok()) return s;
+  uint64_t bytes = 0;
+  s = WritePairImages(frames_, pair, &bytes);
+  if (!s.ok()) return s;
+  return CommitRow(pair, joints, bytes);
+}
+
+Status SessionRecorder::CheckWrite(int64_t frame,
+                                   const std::vector<double>& joints) const {
   if (!open_) {
     return Status::Error(Status::Kind::kIoError, "recorder not open");
   }
   if (joints.size() != info_.joint_names.size()) {
     return Status::Error(
         Status::Kind::kUnsupported,
-        "frame " + std::to_string(frames_) + ": " +
+        "frame " + std::to_string(frame) + ": " +
             std::to_string(joints.size()) + " joint values for " +
             std::to_string(info_.joint_names.size()) + " joint columns");
   }
-  if (frames_ >= kMaxFrames) {
+  if (frame >= kMaxFrames) {
     return Status::Error(Status::Kind::kUnsupported,
                          "a session holds at most " +
                              std::to_string(kMaxFrames) +
                              " frames (file names must sort in order)");
   }
-  const std::string name = FrameFileName(frames_);
+  return Status::Ok();
+}
+
+Status SessionRecorder::WritePairImages(int64_t frame, const StereoFrame& pair,
+                                        uint64_t* bytes) const {
+  const std::string name = FrameFileName(frame);
   const std::string left = dir_ + "/left/" + name;
   const std::string right = dir_ + "/right/" + name;
-  // PNG encoding dominates; the two sides are encoded on two threads.
   size_t left_bytes = 0, right_bytes = 0;
-  Status left_status;
-  std::thread left_writer([&] {
-    left_status = WritePngAtomic(left, pair.left.image,
-                                 options_.png_compression, &left_bytes);
-  });
-  const Status right_status = WritePngAtomic(
-      right, pair.right.image, options_.png_compression, &right_bytes);
-  left_writer.join();
+  Status left_status = WritePngAtomic(left, pair.left.image,
+                                      options_.png_compression, &left_bytes);
+  Status right_status =
+      left_status.ok() ? WritePngAtomic(right, pair.right.image,
+                                        options_.png_compression, &right_bytes)
+                       : Status::Ok();
   if (!left_status.ok() || !right_status.ok()) {
-    ::unlink(left.c_str());  // never leave half a pair
-    ::unlink(right.c_str());
+    RemovePairImages(frame);  // never leave half a pair
     return left_status.ok() ? right_status : left_status;
   }
+  *bytes = left_bytes + right_bytes;
+  return Status::Ok();
+}
+
+void SessionRecorder::RemovePairImages(int64_t frame) const {
+  const std::string name = FrameFileName(frame);
+  ::unlink((dir_ + "/left/" + name).c_str());
+  ::unlink((dir_ + "/right/" + name).c_str());
+}
+
+Status SessionRecorder::CommitRow(const StereoFrame& pair,
+                                  const std::vector<double>& joints,
+                                  uint64_t bytes) {
+  Status s = CheckWrite(frames_, joints);
+  if (!s.ok()) return s;
   std::string row = std::to_string(frames_) + "," +
                     Fixed(pair.left.timestamp_s, 6) + "," +
                     Fixed(pair.right.timestamp_s, 6) + "," +
                     std::to_string(pair.left.sequence) + "," +
                     std::to_string(pair.right.sequence);
   for (double v : joints) {
-    std::ostringstream os;
-    os.precision(10);
-    os << v;
-    row += "," + os.str();
+    row += ",";
+    if (v == v) {  // NaN = no reading: empty cell
+      std::ostringstream os;
+      os.precision(10);
+      os << v;
+      row += os.str();
+    }
   }
   row += "\n";
   if (std::fputs(row.c_str(), journal_) < 0 || std::fflush(journal_) != 0) {
     const int err = errno;
-    ::unlink(left.c_str());
-    ::unlink(right.c_str());
+    RemovePairImages(frames_);
     return IoError(dir_ + "/frames.csv.part", "write failed", err);
   }
   rows_.push_back(std::move(row));
-  bytes_ += left_bytes + right_bytes;
+  bytes_ += bytes;
   ++frames_;
+  return Status::Ok();
+}
+
+Status SessionRecorder::SetJointColumns(
+    const std::vector<std::string>& names,
+    const std::vector<std::vector<double>>& values) {
+  if (!info_.joint_names.empty()) {
+    return Status::Error(Status::Kind::kUnsupported,
+                         "the session already has joint columns");
+  }
+  if (values.size() != rows_.size()) {
+    return Status::Error(Status::Kind::kUnsupported,
+                         std::to_string(values.size()) + " joint rows for " +
+                             std::to_string(rows_.size()) + " frames");
+  }
+  std::set<std::string> seen = {"frame", "t_left", "t_right", "seq_left",
+                                "seq_right"};
+  for (const std::string& n : names) {
+    if (n.empty() || !seen.insert(n).second) {
+      return Status::Error(
+          Status::Kind::kUnsupported,
+          "joint column '" + n + "' is empty or repeats another column");
+    }
+  }
+  for (size_t r = 0; r < rows_.size(); ++r) {
+    if (values[r].size() != names.size()) {
+      return Status::Error(
+          Status::Kind::kUnsupported,
+          "frame " + std::to_string(r) + ": wrong number of joint values");
+    }
+    std::string& row = rows_[r];
+    row.pop_back();  // "\n"
+    for (double v : values[r]) {
+      row += ",";
+      if (v == v) {
+        std::ostringstream os;
+        os.precision(10);
+        os << v;
+        row += os.str();
+      }
+    }
+    row += "\n";
+  }
+  info_.joint_names = names;
   return Status::Ok();
 }
 
@@ -326,6 +388,7 @@ std::string SessionRecorder::SessionYaml(const SessionSummary* summary) const {
   if (summary != nullptr) {
     y << YAML::Key << "dropped_left" << YAML::Value << summary->dropped_left;
     y << YAML::Key << "dropped_right" << YAML::Value << summary->dropped_right;
+    y << YAML::Key << "dropped_pairs" << YAML::Value << summary->dropped_pairs;
     y << YAML::Key << "length_mismatch" << YAML::Value
       << summary->length_mismatch;
   }

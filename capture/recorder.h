@@ -36,6 +36,7 @@ struct SessionSummary {
   bool complete = true;     // false after a failure
   int64_t dropped_left = 0;
   int64_t dropped_right = 0;
+  int64_t dropped_pairs = 0;  // queue full: disk/encoder slower than cameras
   bool length_mismatch = false;
   double seconds = 0;  // wall time of the recording
 };
@@ -70,8 +71,32 @@ class SessionRecorder {
   // session.yaml (status: recording). DIR must not exist or be empty.
   Status Open(const std::string& dir, const SessionInfo& info);
   // Writes one pair as frame frames(); `joints` has one value per
-  // SessionInfo::joint_names entry (kUnsupported otherwise).
+  // SessionInfo::joint_names entry (kUnsupported otherwise); NaN = no
+  // reading (an empty cell).
   Status Write(const StereoFrame& pair, const std::vector<double>& joints = {});
+
+  // Write in two steps, for writer threads (capture/async_recorder.h):
+  // WritePairImages encodes and writes the two images of frame `frame`
+  // (thread-safe, const: touches only those two files; on failure neither
+  // is left on disk); CommitRow then appends the row of frame frames() to
+  // the journal, whose images must be on disk (one thread, frame order).
+  Status CheckWrite(int64_t frame, const std::vector<double>& joints) const;
+  Status WritePairImages(int64_t frame, const StereoFrame& pair,
+                         uint64_t* bytes) const;
+  Status CommitRow(const StereoFrame& pair, const std::vector<double>& joints,
+                   uint64_t bytes);
+  // Joint readings merged after recording (capture --joints): adds the
+  // columns `names` with one row of values per recorded frame (NaN = no
+  // reading) to the frames.csv that Finalize writes. Only for a session
+  // opened without joint columns.
+  Status SetJointColumns(const std::vector<std::string>& names,
+                         const std::vector<std::vector<double>>& values);
+  // Adds or replaces a `settings` entry of session.yaml.
+  void SetSetting(const std::string& key, const std::string& value) {
+    info_.settings[key] = value;
+  }
+  // Removes frame `frame`'s images (written but never committed).
+  void RemovePairImages(int64_t frame) const;
   // Writes frames.csv and session.yaml (atomically) and removes the journal.
   Status Finalize(const SessionSummary& summary);
 

@@ -5,3 +5,15 @@ kincal_test(e2e_capture_cli_test
 if(TARGET e2e_capture_cli_test)
   add_dependencies(e2e_capture_cli_test kincal)
 endif()
+kincal_test(e2e_capture_joints_cli_test
+  SOURCES ${CMAKE_CURRENT_SOURCE_DIR}/capture_joints_cli_test.cc
+  DEPS kincal_capture nlohmann_json::nlohmann_json)
+if(TARGET e2e_capture_joints_cli_test)
+  add_dependencies(e2e_capture_joints_cli_test kincal)
+endif()
+kincal_test(e2e_capture_robot_cli_test
+  SOURCES ${CMAKE_CURRENT_SOURCE_DIR}/capture_robot_cli_test.cc
+  DEPS kincal_capture nlohmann_json::nlohmann_json)
+if(TARGET e2e_capture_robot_cli_test)
+  add_dependencies(e2e_capture_robot_cli_test kincal)
+endif()

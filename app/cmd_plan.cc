@@ -1,0 +1,217 @@
+// kincal plan: choose the robot poses of a calibration experiment (design of
+// experiments on the identification Jacobian, plan/plan.h).
+
+#include <cmath>
+#include <cstdio>
+#include <memory>
+#include <optional>
+
+#include "app/app_util.h"
+#include "app/command.h"
+#include "camcal/rig.h"
+#include "data/atomic_file.h"
+#include "data/error.h"
+#include "data/urdf.h"
+#include "plan/confirm.h"
+#include "plan/plan.h"
+#include "vision/target.h"
+
+namespace kincal::app {
+namespace {
+
+struct PlanArgs {
+  std::string robot, root, tip, out, random_out, rig, target;
+  std::vector<double> rig_from_base;
+  std::string criterion = "sigma";
+  int confirm = 0;
+  PlanOptions options;
+  bool json = false;
+};
+
+int RunPlan(PlanArgs args) {
+  const Robot robot = ReadRobot(args.robot, args.root, args.tip);
+  if (args.rig.empty() != args.target.empty()) {
+    throw InputError("--rig and --target go together");
+  }
+  std::optional<Rig> rig;
+  std::optional<Target> target;
+  if (!args.rig.empty()) {
+    rig = ReadRigYaml(args.rig);
+    target = ReadTargetYaml(args.target);
+    args.options.rig = &*rig;
+    args.options.target = &*target;
+  }
+  if (!args.rig_from_base.empty()) {
+    if (args.rig_from_base.size() != 6 || args.rig.empty()) {
+      throw InputError(
+          "--rig-from-base: expected 6 numbers (rotation vector in deg, "
+          "translation in mm) together with --rig");
+    }
+    const Eigen::Vector3d w(args.rig_from_base[0], args.rig_from_base[1],
+                            args.rig_from_base[2]);
+    Rigid3 r;
+    if (w.norm() > 0) {
+      r.R = Eigen::AngleAxisd(w.norm() * M_PI / 180, w.normalized())
+                .toRotationMatrix();
+    }
+    r.t = Eigen::Vector3d(args.rig_from_base[3], args.rig_from_base[4],
+                          args.rig_from_base[5]);
+    args.options.rig_from_base = r;
+  }
+  if (args.criterion == "d") {
+    args.options.criterion = PlanOptions::kDOptimal;
+  } else if (args.criterion == "sigma") {
+    args.options.criterion = PlanOptions::kSigma;
+  } else {
+    throw InputError("--criterion: expected 'd' or 'sigma', got '" +
+                     args.criterion + "'");
+  }
+  const PlanResult plan = PlanPoses(robot, args.options);
+  WriteFileAtomic(args.out, FormatPosesCsv(robot, plan.poses));
+  if (!args.random_out.empty()) {
+    WriteFileAtomic(args.random_out, FormatPosesCsv(robot, plan.random_poses));
+  }
+  nlohmann::json sigma = nlohmann::json::object();
+  nlohmann::json random_sigma = nlohmann::json::object();
+  for (size_t k = 0; k < plan.params.size(); ++k) {
+    sigma[plan.params[k].name] = Number(plan.planned.sigma[k]);
+    random_sigma[plan.params[k].name] = Number(plan.random.sigma[k]);
+  }
+  if (args.json) {
+    nlohmann::json j;
+    j["n"] = plan.poses.size();
+    j["out"] = args.out;
+    j["mode"] = args.options.fixed_point ? "fixed_point" : "free";
+    j["criterion"] = args.criterion;
+    j["noise_mm"] = args.options.noise_mm;
+    j["predicted_sigma"] = sigma;
+    j["random_predicted_sigma"] = random_sigma;
+    j["predicted_tip_rms_mm"] = Number(plan.planned.tip_rms_mm);
+    j["random_predicted_tip_rms_mm"] = Number(plan.random.tip_rms_mm);
+    j["sigma_gmean_over_bound"] = Number(plan.planned_sigma_gmean);
+    j["random_sigma_gmean_over_bound"] = Number(plan.random_sigma_gmean);
+    j["sigma_gain"] =
+        Number(plan.random_sigma_gmean / plan.planned_sigma_gmean);
+    j["log_det"] = Number(plan.planned.log_det);
+    j["random_log_det"] = Number(plan.random.log_det);
+    j["joint_travel"] = Number(plan.planned.joint_travel);
+    j["random_joint_travel"] = Number(plan.random.joint_travel);
+    j["unidentifiable"] = plan.unidentifiable;
+    j["candidates"] = plan.feasible_candidates;
+    j["draws"] = plan.draws;
+    j["swaps"] = plan.swaps;
+    if (rig) {
+      const Eigen::AngleAxisd aa(plan.rig_from_base.R);
+      const Eigen::Vector3d w = aa.axis() * aa.angle() * 180 / M_PI;
+      j["rig_from_base"] = {w.x(),
+                            w.y(),
+                            w.z(),
+                            plan.rig_from_base.t.x(),
+                            plan.rig_from_base.t.y(),
+                            plan.rig_from_base.t.z()};
+    }
+    if (args.options.fixed_point) {
+      const Eigen::Vector3d& p = plan.fixed_point_in_base;
+      j["fixed_point_in_base"] = {p.x(), p.y(), p.z()};
+    }
+    if (args.confirm > 0) {
+      ConfirmOptions co;
+      co.repetitions = args.confirm;
+      co.seed = args.options.seed;
+      const ConfirmResult a =
+          ConfirmDesign(robot, plan, plan.poses, args.options, co);
+      const ConfirmResult b =
+          ConfirmDesign(robot, plan, plan.random_poses, args.options, co);
+      nlohmann::json err = nlohmann::json::object();
+      nlohmann::json rerr = nlohmann::json::object();
+      for (size_t k = 0; k < plan.params.size(); ++k) {
+        err[plan.params[k].name] = Number(a.rms_error[k]);
+        rerr[plan.params[k].name] = Number(b.rms_error[k]);
+      }
+      j["confirmed"] = {{"repetitions", args.confirm},
+                        {"rms_error", err},
+                        {"random_rms_error", rerr},
+                        {"tip_rms_mm", Number(a.tip_rms_mm)},
+                        {"random_tip_rms_mm", Number(b.tip_rms_mm)},
+                        {"error_gain", Number(b.error_gmean / a.error_gmean)},
+                        {"failed_fits", a.failed_fits + b.failed_fits}};
+    }
+    j["seconds"] = plan.seconds;
+    PrintJson(j);
+    return 0;
+  }
+  std::printf("kincal plan: %zu poses -> %s (%s, %d feasible candidates)\n",
+              plan.poses.size(), args.out.c_str(),
+              args.options.fixed_point ? "fixed point" : "free",
+              plan.feasible_candidates);
+  std::printf("  %-24s %12s %12s\n", "parameter", "planned", "random");
+  for (size_t k = 0; k < plan.params.size(); ++k) {
+    std::printf("  %-24s %12.5f %12.5f %s\n", plan.params[k].name.c_str(),
+                plan.planned.sigma[k], plan.random.sigma[k],
+                plan.params[k].angle ? "deg" : "mm");
+  }
+  std::printf("  predicted tip RMS %.4f mm (random poses: %.4f mm)\n",
+              plan.planned.tip_rms_mm, plan.random.tip_rms_mm);
+  std::printf(
+      "  sigma geometric mean %.3gx smaller than random; joint travel "
+      "%.2f (random %.2f)\n",
+      plan.random_sigma_gmean / plan.planned_sigma_gmean,
+      plan.planned.joint_travel, plan.random.joint_travel);
+  return 0;
+}
+
+}  // namespace
+
+void AddPlanCommand(CLI::App& app, Runner* run) {
+  auto args = std::make_shared<PlanArgs>();
+  CLI::App* sub = app.add_subcommand(
+      "plan",
+      "Choose N robot poses that best determine the identifiable parameters "
+      "(D-optimal design within joint limits, tags visible when a rig is "
+      "given), ordered for short joint motions");
+  sub->add_option("--robot", args->robot, "robot.yaml or .urdf with limits")
+      ->required();
+  sub->add_option("--root", args->root, "URDF root link");
+  sub->add_option("--tip", args->tip, "URDF tip link");
+  sub->add_option("--n", args->options.n, "number of poses")->required();
+  sub->add_option("--out", args->out, "POSES.csv to write")->required();
+  sub->add_option("--random-out", args->random_out,
+                  "also write the N random feasible poses it compares with");
+  sub->add_option("--rig", args->rig, "rig.yaml (visibility constraint)");
+  sub->add_option("--target", args->target, "target.yaml (with --rig)");
+  sub->add_option("--rig-from-base", args->rig_from_base,
+                  "pose of the robot base in the rig: rx ry rz (rotation "
+                  "vector, deg) tx ty tz (mm); default: the rig is placed "
+                  "looking at the tags")
+      ->expected(6);
+  sub->add_option("--seed", args->options.seed, "random seed");
+  sub->add_option("--candidates", args->options.candidates,
+                  "feasible random candidate poses to choose from")
+      ->check(CLI::Range(2, 100000));
+  sub->add_option("--noise-mm", args->options.noise_mm,
+                  "measurement noise per coordinate, for the predictions")
+      ->check(CLI::PositiveNumber);
+  sub->add_flag("--fixed-point", args->options.fixed_point,
+                "the seed's experiment: tip held at one point, orientations "
+                "varied");
+  sub->add_option("--min-tags", args->options.min_tags,
+                  "tags that must be visible in both cameras")
+      ->check(CLI::Range(1, 1000));
+  sub->add_option("--max-obliquity", args->options.max_obliquity_deg,
+                  "largest angle between a tag's normal and the view ray, deg")
+      ->check(CLI::Range(1.0, 89.0));
+  sub->add_option("--criterion", args->criterion,
+                  "sigma: minimise the product of the robot parameters' "
+                  "predicted sigmas; d: D-optimal (log det)");
+  sub->add_option("--extreme", args->options.extreme_fraction,
+                  "probability that a candidate puts a joint at a limit")
+      ->check(CLI::Range(0.0, 1.0));
+  sub->add_option("--confirm", args->confirm,
+                  "also simulate this many sessions at the planned and at the "
+                  "random poses, calibrate them and report the actual errors")
+      ->check(CLI::Range(0, 1000));
+  sub->add_flag("--json", args->json, "print one JSON object");
+  sub->callback([run, args] { *run = [args] { return RunPlan(*args); }; });
+}
+
+}  // namespace kincal::app
