@@ -23,6 +23,7 @@ void AddCamcalCommand(CLI::App& app, Runner* run);
 void AddTrackCommand(CLI::App& app, Runner* run);
 void AddImportCommand(CLI::App& app, Runner* run);
 void AddCaptureCommand(CLI::App& app, Runner* run);
+void AddBundleCommand(CLI::App& app, Runner* run);
 
 // Prints a result object as one line of JSON on stdout, with the command line
 // and tool version added ("command", "kincal_version").

@@ -34,6 +34,7 @@ int main(int argc, char** argv) {
   kincal::app::AddTrackCommand(app, &run);
   kincal::app::AddImportCommand(app, &run);
   kincal::app::AddCaptureCommand(app, &run);
+  kincal::app::AddBundleCommand(app, &run);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
