@@ -2,6 +2,7 @@
 // session to the robot's parameters (../shared/spec/formats.md v2,
 // docs/BUNDLE.md).
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -54,12 +55,18 @@ ToolPoseResult RefitPose(const Rig& rig, const Target& target,
                          const BundleFrame& f) {
   std::vector<std::vector<TagDetection>> dets(rig.cameras.size());
   std::map<std::pair<int, int>, TagDetection> by_tag;
+  std::map<std::pair<int, int>, int> count;
   for (const BundleCorner& c : f.corners) {
     TagDetection& d = by_tag[{c.camera, c.tag}];
     d.id = target.tags[c.tag].id;
     d.corners[c.corner] = c.px;
+    d.detector_corners[c.corner] = c.px;
+    ++count[{c.camera, c.tag}];
   }
-  for (const auto& [key, d] : by_tag) dets[key.first].push_back(d);
+  // Tags the per-corner check left with 3 corners are left out here.
+  for (const auto& [key, d] : by_tag) {
+    if (count[key] == 4) dets[key.first].push_back(d);
+  }
   return EstimateToolPose(rig, target, dets);
 }
 
@@ -165,6 +172,28 @@ int RunBundleCommand(BundleArgs args) {
                             {"significant", z > 4.0}});
     }
   }
+  // Per-frame reprojection RMS of the final model (the worst frames).
+  std::vector<std::pair<double, int>> frame_rms;
+  for (size_t i = 0; i < obs.frames.size(); ++i) {
+    const BundleFrame& f = obs.frames[i];
+    if (f.corners.empty()) continue;
+    const Rigid3 rt = ModelRigFromTool(r, static_cast<int>(i));
+    double sum = 0;
+    for (const BundleCorner& c : f.corners) {
+      const Camera& cam = r.rig.cameras[c.camera];
+      const Eigen::Vector2d px = Project(
+          cam.intrinsics,
+          cam.cam_from_rig * (rt * target.tags[c.tag].CornerInTool(c.corner)));
+      sum += (px - c.px).squaredNorm();
+    }
+    frame_rms.push_back({std::sqrt(sum / f.corners.size()), f.frame});
+  }
+  std::sort(frame_rms.rbegin(), frame_rms.rend());
+  nlohmann::json worst = nlohmann::json::array();
+  for (size_t k = 0; k < frame_rms.size() && k < 5; ++k) {
+    worst.push_back(
+        {{"frame", frame_rms[k].second}, {"rms_px", frame_rms[k].first}});
+  }
   auto rigid_json = [](const std::array<double, 6>& b) {
     return nlohmann::json{
         {"rotation_vector_deg",
@@ -187,6 +216,7 @@ int RunBundleCommand(BundleArgs args) {
     j["heldout_tip_rms_mm"] = r.heldout_tip_rms_mm;
     j["heldout_tips"] = r.heldout_tips;
     j["sigma0_px"] = r.sigma0_px;
+    j["worst_frames"] = worst;
     j["identifiable"] = r.identifiable;
     j["unidentifiable"] = r.unidentifiable;
     j["params"] = params;

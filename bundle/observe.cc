@@ -84,12 +84,10 @@ SessionObservations ObserveSession(const Session& session, const Rig& rig,
           if (target.tags[k].id == t.tag_id) tag_index = static_cast<int>(k);
         }
         if (tag_index < 0) continue;
-        for (const TagDetection& d : dets[t.camera]) {
-          if (d.id != t.tag_id) continue;
-          for (int k = 0; k < 4; ++k) {
-            f.corners.push_back({t.camera, tag_index, k, d.corners[k]});
+        for (int k = 0; k < 4; ++k) {
+          if (t.corner_used[k]) {
+            f.corners.push_back({t.camera, tag_index, k, t.corners_px[k]});
           }
-          break;
         }
       }
     }

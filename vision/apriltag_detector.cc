@@ -240,25 +240,102 @@ std::vector<TagDetection> AprilTagDetector::DetectInRegion(const cv::Mat& gray,
       t.corners[k] = Eigen::Vector2d(d->p[k][0], d->p[k][1]) + offset;
     }
     t.center = Eigen::Vector2d(d->c[0], d->c[1]) + offset;
+    t.detector_corners = t.corners;
     switch (options_.refinement) {
       case CornerRefinement::kNone:
         break;
       case CornerRefinement::kCornerSubPix:
-        RefineCornersBySubPix(gray, &t);
+        if (RefineCornersBySubPix(gray, &t))
+          t.refined = {true, true, true, true};
         break;
-      case CornerRefinement::kEdges:
-        RefineCornersByEdges(gray, &t);
+      case CornerRefinement::kEdges: {
+        std::array<double, 4> side_rms{};
+        if (RefineCornersByEdges(gray, &t, &side_rms)) {
+          for (int k = 0; k < 4; ++k) {
+            // Corner k joins side k-1 and side k.
+            const bool sides_ok =
+                side_rms[k] <= options_.max_edge_rms_px &&
+                side_rms[(k + 3) % 4] <= options_.max_edge_rms_px;
+            const bool near = (t.corners[k] - t.detector_corners[k]).norm() <=
+                              options_.max_refine_shift_px;
+            t.refined[k] = sides_ok && near;
+            if (!t.refined[k]) t.corners[k] = t.detector_corners[k];
+          }
+        }
         break;
+      }
     }
     out.push_back(t);
   }
   apriltag_detections_destroy(dets);
+  if (options_.refinement == CornerRefinement::kEdges) {
+    RevertCornersNearOtherTags(&out);
+  }
   std::sort(out.begin(), out.end(),
             [](const TagDetection& a, const TagDetection& b) {
               if (a.id != b.id) return a.id < b.id;
               return a.center.x() < b.center.x();
             });
   return out;
+}
+
+namespace {
+double SegmentDistance(const Eigen::Vector2d& p, const Eigen::Vector2d& a,
+                       const Eigen::Vector2d& b) {
+  const Eigen::Vector2d ab = b - a;
+  const double t = std::clamp((p - a).dot(ab) / ab.squaredNorm(), 0.0, 1.0);
+  return (p - (a + t * ab)).norm();
+}
+double SegmentsDistance(const Eigen::Vector2d& a, const Eigen::Vector2d& b,
+                        const Eigen::Vector2d& c, const Eigen::Vector2d& d) {
+  // Segments that cross have distance 0.
+  auto cross = [](const Eigen::Vector2d& u, const Eigen::Vector2d& v) {
+    return u.x() * v.y() - u.y() * v.x();
+  };
+  const double d1 = cross(b - a, c - a), d2 = cross(b - a, d - a);
+  const double d3 = cross(d - c, a - c), d4 = cross(d - c, b - c);
+  if (((d1 > 0) != (d2 > 0)) && ((d3 > 0) != (d4 > 0))) return 0.0;
+  return std::min({SegmentDistance(a, c, d), SegmentDistance(b, c, d),
+                   SegmentDistance(c, a, b), SegmentDistance(d, a, b)});
+}
+}  // namespace
+
+// A side whose sampling reaches another tag's quad (its black square within
+// one cell plus the window of the side) is measured on that tag's edges too:
+// its corners fall back to libapriltag's.
+void RevertCornersNearOtherTags(std::vector<TagDetection>* dets) {
+  std::vector<std::array<bool, 4>> revert(dets->size(),
+                                          {false, false, false, false});
+  for (size_t i = 0; i < dets->size(); ++i) {
+    const auto& c = (*dets)[i].detector_corners;
+    for (int k = 0; k < 4; ++k) {
+      const Eigen::Vector2d& a = c[k];
+      const Eigen::Vector2d& b = c[(k + 1) % 4];
+      const double cell = (b - a).norm() / 8.0;
+      const double reach = 1.5 * cell + 1.0;
+      for (size_t j = 0; j < dets->size(); ++j) {
+        if (j == i) continue;
+        const auto& o = (*dets)[j].detector_corners;
+        for (int m = 0; m < 4 && !revert[i][k]; ++m) {
+          if (SegmentsDistance(a, b, o[m], o[(m + 1) % 4]) < reach) {
+            revert[i][k] = true;
+          }
+        }
+      }
+    }
+  }
+  for (size_t i = 0; i < dets->size(); ++i) {
+    TagDetection& t = (*dets)[i];
+    for (int k = 0; k < 4; ++k) {
+      // Side k runs from corner k to corner k + 1.
+      if (revert[i][k]) {
+        for (int e : {k, (k + 1) % 4}) {
+          t.corners[e] = t.detector_corners[e];
+          t.refined[e] = false;
+        }
+      }
+    }
+  }
 }
 
 // Edge refinement. For each side (corner k to corner k+1) the outward normal
@@ -271,8 +348,10 @@ std::vector<TagDetection> AprilTagDetector::DetectInRegion(const cv::Mat& gray,
 // cell inside and outside the edge. The window is re-centred once. A total
 // least-squares line is fitted to the edge points (3 MAD outliers dropped),
 // and adjacent lines intersect in the new corners.
-bool RefineCornersByEdges(const cv::Mat& gray, TagDetection* det) {
+bool RefineCornersByEdges(const cv::Mat& gray, TagDetection* det,
+                          std::array<double, 4>* side_rms) {
   const auto& c = det->corners;
+  std::array<double, 4> rms_of_side{};
   Eigen::Vector2d centroid = (c[0] + c[1] + c[2] + c[3]) / 4.0;
   std::array<Line2, 4> lines;
   for (int k = 0; k < 4; ++k) {
@@ -345,6 +424,12 @@ bool RefineCornersByEdges(const cv::Mat& gray, TagDetection* det) {
     }
     if (kept.size() < 4) return false;
     if (kept.size() < pts.size()) line = FitLine(kept);
+    double ss = 0;
+    for (const auto& q : kept) {
+      const double r = line.n.dot(q) - line.c;
+      ss += r * r;
+    }
+    rms_of_side[k] = std::sqrt(ss / kept.size());
     lines[k] = line;
   }
   std::array<Eigen::Vector2d, 4> refined;
@@ -354,6 +439,7 @@ bool RefineCornersByEdges(const cv::Mat& gray, TagDetection* det) {
     if ((refined[k] - c[k]).norm() > 3.0) return false;
   }
   det->corners = refined;
+  if (side_rms != nullptr) *side_rms = rms_of_side;
   // Centre: intersection of the diagonals.
   Line2 d0, d1;
   d0.n = Eigen::Vector2d(-(refined[2] - refined[0]).y(),
