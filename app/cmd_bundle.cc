@@ -85,7 +85,17 @@ int RunBundleCommand(BundleArgs args) {
   so.joint_names = robot.JointNames();
   so.require_joint_readings = true;
   const Session session = ReadSession(args.session, so);
-  args.options.extensions = SplitNames(args.extensions);
+  // A cause without a joint ("backlash") stands for that cause at every
+  // joint.
+  for (const std::string& name : SplitNames(args.extensions)) {
+    if (name.find('.') != std::string::npos) {
+      args.options.extensions.push_back(name);
+      continue;
+    }
+    for (const std::string& j : robot.JointNames()) {
+      args.options.extensions.push_back(j + "." + name);
+    }
+  }
 
   ObserveOptions oo;
   if (!args.quiet) {
@@ -172,6 +182,29 @@ int RunBundleCommand(BundleArgs args) {
                             {"significant", z > 4.0}});
     }
   }
+  // Significant extensions, strongest first: what the images name.
+  nlohmann::json findings = nlohmann::json::array();
+  {
+    std::vector<nlohmann::json> sig;
+    for (const auto& e : extensions) {
+      if (e["significant"].get<bool>()) sig.push_back(e);
+    }
+    std::sort(sig.begin(), sig.end(), [](const auto& a, const auto& b) {
+      return a["z"].template get<double>() > b["z"].template get<double>();
+    });
+    for (const auto& e : sig) {
+      const std::string name = e["name"];
+      const size_t dot = name.find('.');
+      findings.push_back(
+          {{"cause", name.substr(dot + 1)},
+           {"joint", name.substr(0, dot)},
+           {"magnitude", e["value"]},
+           {"sigma", e["sigma"]},
+           {"ci95",
+            {e["value"].get<double>() - 1.96 * e["sigma"].get<double>(),
+             e["value"].get<double>() + 1.96 * e["sigma"].get<double>()}}});
+    }
+  }
   // Per-frame reprojection RMS of the final model (the worst frames).
   std::vector<std::pair<double, int>> frame_rms;
   for (size_t i = 0; i < obs.frames.size(); ++i) {
@@ -220,7 +253,10 @@ int RunBundleCommand(BundleArgs args) {
     j["identifiable"] = r.identifiable;
     j["unidentifiable"] = r.unidentifiable;
     j["params"] = params;
-    if (!args.options.extensions.empty()) j["extensions"] = extensions;
+    if (!args.options.extensions.empty()) {
+      j["extensions"] = extensions;
+      j["findings"] = findings;
+    }
     j["rig_from_base"] = rigid_json(r.rig_from_base);
     j["flange_from_target"] = rigid_json(r.flange_from_tool);
     j["refine_cameras"] = args.options.refine_cameras;
@@ -312,7 +348,9 @@ void AddBundleCommand(CLI::App& app, Runner* run) {
       ->capture_default_str();
   sub->add_option("--extensions", args->extensions,
                   "extension parameters to fit with pixel residuals, "
-                  "comma-separated (e.g. j3.backlash,j2.gain)");
+                  "comma-separated (e.g. j3.backlash,j2.gain; a cause alone, "
+                  "e.g. backlash, means every joint); significant ones "
+                  "(|value| > 4 sigma) are listed under findings");
   sub->add_option("--threads", args->options.num_threads, "Ceres threads")
       ->capture_default_str()
       ->check(CLI::Range(1, 64));
