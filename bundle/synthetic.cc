@@ -7,6 +7,7 @@
 #include "calib/evaluate.h"
 #include "data/error.h"
 #include "synth/render.h"
+#include "vision/apriltag_detector.h"
 #include "vision/tool_pose.h"
 
 namespace kincal {
@@ -74,9 +75,10 @@ Target ThreeTagHolder(double s, const std::string& family) {
     tag.id = i;
     tag.size_mm = s;
     // Middle tag flat at the origin; the outer ones hinged at its edges.
-    // Each tag's black square has a white border of one cell (s / 8 for
-    // tag36h11); the printed squares touch along the hinge.
-    const double half = s / 2 + s / 8;  // half printed width
+    // The printed squares (black square, white ring, any outer data ring)
+    // touch along the hinge, but for the gap.
+    const double half = 0.5 * s * TagImage(family, 0).cols /
+                        TagBlackSquareCells(family);  // half printed width
     if (i == 1) {
       tag.tool_from_tag.t = Eigen::Vector3d::Zero();
     } else {

@@ -5,6 +5,7 @@ extern "C" {
 #include <apriltag/tag16h5.h>
 #include <apriltag/tag25h9.h>
 #include <apriltag/tag36h11.h>
+#include <apriltag/tagStandard41h12.h>
 }
 
 #include <algorithm>
@@ -29,6 +30,7 @@ const FamilyFunctions* FindFamily(const std::string& name) {
       {"tag36h11", tag36h11_create, tag36h11_destroy},
       {"tag25h9", tag25h9_create, tag25h9_destroy},
       {"tag16h5", tag16h5_create, tag16h5_destroy},
+      {"tagStandard41h12", tagStandard41h12_create, tagStandard41h12_destroy},
   };
   for (const auto& f : kFamilies) {
     if (name == f.name) return &f;
@@ -36,7 +38,9 @@ const FamilyFunctions* FindFamily(const std::string& name) {
   return nullptr;
 }
 
-std::string KnownFamilies() { return "tag36h11, tag25h9, tag16h5"; }
+std::string KnownFamilies() {
+  return "tag36h11, tag25h9, tag16h5, tagStandard41h12";
+}
 
 // A family instance that destroys itself.
 struct FamilyHandle {
@@ -145,11 +149,14 @@ cv::Mat TagImage(const std::string& family, int id) {
   // As libapriltag's apriltag_to_image (whose image type is not exported):
   // black square of width_at_border cells with a one-cell white ring around
   // it, data bits at (bit_x, bit_y) from the black square's corner, MSB first.
+  // Families with a reversed border (tagStandard41h12) have their white
+  // ring on the detected square itself, with a black ring outside it and
+  // data bits outside that (as libapriltag draws them).
   const apriltag_family_t* fam = f.family;
   const int total = fam->total_width;
   const int start = (total - fam->width_at_border) / 2;
   cv::Mat out(total, total, CV_8UC1, cv::Scalar(0));
-  const int ring = start - 1;
+  const int ring = fam->reversed_border ? start : start - 1;
   for (int i = ring; i < total - ring; ++i) {
     out.at<uint8_t>(ring, i) = 255;
     out.at<uint8_t>(total - 1 - ring, i) = 255;
@@ -364,8 +371,14 @@ bool RefineCornersByEdges(const cv::Mat& gray, TagDetection* det,
     if (n.dot((a + b) / 2 - centroid) < 0) n = -n;
     // Cells across the black square: 8 for tag36h11; the white border is one
     // cell wide. A conservative 8 keeps windows inside one cell for smaller
-    // families too.
-    const double cell = len / 8.0;
+    // families too. The cell across this side is set by the sides that run
+    // across it, which are shorter than this one when the tag is seen
+    // obliquely: the shortest side bounds it.
+    double shortest = len;
+    for (int j = 0; j < 4; ++j) {
+      shortest = std::min(shortest, (c[(j + 1) % 4] - c[j]).norm());
+    }
+    const double cell = shortest / 8.0;
     const double w = std::min(0.45 * cell, 3.0);
     if (w < 0.8) return false;
     const int samples = std::max(6, static_cast<int>(len * 0.8));
@@ -385,7 +398,9 @@ bool RefineCornersByEdges(const cv::Mat& gray, TagDetection* det,
     if (base.size() < 4) return false;
     const double i_dark = Median(dark);
     const double i_bright = Median(bright);
-    if (i_bright - i_dark < 5.0) return false;
+    // Reversed-border families (tagStandard41h12) have the bright side
+    // inside: the area rule only needs the two levels apart.
+    if (std::abs(i_bright - i_dark) < 5.0) return false;
     const double inv = 1.0 / (i_bright - i_dark);
     const double h = 0.25;  // px between profile samples
     const int m = static_cast<int>(std::ceil(w / h));

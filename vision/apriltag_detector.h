@@ -55,11 +55,13 @@ enum class CornerRefinement {
 
 // Detector settings (libapriltag's fields plus the refinement).
 struct AprilTagOptions {
-  std::string family = "tag36h11";  // tag36h11, tag25h9, tag16h5,
-                                    // tagStandard41h12
-  double quad_decimate = 2.0;       // quad search on a decimated image
-  double quad_sigma = 0.8;          // Gaussian blur for the quad search, px
-  bool refine_edges = true;         // libapriltag's own edge snapping
+  // tag36h11, tag25h9, tag16h5, tagStandard41h12 (reversed border: its
+  // detected square is the white one inside the black ring; `size` in
+  // target.yaml is that square's edge, width_at_border = 5 cells).
+  std::string family = "tag36h11";
+  double quad_decimate = 2.0;  // quad search on a decimated image
+  double quad_sigma = 0.8;     // Gaussian blur for the quad search, px
+  bool refine_edges = true;    // libapriltag's own edge snapping
   int nthreads = 1;
   double decode_sharpening = 0.25;
   int max_hamming = 1;  // bits corrected when decoding (0..2)
