@@ -162,9 +162,13 @@ int RunTrack(const TrackArgs& args) {
       "# written by " + ToolVersion() + ": " + CommandLine() + "\n";
   points << header << "frame,x,y,z,reproj_px,tags\n";
   poses << header << "# rig_from_tool: R row-major, t in mm; tip in rig, mm\n"
+        << "# good = 1: the tip passes the quality gate (>= --min-tags tag "
+           "observations, reprojection RMS <= --max-reproj px); a found tip "
+           "with good = 0 is the tracker's best guess, not a measurement\n"
         << "frame,found,r00,r01,r02,r10,r11,r12,r20,r21,r22,tx,ty,tz,"
-           "reproj_px,tags,left_image,right_image\n";
+           "reproj_px,tags,left_image,right_image,good\n";
   int found = 0, merged_count = 0;
+  std::vector<int> failed_gate;  // found, but not good
   std::vector<double> rms_values;
   auto last_progress = start;
   for (size_t f = 0; f < n; ++f) {
@@ -202,6 +206,9 @@ int RunTrack(const TrackArgs& args) {
       rms_values.push_back(r.rms_px);
       for (int i = 0; i < 3; ++i)
         points << "," << FormatDouble(r.tip_in_rig(i));
+      const bool good =
+          r.tags_used >= args.min_tags && r.rms_px <= args.max_reproj_px;
+      if (!good) failed_gate.push_back(static_cast<int>(f));
       points << "," << FormatDouble(r.rms_px) << "," << r.tags_used << "\n";
       for (int i = 0; i < 9; ++i) {
         poses << "," << FormatDouble(r.rig_from_tool.R(i / 3, i % 3));
@@ -214,7 +221,12 @@ int RunTrack(const TrackArgs& args) {
       points << ",,,,,0\n";
       poses << ",,,,,,,,,,,,,,0";
     }
-    poses << "," << CsvQuote(left[f]) << "," << CsvQuote(right[f]) << "\n";
+    poses << "," << CsvQuote(left[f]) << "," << CsvQuote(right[f]) << ","
+          << (r.found && r.tags_used >= args.min_tags &&
+                      r.rms_px <= args.max_reproj_px
+                  ? 1
+                  : 0)
+          << "\n";
     const auto now = std::chrono::steady_clock::now();
     if (!args.quiet && n >= 20 &&
         (now - last_progress > std::chrono::milliseconds(500) || f + 1 == n)) {
@@ -257,6 +269,8 @@ int RunTrack(const TrackArgs& args) {
     nlohmann::json j;
     j["frames"] = n;
     j["found"] = found;
+    j["good"] = found - static_cast<int>(failed_gate.size());
+    j["failed_gate"] = failed_gate;
     j["seconds"] = seconds;
     j["out"] = args.out;
     j["poses"] = poses_path;
@@ -273,6 +287,17 @@ int RunTrack(const TrackArgs& args) {
               found, seconds);
   std::printf("  median reprojection RMS %.3f px; full-frame searches %d/%d\n",
               median_rms, full0, full1);
+  if (!failed_gate.empty()) {
+    std::printf(
+        "  %zu found tips fail the quality gate (< %d tags or > %.2f px; "
+        "good = 0 in %s): frames",
+        failed_gate.size(), args.min_tags, args.max_reproj_px,
+        poses_path.c_str());
+    for (size_t k = 0; k < failed_gate.size() && k < 20; ++k) {
+      std::printf(" %d", failed_gate[k]);
+    }
+    std::printf(failed_gate.size() > 20 ? " ...\n" : "\n");
+  }
   std::printf("  wrote %s and %s\n", args.out.c_str(), poses_path.c_str());
   return 0;
 }

@@ -39,6 +39,10 @@ TEST(RenderPipelineTest, ImagesToCalibratedRobot) {
   const auto track = nlohmann::json::parse(r.out);
   const int found = track["found"].get<int>();
   const int merged = track["merged"].get<int>();
+  // Tips that fail the quality gate are reported (good = 0, failed_gate),
+  // and only good ones are merged.
+  EXPECT_EQ(track["good"].get<int>(), merged);
+  EXPECT_EQ(track["failed_gate"].size(), static_cast<size_t>(found - merged));
   // Tags face away from the cameras in part of the random poses; the merge
   // keeps only well-determined tool poses (>= 2 tags, <= 0.5 px).
   EXPECT_GT(found, 25);
