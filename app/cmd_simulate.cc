@@ -115,6 +115,7 @@ int RunSimulate(SimulateArgs args) {
   Target target = ExampleTarget();
   double rig_distance = 0.0;
   if (args.render) {
+    args.render_options.motion_angle_deg = 30.0;
     args.render_options.Check();
     // Same seed, so the same poses and truth; only the frame is placed.
     std::array<double, 6> rig_from_base;
@@ -314,6 +315,19 @@ void AddSimulateCommand(CLI::App& app, Runner* run) {
       ->capture_default_str();
   sub->add_flag("--render-needle", args->render_options.draw_needle,
                 "draw the needle");
+  sub->add_option("--render-defocus", args->render_options.defocus_px,
+                  "defocus disk radius, px")
+      ->capture_default_str();
+  sub->add_option("--render-motion", args->render_options.motion_px,
+                  "linear motion blur length, px (at 30 deg)")
+      ->capture_default_str();
+  sub->add_option("--render-vignetting", args->render_options.vignetting,
+                  "vignetting: gain 1 - v (r / r_corner)^2")
+      ->capture_default_str();
+  sub->add_option("--render-jpeg", args->render_options.jpeg_quality,
+                  "JPEG-compress the images at this quality (1..100; 0 = "
+                  "lossless)")
+      ->capture_default_str();
   sub->add_flag("--json", args->json, "print a JSON summary");
   sub->callback([run, args] { *run = [args] { return RunSimulate(*args); }; });
 }
