@@ -188,9 +188,12 @@ void ParseSessionFramesCsv(const std::string& text_in, const std::string& file,
                        "frame " + std::to_string(frame) + " appears twice");
     }
     f.frame = static_cast<int>(frame);
+    // Times and sequence numbers may be empty (unknown); anything else in
+    // them must be a number.
     double* times[2] = {&f.t_left, &f.t_right};
     for (int k = 0; k < 2; ++k) {
       const CsvField& c = line.fields[1 + k];
+      if (c.text.empty()) continue;
       if (!ParseFiniteDouble(c.text, times[k])) {
         throw InputError(file, line.line, c.column,
                          std::string(kFixedColumns[1 + k]) +
@@ -201,6 +204,7 @@ void ParseSessionFramesCsv(const std::string& text_in, const std::string& file,
     long long* seqs[2] = {&f.seq_left, &f.seq_right};
     for (int k = 0; k < 2; ++k) {
       const CsvField& c = line.fields[3 + k];
+      if (c.text.empty()) continue;
       if (!ParseInteger(c.text, seqs[k])) {
         throw InputError(file, line.line, c.column,
                          std::string(kFixedColumns[3 + k]) +
@@ -313,6 +317,36 @@ Session ReadSession(const std::string& dir_in,
                        "left/ and right/ with one image per frame)");
     }
     images[k] = ListImages(folder);
+  }
+  // Images named otherwise than by frame number (e.g. frame numbers from 1
+  // but images from 000000): when no row finds an image by its number, and
+  // left/ and right/ hold the same names, one per row, they pair in sorted
+  // order.
+  bool any = false;
+  for (const SessionFrame& f : s.frames) {
+    any = any || FindImage(images[0], f.frame) || FindImage(images[1], f.frame);
+  }
+  bool by_order = false;
+  if (!any && !s.frames.empty() && images[0].size() == s.frames.size() &&
+      images[1].size() == s.frames.size()) {
+    by_order = true;
+    for (auto a = images[0].begin(), b = images[1].begin();
+         a != images[0].end(); ++a, ++b) {
+      by_order = by_order && a->first == b->first;
+    }
+  }
+  if (by_order) {
+    auto a = images[0].begin(), b = images[1].begin();
+    for (SessionFrame& f : s.frames) {
+      f.left_image = (a++)->second;
+      f.right_image = (b++)->second;
+    }
+    if (options.require_joint_readings && s.CountWithJoints() == 0) {
+      throw InputError(s.frames_csv, 0, 0,
+                       "no frame has joint readings (the joint cells are "
+                       "empty in every row)");
+    }
+    return s;
   }
   // Last row with both images (an unfinished session stops there).
   int last_complete = -1;

@@ -14,7 +14,10 @@
 //                            recording, ... (other keys are free-form)
 //
 // Frames pair by name: frame f's images are left/<f as %06d>.<ext> and
-// right/<same name> (a stem equal to the plain number is accepted too). A
+// right/<same name> (a stem equal to the plain number is accepted too; when
+// no row finds its images by number and left/ and right/ hold the same
+// names, one pair per row, rows and sorted names pair in order). Empty
+// t_left/t_right/seq cells mean unknown (0). A
 // session whose status is `recording` or `failed` is read up to its last
 // complete pair: frames.csv.part is used when frames.csv is absent, a
 // truncated last line is ignored, and trailing rows without both images are

@@ -122,6 +122,27 @@ TEST(Session, UnfinishedSessionIsReadUpToItsLastCompletePair) {
   EXPECT_THAT(ErrorOf(dir2, o), HasSubstr("frames.csv:5:"));
 }
 
+TEST(Session, ImagesNamedOtherwisePairInSortedOrder) {
+  const std::string csv =
+      "frame,t_left,t_right,seq_left,seq_right,j1,j2\n"
+      "1,,,,,1,2\n"
+      "2,,,,,3,4\n";
+  const std::string dir = MakeSession("order", csv, 0);
+  for (const char* side : {"/left/", "/right/"}) {
+    Write(dir + side + "img_a.png", "x");
+    Write(dir + side + "img_b.png", "x");
+  }
+  SessionReadOptions o;
+  o.joint_names = {"j1", "j2"};
+  const Session s = ReadSession(dir, o);
+  ASSERT_EQ(s.frames.size(), 2u);
+  EXPECT_EQ(s.frames[1].left_image, dir + "/left/img_b.png");
+  EXPECT_EQ(s.frames[1].q, (std::vector<double>{3, 4}));
+  // Different names in left/ and right/ are frames without pairs.
+  std::filesystem::rename(dir + "/right/img_b.png", dir + "/right/img_c.png");
+  EXPECT_THAT(ErrorOf(dir, o), HasSubstr("no left image"));
+}
+
 TEST(Session, BadCellsAndHeaderAndStatus) {
   SessionReadOptions o;
   o.joint_names = {"j1", "j2"};
