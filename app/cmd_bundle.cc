@@ -15,6 +15,8 @@
 #include "app/command.h"
 #include "bundle/bundle.h"
 #include "bundle/observe.h"
+#include "calib/chain.h"
+#include "calib/model_state.h"
 #include "camcal/rig.h"
 #include "data/atomic_file.h"
 #include "data/error.h"
@@ -92,8 +94,20 @@ int RunBundleCommand(BundleArgs args) {
       args.options.extensions.push_back(name);
       continue;
     }
+    if (name == "axis_tilt") {  // Hayati beta of rows with parallel axes
+      const Chain chain = Chain::FromRobot(robot);
+      for (int row : ParallelAxisRows(chain)) {
+        args.options.extensions.push_back(AxisTiltParam(chain, row).name);
+      }
+      continue;
+    }
     for (const std::string& j : robot.JointNames()) {
-      args.options.extensions.push_back(j + "." + name);
+      if (name == "cyclic") {
+        args.options.extensions.push_back(j + ".cyclic_cos");
+        args.options.extensions.push_back(j + ".cyclic_sin");
+      } else {
+        args.options.extensions.push_back(j + "." + name);
+      }
     }
   }
 
@@ -346,11 +360,13 @@ void AddBundleCommand(CLI::App& app, Runner* run) {
   sub->add_option("--prior-translation", args->options.prior_translation_mm,
                   "prior sigma of the right camera's translation (mm)")
       ->capture_default_str();
-  sub->add_option("--extensions", args->extensions,
-                  "extension parameters to fit with pixel residuals, "
-                  "comma-separated (e.g. j3.backlash,j2.gain; a cause alone, "
-                  "e.g. backlash, means every joint); significant ones "
-                  "(|value| > 4 sigma) are listed under findings");
+  sub->add_option(
+      "--extensions", args->extensions,
+      "extension parameters to fit with pixel residuals, "
+      "comma-separated (e.g. j3.backlash,j2.gain; a cause alone, "
+      "e.g. backlash, gain, compliance, cyclic, axis_tilt, means every "
+      "joint); significant ones "
+      "(|value| > 4 sigma) are listed under findings");
   sub->add_option("--threads", args->options.num_threads, "Ceres threads")
       ->capture_default_str()
       ->check(CLI::Range(1, 64));
