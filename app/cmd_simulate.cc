@@ -8,12 +8,13 @@
 #include "app/app_util.h"
 #include "app/command.h"
 #include "calib/model_state.h"
-#include "synth/simulate.h"
 #include "data/atomic_file.h"
 #include "data/error.h"
 #include "data/provenance.h"
 #include "data/urdf.h"
+#include "synth/recorded_session.h"
 #include "synth/render.h"
+#include "synth/simulate.h"
 
 namespace kincal::app {
 namespace {
@@ -114,6 +115,7 @@ int RunSimulate(SimulateArgs args) {
   Target target = ExampleTarget();
   double rig_distance = 0.0;
   if (args.render) {
+    args.render_options.motion_angle_deg = 30.0;
     args.render_options.Check();
     // Same seed, so the same poses and truth; only the frame is placed.
     std::array<double, 6> rig_from_base;
@@ -190,8 +192,20 @@ int RunSimulate(SimulateArgs args) {
     for (const Eigen::Matrix4d& m : s.base_from_tip) {
       rig_from_tool.push_back(rig_from_base * ToRigid(m) * tip_from_tool);
     }
-    rendered = RenderSession(rig, target, rig_from_tool, args.render_options,
-                             opt.seed, args.out + "/images");
+    // A recorded session (spec layout, joint columns) beside the rig and
+    // target it was seen with.
+    RecordedSessionInput in;
+    in.rig_from_tool = rig_from_tool;
+    in.joint_names = nominal.JointNames();
+    for (const Observation& row : s.observations.rows) {
+      in.joints.push_back(row.q);
+      in.t_s.push_back(row.HasTime() ? row.t_s : 0.0);
+    }
+    if (!s.observations.AnyTime()) in.t_s.clear();
+    rendered = RenderRecordedSession(rig, target, in, args.render_options,
+                                     opt.seed, args.out + "/session");
+    WriteRigYaml(args.out + "/rig.yaml", rig);
+    WriteTargetYaml(args.out + "/target.yaml", target);
   }
   WriteFileAtomic(args.out + "/robot.yaml", robot_text);
   WriteFileAtomic(args.out + "/truth_robot.yaml", truth_robot_text);
@@ -206,7 +220,9 @@ int RunSimulate(SimulateArgs args) {
         {"files",
          {"robot.yaml", "observations.csv", "truth.json", "truth_robot.yaml"}}};
     if (args.render) {
-      j["render"] = {{"folder", args.out + "/images"},
+      j["render"] = {{"session", args.out + "/session"},
+                     {"rig", args.out + "/rig.yaml"},
+                     {"target", args.out + "/target.yaml"},
                      {"frames", rendered},
                      {"rig_distance_mm", rig_distance},
                      {"tag_size_mm", target.tags.at(0).size_mm}};
@@ -218,15 +234,17 @@ int RunSimulate(SimulateArgs args) {
               << "/ (robot.yaml, observations.csv, truth.json)\n";
     if (args.render) {
       std::cout << "rendered " << rendered << " stereo pairs into " << args.out
-                << "/images/ (rig " << rig_distance
-                << " mm from the workspace centre); track them with\n  kincal "
-                   "track --rig "
-                << args.out << "/images/rig.yaml --target " << args.out
-                << "/images/target.yaml --left '" << args.out
-                << "/images/left_*.png' --right '" << args.out
-                << "/images/right_*.png' --out points.csv --obs " << args.out
-                << "/observations.csv --robot " << args.out
-                << "/robot.yaml --out-obs tracked.csv\n";
+                << "/session/ (rig " << rig_distance
+                << " mm from the workspace centre); calibrate from them with\n"
+                << "  kincal bundle --robot " << args.out
+                << "/robot.yaml --rig " << args.out << "/rig.yaml --target "
+                << args.out << "/target.yaml --session " << args.out
+                << "/session --out cal.yaml --out-obs tracked.csv\n"
+                << "or track them with\n  kincal track --rig " << args.out
+                << "/rig.yaml --target " << args.out
+                << "/target.yaml --session " << args.out << "/session --robot "
+                << args.out
+                << "/robot.yaml --out points.csv --out-obs tracked.csv\n";
     }
   }
   return 0;
@@ -279,7 +297,9 @@ void AddSimulateCommand(CLI::App& app, Runner* run) {
   sub->add_flag("--render", args->render,
                 "also render stereo images of a tagged tool at every pose "
                 "(the rig is placed to see the workspace; its frame is the "
-                "measuring frame); into OUT/images");
+                "measuring frame): a recorded session OUT/session (left/, "
+                "right/, frames.csv with joint columns, session.yaml) and "
+                "OUT/rig.yaml, OUT/target.yaml");
   sub->add_option("--render-width", args->render_width, "image width, px")
       ->capture_default_str();
   sub->add_option("--render-height", args->render_height, "image height, px")
@@ -295,6 +315,19 @@ void AddSimulateCommand(CLI::App& app, Runner* run) {
       ->capture_default_str();
   sub->add_flag("--render-needle", args->render_options.draw_needle,
                 "draw the needle");
+  sub->add_option("--render-defocus", args->render_options.defocus_px,
+                  "defocus disk radius, px")
+      ->capture_default_str();
+  sub->add_option("--render-motion", args->render_options.motion_px,
+                  "linear motion blur length, px (at 30 deg)")
+      ->capture_default_str();
+  sub->add_option("--render-vignetting", args->render_options.vignetting,
+                  "vignetting: gain 1 - v (r / r_corner)^2")
+      ->capture_default_str();
+  sub->add_option("--render-jpeg", args->render_options.jpeg_quality,
+                  "JPEG-compress the images at this quality (1..100; 0 = "
+                  "lossless)")
+      ->capture_default_str();
   sub->add_flag("--json", args->json, "print a JSON summary");
   sub->callback([run, args] { *run = [args] { return RunSimulate(*args); }; });
 }

@@ -17,6 +17,7 @@
 #include "data/glob.h"
 #include "data/observations.h"
 #include "data/provenance.h"
+#include "data/session.h"
 #include "data/urdf.h"
 #include "data/yaml_util.h"
 #include "vision/target.h"
@@ -28,6 +29,8 @@ namespace {
 
 struct TrackArgs {
   std::string rig, target, left, right, out;
+  // A recorded session folder instead of --left/--right (data/session.h).
+  std::string session;
   // Optional: joint readings of the same frames (one row per frame pair, in
   // order) to merge with the tracked tips into observations for calibrate.
   std::string obs, robot, out_obs;
@@ -71,9 +74,34 @@ int RunTrack(const TrackArgs& args) {
     throw InputError(args.rig + ": track needs a stereo rig (2 cameras), got " +
                      std::to_string(rig.cameras.size()));
   }
-  const std::vector<std::string> left = GlobSortedOrThrow(args.left, "--left");
-  const std::vector<std::string> right =
-      GlobSortedOrThrow(args.right, "--right");
+  std::vector<std::string> left, right;
+  Session session;
+  if (!args.session.empty()) {
+    if (!args.left.empty() || !args.right.empty()) {
+      throw InputError(
+          "--session replaces --left/--right; give one or the "
+          "other");
+    }
+    SessionReadOptions so;
+    if (!args.robot.empty() && args.obs.empty()) {
+      so.joint_names = ReadRobot(args.robot).JointNames();
+      so.require_joint_readings = !args.out_obs.empty();
+    }
+    session = ReadSession(args.session, so);
+    for (const SessionFrame& f : session.frames) {
+      left.push_back(f.left_image);
+      right.push_back(f.right_image);
+    }
+    if (left.empty()) {
+      throw InputError(args.session + ": the session has no complete frame");
+    }
+  } else {
+    if (args.left.empty() || args.right.empty()) {
+      throw InputError("give --left and --right (image globs) or --session");
+    }
+    left = GlobSortedOrThrow(args.left, "--left");
+    right = GlobSortedOrThrow(args.right, "--right");
+  }
   if (left.size() != right.size()) {
     throw InputError("--left matches " + std::to_string(left.size()) +
                      " images but --right matches " +
@@ -81,7 +109,30 @@ int RunTrack(const TrackArgs& args) {
   }
   // Validate the merge inputs before any work, so bad input writes nothing.
   Observations merged;
-  if (!args.obs.empty() || !args.out_obs.empty()) {
+  // merged row of each frame pair, -1 = none (session frames without joint
+  // readings).
+  std::vector<int> merged_row(left.size(), -1);
+  if (!args.session.empty() && args.obs.empty() &&
+      (!args.robot.empty() || !args.out_obs.empty())) {
+    if (args.robot.empty() || args.out_obs.empty()) {
+      throw InputError(
+          "--robot and --out-obs go together (with --session: merge tracked "
+          "tips into the session's joint readings)");
+    }
+    merged.source = session.frames_csv;
+    merged.joint_names = ReadRobot(args.robot).JointNames();
+    for (size_t f = 0; f < session.frames.size(); ++f) {
+      const SessionFrame& sf = session.frames[f];
+      if (!sf.HasJoints()) continue;
+      Observation o;
+      o.pose = std::to_string(sf.frame);
+      o.q = sf.q;
+      o.t_s = sf.t_left;
+      o.line = sf.line;
+      merged_row[f] = static_cast<int>(merged.rows.size());
+      merged.rows.push_back(o);
+    }
+  } else if (!args.obs.empty() || !args.out_obs.empty()) {
     if (args.obs.empty() || args.robot.empty() || args.out_obs.empty()) {
       throw InputError(
           "--obs, --robot and --out-obs go together (merge tracked tips "
@@ -93,6 +144,8 @@ int RunTrack(const TrackArgs& args) {
                        " observation rows but " + std::to_string(left.size()) +
                        " frame pairs; rows must match frames in order");
     }
+    for (size_t f = 0; f < left.size(); ++f)
+      merged_row[f] = static_cast<int>(f);
   }
   TrackerOptions topt;
   topt.detector.family = target.family;
@@ -109,9 +162,13 @@ int RunTrack(const TrackArgs& args) {
       "# written by " + ToolVersion() + ": " + CommandLine() + "\n";
   points << header << "frame,x,y,z,reproj_px,tags\n";
   poses << header << "# rig_from_tool: R row-major, t in mm; tip in rig, mm\n"
+        << "# good = 1: the tip passes the quality gate (>= --min-tags tag "
+           "observations, reprojection RMS <= --max-reproj px); a found tip "
+           "with good = 0 is the tracker's best guess, not a measurement\n"
         << "frame,found,r00,r01,r02,r10,r11,r12,r20,r21,r22,tx,ty,tz,"
-           "reproj_px,tags,left_image,right_image\n";
+           "reproj_px,tags,left_image,right_image,good\n";
   int found = 0, merged_count = 0;
+  std::vector<int> failed_gate;  // found, but not good
   std::vector<double> rms_values;
   auto last_progress = start;
   for (size_t f = 0; f < n; ++f) {
@@ -136,11 +193,12 @@ int RunTrack(const TrackArgs& args) {
     const ToolPoseResult r = EstimateToolPose(rig, target, dets);
     points << f;
     poses << f << "," << (r.found ? 1 : 0);
-    if (!merged.rows.empty()) {
+    if (merged_row[f] >= 0) {
+      Observation& row = merged.rows[merged_row[f]];
       const bool good = r.found && r.tags_used >= args.min_tags &&
                         r.rms_px <= args.max_reproj_px;
-      merged.rows[f].has_point = good;
-      if (good) merged.rows[f].p_in_meas = r.tip_in_rig;
+      row.has_point = good;
+      if (good) row.p_in_meas = r.tip_in_rig;
       merged_count += good ? 1 : 0;
     }
     if (r.found) {
@@ -148,6 +206,9 @@ int RunTrack(const TrackArgs& args) {
       rms_values.push_back(r.rms_px);
       for (int i = 0; i < 3; ++i)
         points << "," << FormatDouble(r.tip_in_rig(i));
+      const bool good =
+          r.tags_used >= args.min_tags && r.rms_px <= args.max_reproj_px;
+      if (!good) failed_gate.push_back(static_cast<int>(f));
       points << "," << FormatDouble(r.rms_px) << "," << r.tags_used << "\n";
       for (int i = 0; i < 9; ++i) {
         poses << "," << FormatDouble(r.rig_from_tool.R(i / 3, i % 3));
@@ -160,7 +221,12 @@ int RunTrack(const TrackArgs& args) {
       points << ",,,,,0\n";
       poses << ",,,,,,,,,,,,,,0";
     }
-    poses << "," << CsvQuote(left[f]) << "," << CsvQuote(right[f]) << "\n";
+    poses << "," << CsvQuote(left[f]) << "," << CsvQuote(right[f]) << ","
+          << (r.found && r.tags_used >= args.min_tags &&
+                      r.rms_px <= args.max_reproj_px
+                  ? 1
+                  : 0)
+          << "\n";
     const auto now = std::chrono::steady_clock::now();
     if (!args.quiet && n >= 20 &&
         (now - last_progress > std::chrono::milliseconds(500) || f + 1 == n)) {
@@ -179,7 +245,7 @@ int RunTrack(const TrackArgs& args) {
   if (!merged.rows.empty()) {
     WriteFileAtomic(args.out_obs,
                     FormatObservationsCsv(
-                        merged, {"joint readings from " + args.obs +
+                        merged, {"joint readings from " + merged.source +
                                  "; x,y,z = needle tip tracked in the rig "
                                  "frame (empty where the tool was not found, "
                                  "or seen with fewer than " +
@@ -203,6 +269,8 @@ int RunTrack(const TrackArgs& args) {
     nlohmann::json j;
     j["frames"] = n;
     j["found"] = found;
+    j["good"] = found - static_cast<int>(failed_gate.size());
+    j["failed_gate"] = failed_gate;
     j["seconds"] = seconds;
     j["out"] = args.out;
     j["poses"] = poses_path;
@@ -219,6 +287,17 @@ int RunTrack(const TrackArgs& args) {
               found, seconds);
   std::printf("  median reprojection RMS %.3f px; full-frame searches %d/%d\n",
               median_rms, full0, full1);
+  if (!failed_gate.empty()) {
+    std::printf(
+        "  %zu found tips fail the quality gate (< %d tags or > %.2f px; "
+        "good = 0 in %s): frames",
+        failed_gate.size(), args.min_tags, args.max_reproj_px,
+        poses_path.c_str());
+    for (size_t k = 0; k < failed_gate.size() && k < 20; ++k) {
+      std::printf(" %d", failed_gate[k]);
+    }
+    std::printf(failed_gate.size() > 20 ? " ...\n" : "\n");
+  }
   std::printf("  wrote %s and %s\n", args.out.c_str(), poses_path.c_str());
   return 0;
 }
@@ -233,10 +312,12 @@ void AddTrackCommand(CLI::App& app, Runner* run) {
       "tool's AprilTags (writes points.csv and <out>.poses.csv)");
   sub->add_option("--rig", args->rig, "rig.yaml (2 cameras)")->required();
   sub->add_option("--target", args->target, "target.yaml")->required();
-  sub->add_option("--left", args->left, "left images, a glob (quote it)")
-      ->required();
-  sub->add_option("--right", args->right, "right images, a glob (quote it)")
-      ->required();
+  sub->add_option("--left", args->left, "left images, a glob (quote it)");
+  sub->add_option("--right", args->right, "right images, a glob (quote it)");
+  sub->add_option("--session", args->session,
+                  "a recorded session folder (left/, right/, frames.csv, "
+                  "session.yaml) instead of --left/--right; with --robot and "
+                  "--out-obs its joint columns are merged with the tips");
   sub->add_option("--out", args->out, "points.csv to write")->required();
   sub->add_option("--decimate", args->decimate,
                   "libapriltag quad_decimate (default 2)")

@@ -37,6 +37,7 @@ int main(int argc, char** argv) {
   kincal::app::AddExportCommand(app, &run);
   kincal::app::AddReportCommand(app, &run);
   kincal::app::AddPlanCommand(app, &run);
+  kincal::app::AddBundleCommand(app, &run);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {

@@ -121,6 +121,12 @@ void RenderOptions::Check() const {
   in_range("exposure_jitter", exposure_jitter, 0, 0.5);
   in_range("needle_radius_mm", needle_radius_mm, 0, 100);
   in_range("needle_gray", needle_gray, 0, 255);
+  in_range("defocus_px", defocus_px, 0, 20);
+  in_range("motion_px", motion_px, 0, 50);
+  in_range("motion_angle_deg", motion_angle_deg, -360, 360);
+  in_range("vignetting", vignetting, 0, 0.9);
+  in_range("light_gradient", light_gradient, -1, 1);
+  in_range("jpeg_quality", jpeg_quality, 0, 100);
 }
 
 TexturedPlane TagPlane(const std::string& family, int id, double size_mm,
@@ -372,6 +378,63 @@ cv::Mat ViewRenderer::Render(const std::vector<TexturedPlane>& planes,
     gain = std::clamp(g(*rng), 0.5, 1.5);
   }
   radiance *= gain;
+  if (options.vignetting > 0 || options.light_gradient != 0) {
+    const double cx = 0.5 * (width_ - 1), cy = 0.5 * (height_ - 1);
+    const double r2max = cx * cx + cy * cy;
+    for (int y = 0; y < height_; ++y) {
+      double* row = radiance.ptr<double>(y);
+      for (int x = 0; x < width_; ++x) {
+        const double r2 = (x - cx) * (x - cx) + (y - cy) * (y - cy);
+        row[x] *= (1.0 - options.vignetting * r2 / r2max) *
+                  (1.0 + options.light_gradient *
+                             (static_cast<double>(x) / width_ - 0.5));
+      }
+    }
+  }
+  if (options.defocus_px > 0) {
+    // Disk of radius R, anti-aliased by 8x8 supersampling per kernel cell.
+    const double R = options.defocus_px;
+    const int h = static_cast<int>(std::ceil(R));
+    cv::Mat k(2 * h + 1, 2 * h + 1, CV_64FC1, cv::Scalar(0));
+    for (int y = -h; y <= h; ++y) {
+      for (int x = -h; x <= h; ++x) {
+        int in = 0;
+        for (int sy = 0; sy < 8; ++sy) {
+          for (int sx = 0; sx < 8; ++sx) {
+            const double px = x - 0.5 + (sx + 0.5) / 8;
+            const double py = y - 0.5 + (sy + 0.5) / 8;
+            in += px * px + py * py <= R * R ? 1 : 0;
+          }
+        }
+        k.at<double>(y + h, x + h) = in;
+      }
+    }
+    k /= cv::sum(k)[0];
+    cv::filter2D(radiance, radiance, -1, k, cv::Point(-1, -1), 0,
+                 cv::BORDER_REPLICATE);
+  }
+  if (options.motion_px > 0) {
+    // A line segment of length L (box profile), drawn with 32 samples per px.
+    const double L = options.motion_px;
+    const double a = options.motion_angle_deg * M_PI / 180.0;
+    const int h = static_cast<int>(std::ceil(L / 2)) + 1;
+    cv::Mat k(2 * h + 1, 2 * h + 1, CV_64FC1, cv::Scalar(0));
+    const int n = std::max(2, static_cast<int>(32 * L));
+    for (int i = 0; i < n; ++i) {
+      const double t = (i + 0.5) / n - 0.5;
+      const double x = t * L * std::cos(a) + h, y = t * L * std::sin(a) + h;
+      const int x0 = static_cast<int>(std::floor(x)),
+                y0 = static_cast<int>(std::floor(y));
+      const double fx = x - x0, fy = y - y0;
+      k.at<double>(y0, x0) += (1 - fx) * (1 - fy);
+      k.at<double>(y0, x0 + 1) += fx * (1 - fy);
+      k.at<double>(y0 + 1, x0) += (1 - fx) * fy;
+      k.at<double>(y0 + 1, x0 + 1) += fx * fy;
+    }
+    k /= cv::sum(k)[0];
+    cv::filter2D(radiance, radiance, -1, k, cv::Point(-1, -1), 0,
+                 cv::BORDER_REPLICATE);
+  }
   if (options.blur_sigma_px > 0) {
     cv::GaussianBlur(radiance, radiance, cv::Size(0, 0), options.blur_sigma_px,
                      options.blur_sigma_px, cv::BORDER_REPLICATE);
@@ -385,6 +448,12 @@ cv::Mat ViewRenderer::Render(const std::vector<TexturedPlane>& planes,
   }
   cv::Mat out;
   radiance.convertTo(out, CV_8UC1);  // rounds and saturates
+  if (options.jpeg_quality > 0) {
+    std::vector<uchar> buf;
+    cv::imencode(".jpg", out, buf,
+                 {cv::IMWRITE_JPEG_QUALITY, options.jpeg_quality});
+    out = cv::imdecode(buf, cv::IMREAD_GRAYSCALE);
+  }
   return out;
 }
 

@@ -63,6 +63,18 @@ struct RenderOptions {
   // Exposure: gain drawn per image from N(1, exposure_jitter), clamped to
   // [0.5, 1.5], applied to all gray levels.
   double exposure_jitter = 0.0;
+  // Optics and sensor beyond the Gaussian blur, so that tests do not share
+  // the tracker's assumptions: a defocus disk (radius, px), a linear motion
+  // blur (length, px, along motion_angle_deg from the image x axis),
+  // vignetting (gain 1 - vignetting * (r / r_corner)^2), a horizontal light
+  // gradient (gain 1 + light_gradient * (x / width - 0.5)), and JPEG
+  // compression of the 8-bit image (quality 1..100, 0 = lossless).
+  double defocus_px = 0.0;
+  double motion_px = 0.0;
+  double motion_angle_deg = 0.0;
+  double vignetting = 0.0;
+  double light_gradient = 0.0;
+  int jpeg_quality = 0;
   // The needle: a cylinder from needle_base_in_tool to the target's tip.
   bool draw_needle = false;
   Eigen::Vector3d needle_base_in_tool = Eigen::Vector3d::Zero();

@@ -30,17 +30,19 @@ TEST(RenderPipelineTest, ImagesToCalibratedRobot) {
   ASSERT_EQ(sim["render"]["frames"].get<int>(), 90);
   const double distance = sim["render"]["rig_distance_mm"].get<double>();
 
-  const std::string img = dir + "/s/images";
-  r = RunKincal("track --rig " + img + "/rig.yaml --target " + img +
-                "/target.yaml --left '" + img + "/left_*.png' --right '" + img +
-                "/right_*.png' --out " + dir + "/points.csv --obs " + dir +
-                "/s/observations.csv --robot " + dir +
-                "/s/robot.yaml --out-obs " + dir +
-                "/tracked.csv --json --quiet");
+  // The recorded session's joint columns are merged with the tracked tips.
+  r = RunKincal("track --rig " + dir + "/s/rig.yaml --target " + dir +
+                "/s/target.yaml --session " + dir + "/s/session --out " + dir +
+                "/points.csv --robot " + dir + "/s/robot.yaml --out-obs " +
+                dir + "/tracked.csv --json --quiet");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const auto track = nlohmann::json::parse(r.out);
   const int found = track["found"].get<int>();
   const int merged = track["merged"].get<int>();
+  // Tips that fail the quality gate are reported (good = 0, failed_gate),
+  // and only good ones are merged.
+  EXPECT_EQ(track["good"].get<int>(), merged);
+  EXPECT_EQ(track["failed_gate"].size(), static_cast<size_t>(found - merged));
   // Tags face away from the cameras in part of the random poses; the merge
   // keeps only well-determined tool poses (>= 2 tags, <= 0.5 px).
   EXPECT_GT(found, 25);
@@ -98,16 +100,36 @@ TEST(RenderPipelineTest, MergeNeedsMatchingRows) {
   r = RunKincal("simulate --robot " + SourceDir() +
                 "/data/robots/bh7.yaml --out " + dir + "/other --poses 5");
   ASSERT_EQ(r.exit_code, 0) << r.err;
-  const std::string img = dir + "/s/images";
-  r = RunKincal("track --rig " + img + "/rig.yaml --target " + img +
-                "/target.yaml --left '" + img + "/left_*.png' --right '" + img +
-                "/right_*.png' --out " + dir + "/points.csv --obs " + dir +
-                "/other/observations.csv --robot " + dir +
+  const std::string img = dir + "/s/session";
+  r = RunKincal("track --rig " + dir + "/s/rig.yaml --target " + dir +
+                "/s/target.yaml --left '" + img + "/left/*.png' --right '" +
+                img + "/right/*.png' --out " + dir + "/points.csv --obs " +
+                dir + "/other/observations.csv --robot " + dir +
                 "/s/robot.yaml --out-obs " + dir + "/tracked.csv --quiet");
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_THAT(r.err, ::testing::HasSubstr("rows must match frames"));
   EXPECT_FALSE(Exists(dir + "/points.csv"));
   EXPECT_FALSE(Exists(dir + "/tracked.csv"));
+
+  // --session: a robot whose joints are not the session's columns.
+  const std::string other_robot = dir + "/other_robot.yaml";
+  r = RunShell("sed 's/name: j3/name: elbow/' " + dir + "/s/robot.yaml > " +
+               other_robot);
+  r = RunKincal("track --rig " + dir + "/s/rig.yaml --target " + dir +
+                "/s/target.yaml --session " + img + " --robot " + other_robot +
+                " --out " + dir + "/points.csv --out-obs " + dir +
+                "/tracked.csv --quiet");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_THAT(r.err, ::testing::HasSubstr("frames.csv:2:"));
+  EXPECT_THAT(r.err, ::testing::HasSubstr("missing: elbow"));
+  // An unreadable image.
+  r = RunShell("echo broken > " + img + "/right/000001.png");
+  r = RunKincal("track --rig " + dir + "/s/rig.yaml --target " + dir +
+                "/s/target.yaml --session " + img + " --out " + dir +
+                "/points.csv --quiet");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_THAT(r.err, ::testing::HasSubstr("right/000001.png: cannot read"));
+  EXPECT_FALSE(Exists(dir + "/points.csv"));
 }
 
 }  // namespace

@@ -5,6 +5,7 @@ extern "C" {
 #include <apriltag/tag16h5.h>
 #include <apriltag/tag25h9.h>
 #include <apriltag/tag36h11.h>
+#include <apriltag/tagStandard41h12.h>
 }
 
 #include <algorithm>
@@ -29,6 +30,7 @@ const FamilyFunctions* FindFamily(const std::string& name) {
       {"tag36h11", tag36h11_create, tag36h11_destroy},
       {"tag25h9", tag25h9_create, tag25h9_destroy},
       {"tag16h5", tag16h5_create, tag16h5_destroy},
+      {"tagStandard41h12", tagStandard41h12_create, tagStandard41h12_destroy},
   };
   for (const auto& f : kFamilies) {
     if (name == f.name) return &f;
@@ -36,7 +38,9 @@ const FamilyFunctions* FindFamily(const std::string& name) {
   return nullptr;
 }
 
-std::string KnownFamilies() { return "tag36h11, tag25h9, tag16h5"; }
+std::string KnownFamilies() {
+  return "tag36h11, tag25h9, tag16h5, tagStandard41h12";
+}
 
 // A family instance that destroys itself.
 struct FamilyHandle {
@@ -145,11 +149,14 @@ cv::Mat TagImage(const std::string& family, int id) {
   // As libapriltag's apriltag_to_image (whose image type is not exported):
   // black square of width_at_border cells with a one-cell white ring around
   // it, data bits at (bit_x, bit_y) from the black square's corner, MSB first.
+  // Families with a reversed border (tagStandard41h12) have their white
+  // ring on the detected square itself, with a black ring outside it and
+  // data bits outside that (as libapriltag draws them).
   const apriltag_family_t* fam = f.family;
   const int total = fam->total_width;
   const int start = (total - fam->width_at_border) / 2;
   cv::Mat out(total, total, CV_8UC1, cv::Scalar(0));
-  const int ring = start - 1;
+  const int ring = fam->reversed_border ? start : start - 1;
   for (int i = ring; i < total - ring; ++i) {
     out.at<uint8_t>(ring, i) = 255;
     out.at<uint8_t>(total - 1 - ring, i) = 255;
@@ -240,25 +247,102 @@ std::vector<TagDetection> AprilTagDetector::DetectInRegion(const cv::Mat& gray,
       t.corners[k] = Eigen::Vector2d(d->p[k][0], d->p[k][1]) + offset;
     }
     t.center = Eigen::Vector2d(d->c[0], d->c[1]) + offset;
+    t.detector_corners = t.corners;
     switch (options_.refinement) {
       case CornerRefinement::kNone:
         break;
       case CornerRefinement::kCornerSubPix:
-        RefineCornersBySubPix(gray, &t);
+        if (RefineCornersBySubPix(gray, &t))
+          t.refined = {true, true, true, true};
         break;
-      case CornerRefinement::kEdges:
-        RefineCornersByEdges(gray, &t);
+      case CornerRefinement::kEdges: {
+        std::array<double, 4> side_rms{};
+        if (RefineCornersByEdges(gray, &t, &side_rms)) {
+          for (int k = 0; k < 4; ++k) {
+            // Corner k joins side k-1 and side k.
+            const bool sides_ok =
+                side_rms[k] <= options_.max_edge_rms_px &&
+                side_rms[(k + 3) % 4] <= options_.max_edge_rms_px;
+            const bool near = (t.corners[k] - t.detector_corners[k]).norm() <=
+                              options_.max_refine_shift_px;
+            t.refined[k] = sides_ok && near;
+            if (!t.refined[k]) t.corners[k] = t.detector_corners[k];
+          }
+        }
         break;
+      }
     }
     out.push_back(t);
   }
   apriltag_detections_destroy(dets);
+  if (options_.refinement == CornerRefinement::kEdges) {
+    RevertCornersNearOtherTags(&out);
+  }
   std::sort(out.begin(), out.end(),
             [](const TagDetection& a, const TagDetection& b) {
               if (a.id != b.id) return a.id < b.id;
               return a.center.x() < b.center.x();
             });
   return out;
+}
+
+namespace {
+double SegmentDistance(const Eigen::Vector2d& p, const Eigen::Vector2d& a,
+                       const Eigen::Vector2d& b) {
+  const Eigen::Vector2d ab = b - a;
+  const double t = std::clamp((p - a).dot(ab) / ab.squaredNorm(), 0.0, 1.0);
+  return (p - (a + t * ab)).norm();
+}
+double SegmentsDistance(const Eigen::Vector2d& a, const Eigen::Vector2d& b,
+                        const Eigen::Vector2d& c, const Eigen::Vector2d& d) {
+  // Segments that cross have distance 0.
+  auto cross = [](const Eigen::Vector2d& u, const Eigen::Vector2d& v) {
+    return u.x() * v.y() - u.y() * v.x();
+  };
+  const double d1 = cross(b - a, c - a), d2 = cross(b - a, d - a);
+  const double d3 = cross(d - c, a - c), d4 = cross(d - c, b - c);
+  if (((d1 > 0) != (d2 > 0)) && ((d3 > 0) != (d4 > 0))) return 0.0;
+  return std::min({SegmentDistance(a, c, d), SegmentDistance(b, c, d),
+                   SegmentDistance(c, a, b), SegmentDistance(d, a, b)});
+}
+}  // namespace
+
+// A side whose sampling reaches another tag's quad (its black square within
+// one cell plus the window of the side) is measured on that tag's edges too:
+// its corners fall back to libapriltag's.
+void RevertCornersNearOtherTags(std::vector<TagDetection>* dets) {
+  std::vector<std::array<bool, 4>> revert(dets->size(),
+                                          {false, false, false, false});
+  for (size_t i = 0; i < dets->size(); ++i) {
+    const auto& c = (*dets)[i].detector_corners;
+    for (int k = 0; k < 4; ++k) {
+      const Eigen::Vector2d& a = c[k];
+      const Eigen::Vector2d& b = c[(k + 1) % 4];
+      const double cell = (b - a).norm() / 8.0;
+      const double reach = 1.5 * cell + 1.0;
+      for (size_t j = 0; j < dets->size(); ++j) {
+        if (j == i) continue;
+        const auto& o = (*dets)[j].detector_corners;
+        for (int m = 0; m < 4 && !revert[i][k]; ++m) {
+          if (SegmentsDistance(a, b, o[m], o[(m + 1) % 4]) < reach) {
+            revert[i][k] = true;
+          }
+        }
+      }
+    }
+  }
+  for (size_t i = 0; i < dets->size(); ++i) {
+    TagDetection& t = (*dets)[i];
+    for (int k = 0; k < 4; ++k) {
+      // Side k runs from corner k to corner k + 1.
+      if (revert[i][k]) {
+        for (int e : {k, (k + 1) % 4}) {
+          t.corners[e] = t.detector_corners[e];
+          t.refined[e] = false;
+        }
+      }
+    }
+  }
 }
 
 // Edge refinement. For each side (corner k to corner k+1) the outward normal
@@ -271,8 +355,10 @@ std::vector<TagDetection> AprilTagDetector::DetectInRegion(const cv::Mat& gray,
 // cell inside and outside the edge. The window is re-centred once. A total
 // least-squares line is fitted to the edge points (3 MAD outliers dropped),
 // and adjacent lines intersect in the new corners.
-bool RefineCornersByEdges(const cv::Mat& gray, TagDetection* det) {
+bool RefineCornersByEdges(const cv::Mat& gray, TagDetection* det,
+                          std::array<double, 4>* side_rms) {
   const auto& c = det->corners;
+  std::array<double, 4> rms_of_side{};
   Eigen::Vector2d centroid = (c[0] + c[1] + c[2] + c[3]) / 4.0;
   std::array<Line2, 4> lines;
   for (int k = 0; k < 4; ++k) {
@@ -285,8 +371,14 @@ bool RefineCornersByEdges(const cv::Mat& gray, TagDetection* det) {
     if (n.dot((a + b) / 2 - centroid) < 0) n = -n;
     // Cells across the black square: 8 for tag36h11; the white border is one
     // cell wide. A conservative 8 keeps windows inside one cell for smaller
-    // families too.
-    const double cell = len / 8.0;
+    // families too. The cell across this side is set by the sides that run
+    // across it, which are shorter than this one when the tag is seen
+    // obliquely: the shortest side bounds it.
+    double shortest = len;
+    for (int j = 0; j < 4; ++j) {
+      shortest = std::min(shortest, (c[(j + 1) % 4] - c[j]).norm());
+    }
+    const double cell = shortest / 8.0;
     const double w = std::min(0.45 * cell, 3.0);
     if (w < 0.8) return false;
     const int samples = std::max(6, static_cast<int>(len * 0.8));
@@ -306,7 +398,9 @@ bool RefineCornersByEdges(const cv::Mat& gray, TagDetection* det) {
     if (base.size() < 4) return false;
     const double i_dark = Median(dark);
     const double i_bright = Median(bright);
-    if (i_bright - i_dark < 5.0) return false;
+    // Reversed-border families (tagStandard41h12) have the bright side
+    // inside: the area rule only needs the two levels apart.
+    if (std::abs(i_bright - i_dark) < 5.0) return false;
     const double inv = 1.0 / (i_bright - i_dark);
     const double h = 0.25;  // px between profile samples
     const int m = static_cast<int>(std::ceil(w / h));
@@ -345,6 +439,12 @@ bool RefineCornersByEdges(const cv::Mat& gray, TagDetection* det) {
     }
     if (kept.size() < 4) return false;
     if (kept.size() < pts.size()) line = FitLine(kept);
+    double ss = 0;
+    for (const auto& q : kept) {
+      const double r = line.n.dot(q) - line.c;
+      ss += r * r;
+    }
+    rms_of_side[k] = std::sqrt(ss / kept.size());
     lines[k] = line;
   }
   std::array<Eigen::Vector2d, 4> refined;
@@ -354,6 +454,7 @@ bool RefineCornersByEdges(const cv::Mat& gray, TagDetection* det) {
     if ((refined[k] - c[k]).norm() > 3.0) return false;
   }
   det->corners = refined;
+  if (side_rms != nullptr) *side_rms = rms_of_side;
   // Centre: intersection of the diagonals.
   Line2 d0, d1;
   d0.n = Eigen::Vector2d(-(refined[2] - refined[0]).y(),

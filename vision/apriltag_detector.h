@@ -33,6 +33,10 @@ struct TagDetection {
       Eigen::Vector2d::Zero(), Eigen::Vector2d::Zero(), Eigen::Vector2d::Zero(),
       Eigen::Vector2d::Zero()};
   Eigen::Vector2d center = Eigen::Vector2d::Zero();
+  // libapriltag's own corners (same convention and order); `corners` differ
+  // from them only where refined[k] (the refinement passed its checks).
+  std::array<Eigen::Vector2d, 4> detector_corners = corners;
+  std::array<bool, 4> refined = {false, false, false, false};
   double decision_margin = 0;  // libapriltag's decoding quality
   int hamming = 0;             // bits corrected
 };
@@ -51,17 +55,27 @@ enum class CornerRefinement {
 
 // Detector settings (libapriltag's fields plus the refinement).
 struct AprilTagOptions {
-  std::string family = "tag36h11";  // tag36h11, tag25h9, tag16h5,
-                                    // tagStandard41h12
-  double quad_decimate = 2.0;       // quad search on a decimated image
-  double quad_sigma = 0.8;          // Gaussian blur for the quad search, px
-  bool refine_edges = true;         // libapriltag's own edge snapping
+  // tag36h11, tag25h9, tag16h5, tagStandard41h12 (reversed border: its
+  // detected square is the white one inside the black ring; `size` in
+  // target.yaml is that square's edge, width_at_border = 5 cells).
+  std::string family = "tag36h11";
+  double quad_decimate = 2.0;  // quad search on a decimated image
+  double quad_sigma = 0.8;     // Gaussian blur for the quad search, px
+  bool refine_edges = true;    // libapriltag's own edge snapping
   int nthreads = 1;
   double decode_sharpening = 0.25;
   int max_hamming = 1;  // bits corrected when decoding (0..2)
   CornerRefinement refinement = CornerRefinement::kEdges;
   // Tags whose decision margin is below this are dropped.
   double min_decision_margin = 0.0;
+  // Checks of the edge refinement, per corner (the refinement must never be
+  // worse than the detector it refines): a refined corner falls back to
+  // libapriltag's when it moved more than max_refine_shift_px from it, when
+  // an adjacent side's edge points scatter more than max_edge_rms_px about
+  // their line, or when another tag's quad comes within one cell (+ the
+  // sampling window) of an adjacent side (its edges would enter the window).
+  double max_refine_shift_px = 0.3;
+  double max_edge_rms_px = 0.15;
 
   // Throws InputError naming the bad option and its value.
   void Check() const;
@@ -96,8 +110,14 @@ class AprilTagDetector {
 // Refines the corners of one detection in place (exposed for tests and the
 // bench). Returns false and leaves `det` unchanged when the refinement fails
 // (e.g. a side too close to the image border).
-bool RefineCornersByEdges(const cv::Mat& gray, TagDetection* det);
+// `side_rms` (optional) receives, per side k (corner k to k+1), the RMS
+// distance of the side's edge points from their fitted line, px.
+bool RefineCornersByEdges(const cv::Mat& gray, TagDetection* det,
+                          std::array<double, 4>* side_rms = nullptr);
 bool RefineCornersBySubPix(const cv::Mat& gray, TagDetection* det);
+// Reverts to libapriltag's corners the corners of every side whose sampling
+// band (1.5 cells + 1 px) reaches another detected tag's quad.
+void RevertCornersNearOtherTags(std::vector<TagDetection>* dets);
 
 // The tag's image as printed (libapriltag's apriltag_to_image): one pixel per
 // cell, 0 = black, 255 = white, including the white border (10x10 cells for

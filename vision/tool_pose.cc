@@ -76,6 +76,10 @@ struct TagObs {
   int camera;
   const TagDetection* det;
   const TargetTag* tag;
+  // The corners the fit uses (the detection's, or libapriltag's where the
+  // per-corner check swapped them back) and which of them take part.
+  std::array<Eigen::Vector2d, 4> px;
+  std::array<bool, 4> use = {true, true, true, true};
 };
 
 std::vector<TagObs> CollectObservations(
@@ -89,7 +93,7 @@ std::vector<TagObs> CollectObservations(
     for (const auto& d : detections[c]) {
       const TargetTag* tag = target.FindTag(d.id);
       if (tag == nullptr || count[d.id] != 1) continue;
-      obs.push_back({static_cast<int>(c), &d, tag});
+      obs.push_back({static_cast<int>(c), &d, tag, d.corners});
     }
   }
   return obs;
@@ -123,14 +127,17 @@ Rigid3 Kabsch(const std::vector<Eigen::Vector3d>& a,
 
 double TagRms(const Camera& cam, const Rigid3& rig_from_tool, const TagObs& o) {
   double sum = 0;
+  int n = 0;
   for (int k = 0; k < 4; ++k) {
+    if (!o.use[k]) continue;
     const Eigen::Vector3d p_in_cam =
         cam.cam_from_rig * (rig_from_tool * o.tag->CornerInTool(k));
     const Eigen::Vector2d px = Project(cam.intrinsics, p_in_cam);
     if (!px.allFinite()) return 1e9;
-    sum += (px - o.det->corners[k]).squaredNorm();
+    sum += (px - o.px[k]).squaredNorm();
+    ++n;
   }
-  return std::sqrt(sum / 4);
+  return n > 0 ? std::sqrt(sum / n) : 1e9;
 }
 
 bool InitialFromObservations(const Rig& rig, const std::vector<TagObs>& obs,
@@ -216,8 +223,9 @@ bool FitPose(const Rig& rig, const std::vector<TagObs>& obs,
     if (!used[i]) continue;
     const Camera& cam = rig.cameras[obs[i].camera];
     for (int k = 0; k < 4; ++k) {
+      if (!obs[i].use[k]) continue;
       problem.AddResidualBlock(
-          ToolCornerReprojectionCost::Create(obs[i].det->corners[k],
+          ToolCornerReprojectionCost::Create(obs[i].px[k],
                                              obs[i].tag->CornerInTool(k), cam),
           huber_px > 0 ? new ceres::HuberLoss(huber_px) : nullptr, q, t);
     }
@@ -238,6 +246,67 @@ bool FitPose(const Rig& rig, const std::vector<TagObs>& obs,
   rig_from_tool->R = qs.normalized().toRotationMatrix();
   rig_from_tool->t = Eigen::Vector3d(t[0], t[1], t[2]);
   return rig_from_tool->R.allFinite() && rig_from_tool->t.allFinite();
+}
+
+// Pixel residual of corner k of `o` at `pose` against `px`.
+double CornerResidual(const Camera& cam, const Rigid3& pose, const TagObs& o,
+                      int k, const Eigen::Vector2d& px) {
+  const Eigen::Vector2d p = Project(
+      cam.intrinsics, cam.cam_from_rig * (pose * o.tag->CornerInTool(k)));
+  return p.allFinite() ? (p - px).norm() : 1e9;
+}
+
+// The per-corner check of the refinement against the pose fit (robust first
+// fit): a corner far off the pose (> max(corner_outlier_px, ratio * median
+// corner residual)) goes back to libapriltag's corner when that fits better,
+// and is left out when it still does not fit. A tag observation left with
+// fewer than 3 corners is left out. Returns the number of corners changed.
+int CheckCornersAgainstPose(const Rig& rig, const Rigid3& pose,
+                            const ToolPoseOptions& options,
+                            std::vector<TagObs>* obs, std::vector<bool>* used) {
+  std::vector<double> all;
+  for (size_t i = 0; i < obs->size(); ++i) {
+    if (!(*used)[i]) continue;
+    const TagObs& o = (*obs)[i];
+    for (int k = 0; k < 4; ++k) {
+      if (o.use[k]) {
+        all.push_back(
+            CornerResidual(rig.cameras[o.camera], pose, o, k, o.px[k]));
+      }
+    }
+  }
+  if (all.size() < 8) return 0;
+  std::nth_element(all.begin(), all.begin() + all.size() / 2, all.end());
+  const double limit = std::max(options.corner_outlier_px,
+                                options.outlier_ratio * all[all.size() / 2]);
+  int changed = 0;
+  for (size_t i = 0; i < obs->size(); ++i) {
+    if (!(*used)[i]) continue;
+    TagObs& o = (*obs)[i];
+    const Camera& cam = rig.cameras[o.camera];
+    int kept = 0;
+    for (int k = 0; k < 4; ++k) {
+      if (!o.use[k]) continue;
+      double r = CornerResidual(cam, pose, o, k, o.px[k]);
+      if (r > limit && o.det->refined[k]) {
+        const double r_raw =
+            CornerResidual(cam, pose, o, k, o.det->detector_corners[k]);
+        if (r_raw < r) {
+          o.px[k] = o.det->detector_corners[k];
+          r = r_raw;
+          ++changed;
+        }
+      }
+      if (r > limit) {
+        o.use[k] = false;
+        ++changed;
+      } else {
+        ++kept;
+      }
+    }
+    if (kept < 3) (*used)[i] = false;
+  }
+  return changed;
 }
 
 }  // namespace
@@ -272,7 +341,7 @@ ToolPoseResult EstimateToolPose(
     const ToolPoseOptions& options) {
   options.Check();
   ToolPoseResult result;
-  const std::vector<TagObs> obs = CollectObservations(rig, target, detections);
+  std::vector<TagObs> obs = CollectObservations(rig, target, detections);
   if (static_cast<int>(obs.size()) < options.min_tag_observations ||
       obs.empty()) {
     result.why_not = "no tag of the target seen";
@@ -288,6 +357,21 @@ ToolPoseResult EstimateToolPose(
                &pose)) {
     result.why_not = "pose fit failed";
     return result;
+  }
+  // Per corner: refined corners off the pose go back to libapriltag's, or
+  // out; then refit.
+  if (CheckCornersAgainstPose(rig, pose, options, &obs, &used) > 0) {
+    int n_used = 0;
+    for (bool u : used) n_used += u ? 1 : 0;
+    if (n_used < options.min_tag_observations || n_used == 0) {
+      result.why_not = "no tag left after the per-corner check";
+      return result;
+    }
+    if (!FitPose(rig, obs, used, options.huber_px, options.max_iterations,
+                 &pose)) {
+      result.why_not = "pose fit failed after the per-corner check";
+      return result;
+    }
   }
   // Reject the worst tag observation while it is an outlier, refitting.
   std::vector<double> rms(obs.size());
@@ -329,10 +413,13 @@ ToolPoseResult EstimateToolPose(
   int corners = 0;
   for (size_t i = 0; i < obs.size(); ++i) {
     const double r = TagRms(rig.cameras[obs[i].camera], pose, obs[i]);
-    result.tags.push_back({obs[i].camera, obs[i].tag->id, r, used[i]});
+    result.tags.push_back(
+        {obs[i].camera, obs[i].tag->id, r, used[i], obs[i].use, obs[i].px});
     if (!used[i]) continue;
-    sum += 4 * r * r;
-    corners += 4;
+    int n = 0;
+    for (bool u : obs[i].use) n += u ? 1 : 0;
+    sum += n * r * r;
+    corners += n;
     ++result.tags_used;
   }
   // A single tag in a single camera fixes the pose only weakly, but it does

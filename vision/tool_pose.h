@@ -8,6 +8,7 @@
 // The needle tip is rig_from_tool * tip_in_tool.
 
 #include <Eigen/Core>
+#include <array>
 #include <string>
 #include <vector>
 
@@ -23,6 +24,11 @@ struct ToolPoseOptions {
   // first, then the fit is redone.
   double outlier_px = 1.5;
   double outlier_ratio = 5.0;
+  // Per corner, after the robust first fit: a corner whose residual exceeds
+  // max(corner_outlier_px, outlier_ratio * median corner residual) goes back
+  // to libapriltag's corner (TagDetection::detector_corners) if that fits
+  // better, and is left out otherwise (a tag keeps >= 3 corners or is out).
+  double corner_outlier_px = 0.3;
   // Huber scale of the first fit (px); the final fit is plain least squares.
   double huber_px = 2.0;
   int min_tag_observations = 1;
@@ -37,6 +43,10 @@ struct TagObservationResult {
   int tag_id = 0;
   double rms_px = 0;  // corner RMS against the final pose
   bool used = false;
+  // Corners that took part (the per-corner check may leave some out) and
+  // the pixels used for them (refined, or libapriltag's).
+  std::array<bool, 4> corner_used = {true, true, true, true};
+  std::array<Eigen::Vector2d, 4> corners_px;
 };
 
 struct ToolPoseResult {

@@ -112,7 +112,9 @@ TEST(ToolPose, RejectsOutlierTagAndWorksWithOneCamera) {
   std::vector<std::vector<TagDetection>> dets;
   for (const auto& v : frame.views) dets.push_back(detector.Detect(v.image));
   ASSERT_FALSE(dets[1].empty());
+  // A tag whose detection itself is off (libapriltag's corners too).
   for (auto& c : dets[1][0].corners) c += Eigen::Vector2d(6, -2);
+  for (auto& c : dets[1][0].detector_corners) c += Eigen::Vector2d(6, -2);
   const ToolPoseResult r = EstimateToolPose(rig, target, dets);
   ASSERT_TRUE(r.found);
   EXPECT_EQ(r.tags_used, static_cast<int>(dets[0].size() + dets[1].size()) - 1);
@@ -132,6 +134,47 @@ TEST(ToolPose, RejectsOutlierTagAndWorksWithOneCamera) {
   const ToolPoseResult none = EstimateToolPose(rig, target, {{}, {}});
   EXPECT_FALSE(none.found);
   EXPECT_FALSE(none.why_not.empty());
+}
+
+// A refined corner that went wrong (e.g. an edge window reaching a
+// neighbouring tag) while libapriltag's corner is fine: the per-corner check
+// against the pose puts libapriltag's corner back; one that is off in both
+// is left out, and the tag keeps its other corners.
+TEST(ToolPose, PerCornerCheckFallsBackOrDrops) {
+  const Rig rig = ExampleStereoRig(640, 512);
+  const Target target = ExampleTarget();
+  RenderOptions o;
+  o.blur_sigma_px = 0.6;
+  StereoRenderer renderer(rig, target, o);
+  std::mt19937_64 rng(4);
+  const StereoFrameTruth frame = renderer.Render(ExampleToolPose(3), &rng);
+  AprilTagDetector detector;
+  std::vector<std::vector<TagDetection>> dets;
+  for (const auto& v : frame.views) dets.push_back(detector.Detect(v.image));
+  ASSERT_GE(dets[0].size(), 2u);
+  const ToolPoseResult clean = EstimateToolPose(rig, target, dets);
+  ASSERT_TRUE(clean.found);
+  TagDetection& a = dets[0][0];
+  a.refined[1] = true;
+  a.corners[1] = a.detector_corners[1] + Eigen::Vector2d(1.5, 0.8);
+  TagDetection& b = dets[0][1];
+  b.corners[2] += Eigen::Vector2d(-2.0, 1.0);
+  b.detector_corners[2] = b.corners[2];
+  const ToolPoseResult r = EstimateToolPose(rig, target, dets);
+  ASSERT_TRUE(r.found);
+  EXPECT_EQ(r.tags_used, clean.tags_used);
+  for (const auto& t : r.tags) {
+    if (t.camera != 0) continue;
+    if (t.tag_id == a.id) {
+      EXPECT_TRUE(t.corner_used[1]);
+      EXPECT_LT((t.corners_px[1] - a.detector_corners[1]).norm(), 1e-12);
+    }
+    if (t.tag_id == b.id) {
+      EXPECT_FALSE(t.corner_used[2]);
+    }
+  }
+  EXPECT_LT(r.rms_px, 0.1);
+  EXPECT_LT((r.tip_in_rig - clean.tip_in_rig).norm(), 0.05);
 }
 
 }  // namespace

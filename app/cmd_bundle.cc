@@ -1,0 +1,385 @@
+// kincal bundle: one Ceres problem from the tag corners of a recorded
+// session to the robot's parameters (../shared/spec/formats.md v2,
+// docs/BUNDLE.md).
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <iostream>
+#include <map>
+#include <memory>
+#include <sstream>
+
+#include "app/app_util.h"
+#include "app/command.h"
+#include "bundle/bundle.h"
+#include "bundle/observe.h"
+#include "calib/chain.h"
+#include "calib/model_state.h"
+#include "camcal/rig.h"
+#include "data/atomic_file.h"
+#include "data/error.h"
+#include "data/observations.h"
+#include "data/provenance.h"
+#include "data/robot.h"
+#include "data/session.h"
+#include "data/urdf.h"
+#include "data/yaml_util.h"
+#include "vision/target.h"
+#include "vision/tool_pose.h"
+
+namespace kincal::app {
+namespace {
+
+struct BundleArgs {
+  std::string robot, rig, target, session, out, out_rig, out_obs;
+  std::string extensions;  // comma-separated parameter names
+  BundleOptions options;
+  // Quality gate of --out-obs tips (as `track`).
+  int min_tags = 2;
+  double max_reproj_px = 0.5;
+  bool json = false, quiet = false;
+};
+
+std::vector<std::string> SplitNames(const std::string& text) {
+  std::vector<std::string> out;
+  std::stringstream ss(text);
+  std::string item;
+  while (std::getline(ss, item, ',')) {
+    if (!item.empty()) out.push_back(item);
+  }
+  return out;
+}
+
+// The frame's tool pose from its bundle corners on `rig` (the refined rig).
+ToolPoseResult RefitPose(const Rig& rig, const Target& target,
+                         const BundleFrame& f) {
+  std::vector<std::vector<TagDetection>> dets(rig.cameras.size());
+  std::map<std::pair<int, int>, TagDetection> by_tag;
+  std::map<std::pair<int, int>, int> count;
+  for (const BundleCorner& c : f.corners) {
+    TagDetection& d = by_tag[{c.camera, c.tag}];
+    d.id = target.tags[c.tag].id;
+    d.corners[c.corner] = c.px;
+    d.detector_corners[c.corner] = c.px;
+    ++count[{c.camera, c.tag}];
+  }
+  // Tags the per-corner check left with 3 corners are left out here.
+  for (const auto& [key, d] : by_tag) {
+    if (count[key] == 4) dets[key.first].push_back(d);
+  }
+  return EstimateToolPose(rig, target, dets);
+}
+
+int RunBundleCommand(BundleArgs args) {
+  const auto start = std::chrono::steady_clock::now();
+  const Robot robot = ReadRobot(args.robot);
+  const Rig rig = ReadRigYaml(args.rig);
+  const Target target = ReadTargetYaml(args.target);
+  if (rig.cameras.size() != 2) {
+    throw InputError(args.rig +
+                     ": a recorded session has two cameras; the "
+                     "rig has " +
+                     std::to_string(rig.cameras.size()));
+  }
+  SessionReadOptions so;
+  so.joint_names = robot.JointNames();
+  so.require_joint_readings = true;
+  const Session session = ReadSession(args.session, so);
+  // A cause without a joint ("backlash") stands for that cause at every
+  // joint.
+  for (const std::string& name : SplitNames(args.extensions)) {
+    if (name.find('.') != std::string::npos) {
+      args.options.extensions.push_back(name);
+      continue;
+    }
+    if (name == "axis_tilt") {  // Hayati beta of rows with parallel axes
+      const Chain chain = Chain::FromRobot(robot);
+      for (int row : ParallelAxisRows(chain)) {
+        args.options.extensions.push_back(AxisTiltParam(chain, row).name);
+      }
+      continue;
+    }
+    for (const std::string& j : robot.JointNames()) {
+      if (name == "cyclic") {
+        args.options.extensions.push_back(j + ".cyclic_cos");
+        args.options.extensions.push_back(j + ".cyclic_sin");
+      } else {
+        args.options.extensions.push_back(j + "." + name);
+      }
+    }
+  }
+
+  ObserveOptions oo;
+  if (!args.quiet) {
+    oo.progress = [](int done, int total) {
+      if (total >= 20 && (done % 10 == 0 || done == total)) {
+        std::fprintf(stderr, "\rkincal bundle: detecting tags %d/%d", done,
+                     total);
+        if (done == total) std::fprintf(stderr, "\n");
+      }
+    };
+  }
+  const SessionObservations obs = ObserveSession(session, rig, target, oo);
+  const BundleResult r =
+      RunBundle(robot, rig, target, obs.frames, args.options);
+
+  // Outputs, all validated and computed before the first write.
+  const std::string robot_text = FormatRobotYaml(
+      r.calibrated,
+      {"calibrated by kincal bundle from the images of " + args.session,
+       "reprojection RMS " + FormatDouble(r.reproj_rms_px) +
+           " px (training), " + FormatDouble(r.heldout_reproj_rms_px) +
+           " px (held out)"});
+  std::string obs_text;
+  int obs_points = 0;
+  if (!args.out_obs.empty()) {
+    Observations out;
+    out.source = session.frames_csv;
+    out.joint_names = robot.JointNames();
+    for (const BundleFrame& f : obs.frames) {
+      Observation o;
+      o.pose = std::to_string(f.frame);
+      o.q = f.q_reading;
+      o.t_s = f.t_s;
+      ToolPoseResult p;
+      if (args.options.refine_cameras && !f.corners.empty()) {
+        p = RefitPose(r.rig, target, f);
+      } else {
+        p.found = f.tracked;
+        p.rig_from_tool = f.rig_from_tool;
+        p.rms_px = f.tracked_rms_px;
+        p.tags_used = f.tracked_tags;
+      }
+      if (p.found && p.tags_used >= args.min_tags &&
+          p.rms_px <= args.max_reproj_px) {
+        o.has_point = true;
+        o.p_in_meas = p.rig_from_tool * target.tip_in_tool;
+        ++obs_points;
+      }
+      out.rows.push_back(o);
+    }
+    obs_text = FormatObservationsCsv(
+        out, {"needle tips seen by the cameras (rig frame, mm) at the "
+              "session's joint readings; empty where the tool pose used "
+              "fewer than " +
+              std::to_string(args.min_tags) + " tags or fit worse than " +
+              FormatDouble(args.max_reproj_px) + " px"});
+  }
+  WriteFileAtomic(args.out, robot_text);
+  if (!args.out_rig.empty()) WriteRigYaml(args.out_rig, r.rig);
+  if (!args.out_obs.empty()) WriteFileAtomic(args.out_obs, obs_text);
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start)
+          .count();
+
+  nlohmann::json params = nlohmann::json::array();
+  for (const BundleParam& p : r.params) {
+    params.push_back(
+        {{"name", p.name},
+         {"value", p.value},
+         {"sigma", std::isfinite(p.sigma) ? nlohmann::json(p.sigma)
+                                          : nlohmann::json(nullptr)}});
+  }
+  nlohmann::json extensions = nlohmann::json::array();
+  for (const std::string& name : args.options.extensions) {
+    for (const BundleParam& p : r.params) {
+      if (p.name != name) continue;
+      const double z = std::isfinite(p.sigma) && p.sigma > 0
+                           ? std::abs(p.value) / p.sigma
+                           : 0.0;
+      extensions.push_back({{"name", p.name},
+                            {"value", p.value},
+                            {"sigma", p.sigma},
+                            {"z", z},
+                            {"significant", z > 4.0}});
+    }
+  }
+  // Significant extensions, strongest first: what the images name.
+  nlohmann::json findings = nlohmann::json::array();
+  {
+    std::vector<nlohmann::json> sig;
+    for (const auto& e : extensions) {
+      if (e["significant"].get<bool>()) sig.push_back(e);
+    }
+    std::sort(sig.begin(), sig.end(), [](const auto& a, const auto& b) {
+      return a["z"].template get<double>() > b["z"].template get<double>();
+    });
+    for (const auto& e : sig) {
+      const std::string name = e["name"];
+      const size_t dot = name.find('.');
+      findings.push_back(
+          {{"cause", name.substr(dot + 1)},
+           {"joint", name.substr(0, dot)},
+           {"magnitude", e["value"]},
+           {"sigma", e["sigma"]},
+           {"ci95",
+            {e["value"].get<double>() - 1.96 * e["sigma"].get<double>(),
+             e["value"].get<double>() + 1.96 * e["sigma"].get<double>()}}});
+    }
+  }
+  // Per-frame reprojection RMS of the final model (the worst frames).
+  std::vector<std::pair<double, int>> frame_rms;
+  for (size_t i = 0; i < obs.frames.size(); ++i) {
+    const BundleFrame& f = obs.frames[i];
+    if (f.corners.empty()) continue;
+    const Rigid3 rt = ModelRigFromTool(r, static_cast<int>(i));
+    double sum = 0;
+    for (const BundleCorner& c : f.corners) {
+      const Camera& cam = r.rig.cameras[c.camera];
+      const Eigen::Vector2d px = Project(
+          cam.intrinsics,
+          cam.cam_from_rig * (rt * target.tags[c.tag].CornerInTool(c.corner)));
+      sum += (px - c.px).squaredNorm();
+    }
+    frame_rms.push_back({std::sqrt(sum / f.corners.size()), f.frame});
+  }
+  std::sort(frame_rms.rbegin(), frame_rms.rend());
+  nlohmann::json worst = nlohmann::json::array();
+  for (size_t k = 0; k < frame_rms.size() && k < 5; ++k) {
+    worst.push_back(
+        {{"frame", frame_rms[k].second}, {"rms_px", frame_rms[k].first}});
+  }
+  auto rigid_json = [](const std::array<double, 6>& b) {
+    return nlohmann::json{
+        {"rotation_vector_deg",
+         {b[0] * 180 / M_PI, b[1] * 180 / M_PI, b[2] * 180 / M_PI}},
+        {"t_mm", {b[3], b[4], b[5]}}};
+  };
+  if (args.json) {
+    nlohmann::json j;
+    j["frames"] = obs.session_frames;
+    j["used_frames"] = r.used_frames;
+    j["train_frames"] = r.train_frames;
+    j["heldout_frames"] = r.heldout_frames;
+    j["frames_without_joints"] = obs.without_joints;
+    j["frames_without_tags"] = obs.without_tags;
+    j["corners"] = r.corners;
+    j["dropped_tags"] = r.dropped_tags;
+    j["start_reproj_rms_px"] = r.start_reproj_rms_px;
+    j["reproj_rms_px"] = r.reproj_rms_px;
+    j["heldout_reproj_rms_px"] = r.heldout_reproj_rms_px;
+    j["heldout_tip_rms_mm"] = r.heldout_tip_rms_mm;
+    j["heldout_tips"] = r.heldout_tips;
+    j["sigma0_px"] = r.sigma0_px;
+    j["worst_frames"] = worst;
+    j["identifiable"] = r.identifiable;
+    j["unidentifiable"] = r.unidentifiable;
+    j["params"] = params;
+    if (!args.options.extensions.empty()) {
+      j["extensions"] = extensions;
+      j["findings"] = findings;
+    }
+    j["rig_from_base"] = rigid_json(r.rig_from_base);
+    j["flange_from_target"] = rigid_json(r.flange_from_tool);
+    j["refine_cameras"] = args.options.refine_cameras;
+    j["termination"] = r.termination;
+    j["iterations"] = r.iterations;
+    j["detect_seconds"] = obs.seconds;
+    j["solve_seconds"] = r.seconds;
+    j["seconds"] = seconds;
+    j["out"] = args.out;
+    if (!args.out_rig.empty()) j["out_rig"] = args.out_rig;
+    if (!args.out_obs.empty()) {
+      j["out_obs"] = args.out_obs;
+      j["out_obs_points"] = obs_points;
+    }
+    PrintJson(j);
+    return 0;
+  }
+  std::printf(
+      "kincal bundle: %d frames, %d used (%d train, %d held out), %d "
+      "corners\n",
+      obs.session_frames, r.used_frames, r.train_frames, r.heldout_frames,
+      r.corners);
+  std::printf(
+      "  reprojection RMS %.4f px (start %.3f px), held out %.4f px; "
+      "held-out tip RMS %.4f mm (%d tips)\n",
+      r.reproj_rms_px, r.start_reproj_rms_px, r.heldout_reproj_rms_px,
+      r.heldout_tip_rms_mm, r.heldout_tips);
+  std::printf("  %zu robot parameters fitted, %zu held at nominal\n",
+              r.params.size(), r.unidentifiable.size());
+  for (const BundleParam& p : r.params) {
+    std::printf("    %-16s %12.5f +- %.5f\n", p.name.c_str(), p.value, p.sigma);
+  }
+  std::printf("  wrote %s (%.1f s: detection %.1f s, solve %.2f s)\n",
+              args.out.c_str(), seconds, obs.seconds, r.seconds);
+  return 0;
+}
+
+}  // namespace
+
+void AddBundleCommand(CLI::App& app, Runner* run) {
+  auto args = std::make_shared<BundleArgs>();
+  CLI::App* sub = app.add_subcommand(
+      "bundle",
+      "Calibrate the robot from a recorded session's images: one Ceres "
+      "problem over every tag corner in every camera at every frame with "
+      "joint readings (robot parameters, base in the rig, target on the "
+      "flange, optionally the cameras)");
+  sub->add_option("--robot", args->robot, "robot.yaml (nominal)")->required();
+  sub->add_option("--rig", args->rig, "rig.yaml (2 cameras)")->required();
+  sub->add_option("--target", args->target, "target.yaml")->required();
+  sub->add_option("--session", args->session,
+                  "recorded session folder (left/, right/, frames.csv with "
+                  "joint columns, session.yaml)")
+      ->required();
+  sub->add_option("--out", args->out, "calibrated robot.yaml to write")
+      ->required();
+  sub->add_option("--out-rig", args->out_rig,
+                  "write the (refined) rig.yaml here");
+  sub->add_option("--out-obs", args->out_obs,
+                  "write observations.csv: joint readings + the needle tips "
+                  "the cameras saw (for diagnose, clearance, sensitivity)");
+  sub->add_option("--holdout", args->options.holdout_fraction,
+                  "fraction of frames held out of the fit")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 0.5));
+  sub->add_option("--seed", args->options.seed, "seed of the hold-out")
+      ->capture_default_str();
+  sub->add_option("--huber", args->options.huber_px,
+                  "per-corner Huber scale, px")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
+  sub->add_flag("--refine-cameras", args->options.refine_cameras,
+                "also refine intrinsics and the right camera's pose, with "
+                "priors at rig.yaml (see --prior-*)");
+  sub->add_option("--prior-focal", args->options.prior_focal_px,
+                  "prior sigma of fx, fy (px)")
+      ->capture_default_str();
+  sub->add_option("--prior-principal", args->options.prior_principal_px,
+                  "prior sigma of cx, cy (px)")
+      ->capture_default_str();
+  sub->add_option("--prior-distortion", args->options.prior_distortion,
+                  "prior sigma of distortion coefficients")
+      ->capture_default_str();
+  sub->add_option("--prior-rotation", args->options.prior_rotation_deg,
+                  "prior sigma of the right camera's rotation (deg)")
+      ->capture_default_str();
+  sub->add_option("--prior-translation", args->options.prior_translation_mm,
+                  "prior sigma of the right camera's translation (mm)")
+      ->capture_default_str();
+  sub->add_option(
+      "--extensions", args->extensions,
+      "extension parameters to fit with pixel residuals, "
+      "comma-separated (e.g. j3.backlash,j2.gain; a cause alone, "
+      "e.g. backlash, gain, compliance, cyclic, axis_tilt, means every "
+      "joint); significant ones "
+      "(|value| > 4 sigma) are listed under findings");
+  sub->add_option("--threads", args->options.num_threads, "Ceres threads")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 64));
+  sub->add_option("--min-tags", args->min_tags,
+                  "--out-obs: a tip needs a pose from at least this many tags")
+      ->capture_default_str();
+  sub->add_option("--max-reproj", args->max_reproj_px,
+                  "--out-obs: a tip needs a pose fit within this RMS, px")
+      ->capture_default_str();
+  sub->add_flag("--quiet", args->quiet, "no progress on stderr");
+  sub->add_flag("--json", args->json, "print one JSON object");
+  sub->callback(
+      [run, args] { *run = [args] { return RunBundleCommand(*args); }; });
+}
+
+}  // namespace kincal::app

@@ -1,0 +1,69 @@
+// Bundle time vs frames: BH-7, the three-tag holder seen by both cameras of
+// the example rig (1280x1024), 0.1 px corner noise, every tag in view (3 tags
+// x 2 cameras x 4 corners = 24 corners per frame). The time is RunBundle's:
+// hand-eye start, identifiability on the pixel Jacobian, the fits with the
+// outlier pass, covariance and held-out statistics (tag detection is not
+// included: it is vision_bench's). Target: 500 frames <= 3 s, ~linear.
+// Run: build/bin/bundle_bench
+
+#include <benchmark/benchmark.h>
+
+#include <cstdio>
+#include <map>
+
+#include "bundle/bundle.h"
+#include "bundle/synthetic.h"
+#include "data/robot.h"
+
+namespace kincal {
+namespace {
+
+const SyntheticBundle& Data(int frames) {
+  static std::map<int, SyntheticBundle> cache;
+  auto it = cache.find(frames);
+  if (it == cache.end()) {
+    SyntheticBundleOptions o;
+    o.frames = frames;
+    o.noise_px = 0.1;
+    o.seed = 42;
+    it = cache
+             .emplace(frames, MakeSyntheticBundle(
+                                  ReadRobotYaml(std::string(KINCAL_SOURCE_DIR) +
+                                                "/data/robots/bh7.yaml"),
+                                  o))
+             .first;
+  }
+  return it->second;
+}
+
+void BM_Bundle(benchmark::State& state) {
+  const SyntheticBundle& s = Data(static_cast<int>(state.range(0)));
+  BundleOptions o;
+  o.refine_cameras = state.range(1) != 0;
+  BundleResult r;
+  for (auto _ : state) {
+    r = RunBundle(s.nominal, s.rig, s.target, s.frames, o);
+    benchmark::DoNotOptimize(r);
+  }
+  int corners = 0;
+  for (const BundleFrame& f : s.frames) {
+    corners += static_cast<int>(f.corners.size());
+  }
+  state.counters["frames"] = static_cast<double>(s.frames.size());
+  state.counters["corners"] = corners;
+  state.counters["reproj_px"] = r.reproj_rms_px;
+  state.counters["iterations"] = r.iterations;
+}
+BENCHMARK(BM_Bundle)
+    ->Args({125, 0})
+    ->Args({250, 0})
+    ->Args({500, 0})
+    ->Args({1000, 0})
+    ->Args({500, 1})
+    ->Unit(benchmark::kMillisecond)
+    ->Iterations(2);
+
+}  // namespace
+}  // namespace kincal
+
+BENCHMARK_MAIN();

@@ -1,0 +1,863 @@
+#include "bundle/bundle.h"
+
+#include <ceres/ceres.h>
+#include <ceres/normal_prior.h>
+#include <ceres/rotation.h>
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <map>
+#include <memory>
+#include <numeric>
+#include <random>
+#include <set>
+#include <sstream>
+
+#include "data/error.h"
+#include "data/observations.h"
+
+namespace kincal {
+namespace {
+
+constexpr int kStride = 16;
+constexpr int kMaxJoints = 16;
+
+template <typename T>
+using Mat3T = Eigen::Matrix<T, 3, 3>;
+
+// The parameter blocks of the whole problem.
+struct State {
+  Chain chain;  // rows[j].p and joint_errors[j] are parameter blocks
+  std::array<double, 6> rig_from_base{};
+  std::array<double, 6> flange_from_tool{};
+  std::vector<std::array<double, kNumIntrinsics>> intrinsics;
+  std::vector<std::array<double, 6>> cam_from_rig;
+};
+
+std::array<double, 6> ToBlock(const Rigid3& r) {
+  const Eigen::AngleAxisd aa(r.R);
+  const Eigen::Vector3d w = aa.axis() * aa.angle();
+  return {w.x(), w.y(), w.z(), r.t.x(), r.t.y(), r.t.z()};
+}
+
+Rigid3 FromBlock(const std::array<double, 6>& b) {
+  Rigid3 r;
+  Eigen::Matrix3d R;
+  ceres::AngleAxisToRotationMatrix(b.data(), R.data());  // column-major
+  r.R = R;
+  r.t = Eigen::Vector3d(b[3], b[4], b[5]);
+  return r;
+}
+
+// All corners of one frame (every camera): 2 residuals per corner, with the
+// per-corner Huber loss applied as a residual scaling (the cost is then
+// exactly sum rho(|r|^2) / 2).
+class FrameCost {
+ public:
+  FrameCost(const Chain* chain, const PoseInput* input, bool with_errors,
+            int num_cameras, std::vector<Eigen::Vector3d> points_in_tool,
+            std::vector<int> cameras, std::vector<Eigen::Vector2d> pixels,
+            double huber_px)
+      : chain_(chain),
+        input_(input),
+        with_errors_(with_errors),
+        num_cameras_(num_cameras),
+        points_(std::move(points_in_tool)),
+        cameras_(std::move(cameras)),
+        pixels_(std::move(pixels)),
+        huber_(huber_px) {}
+
+  // Blocks: rows[0..J-1] (6), rig_from_base (6), flange_from_tool (6),
+  // [joint errors 0..J-1 (9)], per camera: intrinsics (12), cam_from_rig (6).
+  template <typename T>
+  bool operator()(T const* const* p, T* residuals) const {
+    const int nj = chain_->num_joints();
+    T q[kMaxJoints];
+    for (int j = 0; j < nj; ++j) {
+      q[j] = ModelJointValue<T>(chain_->rows[j].type, input_->q[j],
+                                input_->s[j], input_->tau[j],
+                                with_errors_ ? p[nj + 2 + j] : nullptr);
+    }
+    Mat4<T> m = Mat4<T>::Identity();
+    for (int j = 0; j < nj; ++j) {
+      m = m * RowTransform(chain_->convention, chain_->rows[j], p[j], q[j]);
+    }
+    // rig_from_tool = rig_from_base * base_from_flange * flange_from_tool.
+    Mat3T<T> r_rb, r_ft;
+    ceres::AngleAxisToRotationMatrix(p[nj], r_rb.data());
+    ceres::AngleAxisToRotationMatrix(p[nj + 1], r_ft.data());
+    const Vec3<T> t_rb(p[nj][3], p[nj][4], p[nj][5]);
+    const Vec3<T> t_ft(p[nj + 1][3], p[nj + 1][4], p[nj + 1][5]);
+    const Mat3T<T> r_bf = m.template block<3, 3>(0, 0);
+    const Vec3<T> t_bf = m.template block<3, 1>(0, 3);
+    const Mat3T<T> r_rf = r_rb * r_bf;
+    const Vec3<T> t_rf = r_rb * t_bf + t_rb;
+    const Mat3T<T> r_rt = r_rf * r_ft;
+    const Vec3<T> t_rt = r_rf * t_ft + t_rf;
+    const int cam0 = nj + 2 + (with_errors_ ? nj : 0);
+    Mat3T<T> r_cr[4];
+    Vec3<T> t_cr[4];
+    for (int c = 0; c < num_cameras_ && c < 4; ++c) {
+      const T* e = p[cam0 + 2 * c + 1];
+      Mat3T<T> r;
+      ceres::AngleAxisToRotationMatrix(e, r.data());
+      r_cr[c] = r * r_rt;
+      t_cr[c] = r * t_rt + Vec3<T>(e[3], e[4], e[5]);
+    }
+    const T c2(huber_ * huber_);
+    for (size_t i = 0; i < points_.size(); ++i) {
+      const int c = cameras_[i];
+      const Vec3<T> pc = r_cr[c] * points_[i].cast<T>() + t_cr[c];
+      T px[2];
+      if (!ProjectPoint(p[cam0 + 2 * c], pc.data(), px)) return false;
+      T rx = px[0] - T(pixels_[i].x());
+      T ry = px[1] - T(pixels_[i].y());
+      const T s = rx * rx + ry * ry;
+      if (s > c2) {
+        using std::sqrt;
+        const T r = sqrt(s);
+        const T f = sqrt(T(2) * T(huber_) * r - c2) / r;
+        rx *= f;
+        ry *= f;
+      }
+      residuals[2 * i] = rx;
+      residuals[2 * i + 1] = ry;
+    }
+    return true;
+  }
+
+ private:
+  const Chain* chain_;
+  const PoseInput* input_;
+  bool with_errors_;
+  int num_cameras_;
+  std::vector<Eigen::Vector3d> points_;
+  std::vector<int> cameras_;
+  std::vector<Eigen::Vector2d> pixels_;
+  double huber_;
+};
+
+// What is variable in one build of the problem.
+struct Freedom {
+  // Per joint row: indices that are free (empty = row constant).
+  std::vector<std::vector<int>> row_free;
+  // Per joint: error-model indices that are free.
+  std::vector<std::vector<int>> error_free;
+  bool frames = true;  // rig_from_base, flange_from_tool
+  bool cameras = false;
+  bool with_errors = false;  // error blocks present in the residuals
+};
+
+struct Built {
+  std::unique_ptr<ceres::Problem> problem;
+  std::vector<ceres::ResidualBlockId> blocks;  // per training frame
+  int residuals = 0;
+};
+
+void SetFree(ceres::Problem* problem, double* block, int size,
+             const std::vector<int>& free) {
+  if (free.empty()) {
+    problem->SetParameterBlockConstant(block);
+    return;
+  }
+  if (static_cast<int>(free.size()) == size) return;
+  std::vector<int> fixed;
+  for (int k = 0; k < size; ++k) {
+    if (std::find(free.begin(), free.end(), k) == free.end())
+      fixed.push_back(k);
+  }
+  problem->SetManifold(block, new ceres::SubsetManifold(size, fixed));
+}
+
+struct Obs {      // the fit's view of one frame
+  int index = 0;  // into frames
+  std::vector<Eigen::Vector3d> points;
+  std::vector<int> cameras;
+  std::vector<Eigen::Vector2d> pixels;
+  std::vector<int> tag_of;  // per corner: key camera * 1000 + tag index
+};
+
+Built Build(State* st, const std::vector<Obs>& obs,
+            const std::vector<PoseInput>& inputs, const Freedom& fr,
+            const BundleOptions& opt, const Rig& rig0) {
+  Built b;
+  ceres::Problem::Options po;
+  po.manifold_ownership = ceres::TAKE_OWNERSHIP;
+  b.problem = std::make_unique<ceres::Problem>(po);
+  ceres::Problem* problem = b.problem.get();
+  const int nj = st->chain.num_joints();
+  const int ncam = static_cast<int>(st->intrinsics.size());
+  std::vector<double*> params;
+  std::vector<int> sizes;
+  for (int j = 0; j < nj; ++j) {
+    params.push_back(st->chain.rows[j].p.data());
+    sizes.push_back(kRowBlockSize);
+  }
+  params.push_back(st->rig_from_base.data());
+  sizes.push_back(6);
+  params.push_back(st->flange_from_tool.data());
+  sizes.push_back(6);
+  if (fr.with_errors) {
+    for (int j = 0; j < nj; ++j) {
+      params.push_back(st->chain.joint_errors[j].data());
+      sizes.push_back(kJointErrorBlockSize);
+    }
+  }
+  for (int c = 0; c < ncam; ++c) {
+    params.push_back(st->intrinsics[c].data());
+    sizes.push_back(kNumIntrinsics);
+    params.push_back(st->cam_from_rig[c].data());
+    sizes.push_back(6);
+  }
+  for (const Obs& o : obs) {
+    auto* cost = new ceres::DynamicAutoDiffCostFunction<FrameCost, kStride>(
+        new FrameCost(&st->chain, &inputs[o.index], fr.with_errors, ncam,
+                      o.points, o.cameras, o.pixels, opt.huber_px));
+    for (int s : sizes) cost->AddParameterBlock(s);
+    cost->SetNumResiduals(2 * static_cast<int>(o.points.size()));
+    b.blocks.push_back(problem->AddResidualBlock(cost, nullptr, params));
+    b.residuals += 2 * static_cast<int>(o.points.size());
+  }
+  if (obs.empty()) return b;
+  for (int j = 0; j < nj; ++j) {
+    SetFree(problem, st->chain.rows[j].p.data(), kRowBlockSize, fr.row_free[j]);
+    if (fr.with_errors) {
+      SetFree(problem, st->chain.joint_errors[j].data(), kJointErrorBlockSize,
+              fr.error_free[j]);
+    }
+  }
+  if (!fr.frames) {
+    problem->SetParameterBlockConstant(st->rig_from_base.data());
+    problem->SetParameterBlockConstant(st->flange_from_tool.data());
+  }
+  for (int c = 0; c < ncam; ++c) {
+    double* intr = st->intrinsics[c].data();
+    double* ext = st->cam_from_rig[c].data();
+    if (!fr.cameras) {
+      problem->SetParameterBlockConstant(intr);
+      problem->SetParameterBlockConstant(ext);
+      continue;
+    }
+    const CameraIntrinsics& k0 = rig0.cameras[c].intrinsics;
+    const int nd = static_cast<int>(k0.distortion.size());
+    std::vector<int> free = {kFx, kFy, kCx, kCy};
+    for (int i = 0; i < nd && i < 8; ++i) free.push_back(kK1 + i);
+    SetFree(problem, intr, kNumIntrinsics, free);
+    const std::array<double, kNumIntrinsics> a0 = k0.ToArray();
+    Eigen::MatrixXd A = Eigen::MatrixXd::Zero(kNumIntrinsics, kNumIntrinsics);
+    Eigen::VectorXd b0(kNumIntrinsics);
+    for (int i = 0; i < kNumIntrinsics; ++i) {
+      b0[i] = a0[i];
+      const double sigma = i < kCx   ? opt.prior_focal_px
+                           : i < kK1 ? opt.prior_principal_px
+                                     : opt.prior_distortion;
+      A(i, i) = 1.0 / sigma;
+    }
+    problem->AddResidualBlock(new ceres::NormalPrior(A, b0), nullptr, intr);
+    if (c == 0) {  // the rig frame is the first camera's frame
+      problem->SetParameterBlockConstant(ext);
+    } else {
+      const std::array<double, 6> e0 = ToBlock(rig0.cameras[c].cam_from_rig);
+      Eigen::MatrixXd E = Eigen::MatrixXd::Zero(6, 6);
+      Eigen::VectorXd e(6);
+      for (int i = 0; i < 6; ++i) {
+        e[i] = e0[i];
+        E(i, i) = i < 3 ? 1.0 / (opt.prior_rotation_deg * M_PI / 180.0)
+                        : 1.0 / opt.prior_translation_mm;
+      }
+      problem->AddResidualBlock(new ceres::NormalPrior(E, e), nullptr, ext);
+    }
+  }
+  return b;
+}
+
+ceres::Solver::Summary Solve(ceres::Problem* problem, const BundleOptions& o) {
+  ceres::Solver::Options so;
+  so.linear_solver_type = ceres::DENSE_NORMAL_CHOLESKY;
+  so.trust_region_strategy_type = ceres::LEVENBERG_MARQUARDT;
+  so.max_num_iterations = o.max_iterations;
+  so.function_tolerance = 1e-10;
+  so.parameter_tolerance = 1e-10;
+  so.gradient_tolerance = 1e-12;
+  so.num_threads = o.num_threads;
+  so.logging_type = ceres::SILENT;
+  ceres::Solver::Summary summary;
+  ceres::Solve(so, problem, &summary);
+  return summary;
+}
+
+// Per-corner pixel residuals (without the Huber scaling) of frames `obs`.
+std::vector<double> CornerErrors(State* st, const std::vector<Obs>& obs,
+                                 const std::vector<PoseInput>& inputs,
+                                 bool with_errors, const Rig& rig0) {
+  std::vector<double> out;
+  if (obs.empty()) return out;
+  BundleOptions plain;
+  plain.huber_px = 1e12;
+  Freedom fr;
+  fr.row_free.assign(st->chain.num_joints(), {});
+  fr.error_free.assign(st->chain.num_joints(), {});
+  fr.frames = false;
+  fr.with_errors = with_errors;
+  Built b = Build(st, obs, inputs, fr, plain, rig0);
+  for (size_t i = 0; i < obs.size(); ++i) {
+    const ceres::CostFunction* cf =
+        b.problem->GetCostFunctionForResidualBlock(b.blocks[i]);
+    std::vector<double*> ps;
+    b.problem->GetParameterBlocksForResidualBlock(b.blocks[i], &ps);
+    std::vector<double> r(cf->num_residuals());
+    if (!cf->Evaluate(ps.data(), r.data(), nullptr)) {
+      for (size_t k = 0; k < r.size() / 2; ++k) out.push_back(1e6);
+      continue;
+    }
+    for (size_t k = 0; k + 1 < r.size(); k += 2) {
+      out.push_back(std::hypot(r[k], r[k + 1]));
+    }
+  }
+  return out;
+}
+
+double Rms(const std::vector<double>& v) {
+  if (v.empty()) return 0.0;
+  double s = 0;
+  for (double x : v) s += x * x;
+  return std::sqrt(s / v.size());
+}
+
+// A candidate parameter of the scan: its column in the evaluated Jacobian.
+struct Candidate {
+  std::string name;
+  int column = 0;
+  double bound = 0;  // admissible deviation (internal units), 0 = none
+  bool robot = true;
+  ParamInfo info;
+};
+
+Rigid3 BaseFromFlange(const Chain& chain, const PoseInput& in,
+                      bool with_errors) {
+  const int nj = chain.num_joints();
+  Mat4<double> m = Mat4<double>::Identity();
+  for (int j = 0; j < nj; ++j) {
+    const double q = ModelJointValue<double>(
+        chain.rows[j].type, in.q[j], in.s[j], in.tau[j],
+        with_errors ? chain.joint_errors[j].data() : nullptr);
+    m = m * RowTransform(chain.convention, chain.rows[j],
+                         chain.rows[j].p.data(), q);
+  }
+  Rigid3 r;
+  r.R = m.block<3, 3>(0, 0);
+  r.t = m.block<3, 1>(0, 3);
+  return r;
+}
+
+// The tool row's origin minus a wanted tip (3 residuals).
+struct ToolOrigin {
+  const ChainRow* row;
+  Convention conv;
+  Eigen::Vector3d tip;
+  template <typename T>
+  bool operator()(const T* p, T* r) const {
+    const Vec3<T> o = RowApply(conv, *row, p, T(0), Vec3<T>(T(0), T(0), T(0)));
+    for (int k = 0; k < 3; ++k) r[k] = o[k] - T(tip[k]);
+    return true;
+  }
+};
+
+// Sets the tool row so that its origin is `tip_in_flange`.
+void SetToolRow(const Eigen::Vector3d& tip, Chain* chain) {
+  ChainRow& row = chain->rows[chain->tool_row()];
+  if (chain->convention == Convention::kDh) {
+    // Rz(theta) Tz(d) Tx(a) Rx(alpha) Ry(beta): origin (a cos, a sin, d).
+    const double a = std::hypot(tip.x(), tip.y());
+    double theta = a > 1e-9 ? std::atan2(tip.y(), tip.x()) : row.p[0];
+    double sa = a;
+    // Keep the sign of a (and theta near its nominal value) when possible.
+    const double wrap = std::remainder(theta - row.p[0], 2 * M_PI);
+    if (std::abs(wrap) > M_PI / 2 && a > 1e-9) {
+      theta += M_PI;
+      sa = -a;
+    }
+    row.p[0] = row.p[0] + std::remainder(theta - row.p[0], 2 * M_PI);
+    row.p[1] = tip.z();
+    row.p[2] = sa;
+    return;
+  }
+  // Other conventions: least squares on the row's parameters from nominal.
+  ceres::Problem problem;
+  problem.AddResidualBlock(
+      new ceres::AutoDiffCostFunction<ToolOrigin, 3, kRowBlockSize>(
+          new ToolOrigin{&row, chain->convention, tip}),
+      nullptr, row.p.data());
+  if (chain->convention == Convention::kMdh) {
+    problem.SetManifold(row.p.data(),
+                        new ceres::SubsetManifold(kRowBlockSize, {0, 4, 5}));
+  } else {
+    problem.SetManifold(row.p.data(),
+                        new ceres::SubsetManifold(kRowBlockSize, {3, 4, 5}));
+  }
+  ceres::Solver::Options so;
+  so.logging_type = ceres::SILENT;
+  ceres::Solver::Summary s;
+  ceres::Solve(so, &problem, &s);
+}
+
+}  // namespace
+
+bool HandEyeStart(const std::vector<Rigid3>& base_from_flange,
+                  const std::vector<Rigid3>& rig_from_tool, Rigid3* x,
+                  Rigid3* y) {
+  const int n = static_cast<int>(base_from_flange.size());
+  if (n < 3 || rig_from_tool.size() != base_from_flange.size()) return false;
+  // RX RF_i = RT_i RY^T: [RF_i^T (x) I, -(I (x) RT_i)] [vec RX; vec RY^T] = 0.
+  Eigen::MatrixXd A(9 * n, 18);
+  const Eigen::Matrix3d I = Eigen::Matrix3d::Identity();
+  for (int i = 0; i < n; ++i) {
+    const Eigen::Matrix3d& rf = base_from_flange[i].R;
+    const Eigen::Matrix3d& rt = rig_from_tool[i].R;
+    for (int r = 0; r < 3; ++r) {
+      for (int c = 0; c < 3; ++c) {
+        A.block<3, 3>(9 * i + 3 * c, 3 * r) = rf(r, c) * I;  // rf^T(c, r)
+        A.block<3, 3>(9 * i + 3 * c, 9 + 3 * r) = -(I(c, r) * rt);
+      }
+    }
+  }
+  Eigen::JacobiSVD<Eigen::MatrixXd> svd(A, Eigen::ComputeFullV);
+  const Eigen::VectorXd sv = svd.singularValues();
+  // A unique solution leaves one (near) null direction.
+  if (!(sv(16) > 1e-3 * sv(0))) return false;
+  const Eigen::VectorXd v = svd.matrixV().col(17);
+  Eigen::Matrix3d rx = Eigen::Map<const Eigen::Matrix3d>(v.data());
+  Eigen::Matrix3d ryt = Eigen::Map<const Eigen::Matrix3d>(v.data() + 9);
+  const double det = rx.determinant();
+  if (std::abs(det) < 1e-12) return false;
+  const double scale = std::cbrt(det);
+  rx /= scale;
+  ryt /= scale;
+  auto project = [](const Eigen::Matrix3d& m) {
+    Eigen::JacobiSVD<Eigen::Matrix3d> s(
+        m, Eigen::ComputeFullU | Eigen::ComputeFullV);
+    Eigen::Matrix3d d = Eigen::Matrix3d::Identity();
+    d(2, 2) =
+        (s.matrixU() * s.matrixV().transpose()).determinant() < 0 ? -1 : 1;
+    return Eigen::Matrix3d(s.matrixU() * d * s.matrixV().transpose());
+  };
+  x->R = project(rx);
+  y->R = project(ryt).transpose();
+  // t_T = RX RF t_Y + t_X + RX t_F.
+  Eigen::MatrixXd M(3 * n, 6);
+  Eigen::VectorXd b(3 * n);
+  for (int i = 0; i < n; ++i) {
+    M.block<3, 3>(3 * i, 0) = x->R * base_from_flange[i].R;
+    M.block<3, 3>(3 * i, 3) = I;
+    b.segment<3>(3 * i) = rig_from_tool[i].t - x->R * base_from_flange[i].t;
+  }
+  const Eigen::VectorXd t = M.colPivHouseholderQr().solve(b);
+  y->t = t.head<3>();
+  x->t = t.tail<3>();
+  return x->R.allFinite() && y->R.allFinite() && t.allFinite();
+}
+
+Rigid3 ModelRigFromTool(const BundleResult& result, int index) {
+  const bool errors = result.chain.HasJointErrors();
+  return FromBlock(result.rig_from_base) *
+         BaseFromFlange(result.chain, result.inputs.at(index), errors) *
+         FromBlock(result.flange_from_tool);
+}
+
+BundleResult RunBundle(const Robot& nominal, const Rig& rig,
+                       const Target& target,
+                       const std::vector<BundleFrame>& frames,
+                       const BundleOptions& opt) {
+  const auto start = std::chrono::steady_clock::now();
+  BundleResult res;
+  res.frames = static_cast<int>(frames.size());
+  res.rig = rig;
+  State st;
+  st.chain = Chain::FromRobot(nominal);
+  const Chain nominal_chain = st.chain;
+  const int nj = st.chain.num_joints();
+  if (nj > kMaxJoints) throw InputError("bundle: more than 16 joints");
+  if (rig.cameras.size() > 4) throw InputError("bundle: more than 4 cameras");
+  for (const Camera& c : rig.cameras) {
+    st.intrinsics.push_back(c.intrinsics.ToArray());
+    st.cam_from_rig.push_back(ToBlock(c.cam_from_rig));
+  }
+  // Pose inputs (approach directions, torques) in frame order.
+  Observations ob;
+  ob.joint_names = nominal.JointNames();
+  for (const BundleFrame& f : frames) {
+    if (f.q_reading.size() != static_cast<size_t>(nj)) {
+      throw InputError("bundle: frame " + std::to_string(f.frame) + " has " +
+                       std::to_string(f.q_reading.size()) +
+                       " joint readings, the robot " + std::to_string(nj));
+    }
+    Observation o;
+    o.pose = std::to_string(f.frame);
+    o.q = f.q_reading;
+    o.t_s = f.t_s;
+    ob.rows.push_back(o);
+  }
+  res.inputs = MakePoseInputs(nominal_chain, ob);
+  // Extensions.
+  ModelState names_state;
+  names_state.chain = st.chain;
+  std::vector<ParamInfo> ext;
+  for (const std::string& name : opt.extensions) {
+    const ParamInfo p = FindParam(names_state, name);
+    if (p.kind != ParamKind::kJointError &&
+        !(p.kind == ParamKind::kRow && p.index == 4)) {
+      throw InputError("--extensions: '" + name +
+                       "' is not a joint error parameter (e.g. j3.backlash, "
+                       "j2.gain, j2.compliance, j3.cyclic_cos) or a beta");
+    }
+    ext.push_back(p);
+  }
+  bool with_errors = false;
+  for (const ParamInfo& p : ext)
+    with_errors |= p.kind == ParamKind::kJointError;
+  with_errors |= st.chain.HasJointErrors();
+
+  // Frames in the problem: joints and corners.
+  std::vector<int> usable;
+  for (size_t i = 0; i < frames.size(); ++i) {
+    if (!frames[i].corners.empty()) usable.push_back(static_cast<int>(i));
+  }
+  res.used_frames = static_cast<int>(usable.size());
+  // Seeded hold-out.
+  std::vector<int> order = usable;
+  std::mt19937_64 rng(opt.seed);
+  std::shuffle(order.begin(), order.end(), rng);
+  const int nh = static_cast<int>(
+      std::floor(opt.holdout_fraction * static_cast<double>(order.size())));
+  std::set<int> held(order.begin(), order.begin() + nh);
+  for (int i : usable) (held.count(i) ? res.heldout : res.train).push_back(i);
+  res.train_frames = static_cast<int>(res.train.size());
+  res.heldout_frames = static_cast<int>(res.heldout.size());
+
+  auto make_obs = [&](const std::vector<int>& idx,
+                      const std::set<int>& dropped) {
+    std::vector<Obs> out;
+    for (int i : idx) {
+      Obs o;
+      o.index = i;
+      for (const BundleCorner& c : frames[i].corners) {
+        const int key = (i * 8 + c.camera) * 1000 + c.tag;
+        if (dropped.count(key)) continue;
+        o.points.push_back(target.tags.at(c.tag).CornerInTool(c.corner));
+        o.cameras.push_back(c.camera);
+        o.pixels.push_back(c.px);
+        o.tag_of.push_back(key);
+      }
+      if (!o.points.empty()) out.push_back(std::move(o));
+    }
+    return out;
+  };
+  std::set<int> dropped;
+  std::vector<Obs> train = make_obs(res.train, dropped);
+
+  // Start: hand-eye from the tracked poses of training frames.
+  std::vector<Rigid3> bf, rt;
+  for (int i : res.train) {
+    const BundleFrame& f = frames[i];
+    if (!f.tracked || f.tracked_tags < opt.start_min_tags ||
+        f.tracked_rms_px > opt.start_max_rms_px) {
+      continue;
+    }
+    bf.push_back(BaseFromFlange(st.chain, res.inputs[i], false));
+    rt.push_back(f.rig_from_tool);
+  }
+  Rigid3 x, y;
+  if (!HandEyeStart(bf, rt, &x, &y)) {
+    throw InputError(
+        "bundle: " + std::to_string(bf.size()) +
+        " training frames with a well-tracked tool (>= " +
+        std::to_string(opt.start_min_tags) +
+        " tags); need at least 3 with different orientations to find where "
+        "the base is in the rig and where the target sits on the flange");
+  }
+  st.rig_from_base = ToBlock(x);
+  st.flange_from_tool = ToBlock(y);
+
+  Freedom fixed_robot;
+  fixed_robot.row_free.assign(nj, {});
+  fixed_robot.error_free.assign(nj, {});
+  fixed_robot.with_errors = with_errors;
+  res.start_reproj_rms_px =
+      Rms(CornerErrors(&st, train, res.inputs, with_errors, rig));
+  {  // Stage 1: the two frames with the nominal robot.
+    Built b = Build(&st, train, res.inputs, fixed_robot, opt, rig);
+    Solve(b.problem.get(), opt);
+  }
+
+  // Identifiability on the pixel Jacobian, all candidates free.
+  std::vector<ParamInfo> cand_info;
+  for (const ParamInfo& p : GeometryParams(st.chain)) {
+    if (p.block < st.chain.tool_row()) cand_info.push_back(p);
+  }
+  for (const ParamInfo& p : ext) cand_info.push_back(p);
+  Freedom all = fixed_robot;
+  for (const ParamInfo& p : cand_info) {
+    if (p.kind == ParamKind::kRow) all.row_free[p.block].push_back(p.index);
+    if (p.kind == ParamKind::kJointError) {
+      all.error_free[p.block].push_back(p.index);
+    }
+  }
+  std::vector<std::string> accepted;
+  Freedom fit = fixed_robot;
+  {
+    // Evaluate with every candidate block fully variable, columns per block.
+    Freedom eval = fixed_robot;
+    for (int j = 0; j < nj; ++j) {
+      eval.row_free[j] = {0, 1, 2, 3, 4, 5};
+      if (with_errors) {
+        eval.error_free[j].resize(kJointErrorBlockSize);
+        std::iota(eval.error_free[j].begin(), eval.error_free[j].end(), 0);
+      }
+    }
+    Built b = Build(&st, train, res.inputs, eval, opt, rig);
+    ceres::Problem::EvaluateOptions eo;
+    std::vector<double*> blocks = {st.rig_from_base.data(),
+                                   st.flange_from_tool.data()};
+    std::map<std::pair<int, int>, int> base;  // (kind, block) -> column
+    int col = 12;
+    for (int j = 0; j < nj; ++j) {
+      blocks.push_back(st.chain.rows[j].p.data());
+      base[{0, j}] = col;
+      col += kRowBlockSize;
+    }
+    if (with_errors) {
+      for (int j = 0; j < nj; ++j) {
+        blocks.push_back(st.chain.joint_errors[j].data());
+        base[{1, j}] = col;
+        col += kJointErrorBlockSize;
+      }
+    }
+    eo.parameter_blocks = blocks;
+    eo.residual_blocks = b.blocks;
+    eo.num_threads = opt.num_threads;
+    double cost = 0;
+    std::vector<double> residuals;
+    ceres::CRSMatrix crs;
+    b.problem->Evaluate(eo, &cost, &residuals, nullptr, &crs);
+    Eigen::MatrixXd J = Eigen::MatrixXd::Zero(crs.num_rows, crs.num_cols);
+    for (int r = 0; r < crs.num_rows; ++r) {
+      for (int k = crs.rows[r]; k < crs.rows[r + 1]; ++k) {
+        J(r, crs.cols[k]) = crs.values[k];
+      }
+    }
+    // Pixel noise for the statistical criterion: the per-frame tool pose
+    // fits (6 parameters per frame) see detection noise, not model error.
+    std::vector<double> tracked_rms;
+    for (int i : res.train) {
+      if (frames[i].tracked) tracked_rms.push_back(frames[i].tracked_rms_px);
+    }
+    double sigma_px = 0.1;
+    if (!tracked_rms.empty()) {
+      std::nth_element(tracked_rms.begin(),
+                       tracked_rms.begin() + tracked_rms.size() / 2,
+                       tracked_rms.end());
+      sigma_px = std::max(0.02, tracked_rms[tracked_rms.size() / 2]);
+    }
+    // Gram-Schmidt in priority order: the two frames, then candidates.
+    std::vector<Eigen::VectorXd> basis;
+    auto residual_part = [&](Eigen::VectorXd v) {
+      for (int pass = 0; pass < 2; ++pass) {
+        for (const Eigen::VectorXd& e : basis) v -= e.dot(v) * e;
+      }
+      return v;
+    };
+    for (int c = 0; c < 12; ++c) {
+      const Eigen::VectorXd v = J.col(c);
+      if (v.norm() == 0) continue;
+      const Eigen::VectorXd r = residual_part(v / v.norm());
+      if (r.norm() > opt.identifiability_tolerance)
+        basis.push_back(r.normalized());
+    }
+    for (const ParamInfo& p : cand_info) {
+      const int column =
+          base[{p.kind == ParamKind::kRow ? 0 : 1, p.block}] + p.index;
+      const Eigen::VectorXd v = J.col(column);
+      const double norm = v.norm();
+      bool ok = norm > 0;
+      if (ok) {
+        const Eigen::VectorXd r = residual_part(v / norm);
+        const double sine = r.norm();
+        ok = sine > opt.identifiability_tolerance;
+        if (ok && p.kind == ParamKind::kRow) {
+          const double bound =
+              p.angle ? st.chain.bound_angle_rad : st.chain.bound_length_mm;
+          const double cond_sigma = sigma_px / (norm * sine);
+          ok = cond_sigma < opt.max_sigma_fraction * bound;
+        }
+        if (ok) basis.push_back(r / sine);
+      }
+      if (ok) {
+        accepted.push_back(p.name);
+        if (p.kind == ParamKind::kRow) fit.row_free[p.block].push_back(p.index);
+        if (p.kind == ParamKind::kJointError) {
+          fit.error_free[p.block].push_back(p.index);
+        }
+      } else {
+        res.unidentifiable.push_back(p.name);
+      }
+    }
+  }
+  fit.cameras = opt.refine_cameras;
+
+  // Stage 2: the joint fit; then drop outlier tags and refit.
+  ceres::Solver::Summary summary;
+  for (int round = 0; round < 2; ++round) {
+    Built b = Build(&st, train, res.inputs, fit, opt, rig);
+    summary = Solve(b.problem.get(), opt);
+    if (round == 1) break;
+    // Per tag observation RMS.
+    const std::vector<double> e =
+        CornerErrors(&st, train, res.inputs, with_errors, rig);
+    std::map<int, std::pair<double, int>> per_tag;
+    size_t k = 0;
+    for (const Obs& o : train) {
+      for (size_t i = 0; i < o.points.size(); ++i, ++k) {
+        per_tag[o.tag_of[i]].first += e[k] * e[k];
+        per_tag[o.tag_of[i]].second += 1;
+      }
+    }
+    std::vector<double> rms;
+    for (auto& [key, v] : per_tag) rms.push_back(std::sqrt(v.first / v.second));
+    std::vector<double> sorted = rms;
+    std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2,
+                     sorted.end());
+    const double limit =
+        std::max(opt.outlier_px, opt.outlier_ratio * sorted[sorted.size() / 2]);
+    size_t t = 0;
+    for (auto& [key, v] : per_tag) {
+      if (rms[t++] > limit) dropped.insert(key);
+    }
+    if (dropped.empty()) break;
+    res.dropped_tags = static_cast<int>(dropped.size());
+    train = make_obs(res.train, dropped);
+  }
+  res.termination = summary.message;
+  res.iterations = static_cast<int>(summary.iterations.size());
+
+  // Covariance of the free parameters, scaled by the pixel noise estimate.
+  {
+    Built b = Build(&st, train, res.inputs, fit, opt, rig);
+    int nfree = 12;
+    for (const auto& r : fit.row_free) nfree += static_cast<int>(r.size());
+    for (const auto& r : fit.error_free) nfree += static_cast<int>(r.size());
+    double cost = 0;
+    b.problem->Evaluate(ceres::Problem::EvaluateOptions(), &cost, nullptr,
+                        nullptr, nullptr);
+    res.sigma0_px = std::sqrt(2 * cost / std::max(1, b.residuals - nfree));
+    ceres::Covariance::Options co;
+    co.algorithm_type = ceres::DENSE_SVD;
+    co.null_space_rank = -1;
+    co.num_threads = opt.num_threads;
+    ceres::Covariance cov(co);
+    std::vector<std::pair<const double*, const double*>> pairs;
+    std::vector<const double*> row_blocks;
+    for (int j = 0; j < nj; ++j) {
+      if (!fit.row_free[j].empty()) {
+        pairs.push_back({st.chain.rows[j].p.data(), st.chain.rows[j].p.data()});
+      }
+      if (with_errors && !fit.error_free[j].empty()) {
+        pairs.push_back(
+            {st.chain.joint_errors[j].data(), st.chain.joint_errors[j].data()});
+      }
+    }
+    const bool have_cov = !pairs.empty() && cov.Compute(pairs, b.problem.get());
+    const double s2 = res.sigma0_px * res.sigma0_px;
+    for (const ParamInfo& p : cand_info) {
+      if (std::find(accepted.begin(), accepted.end(), p.name) ==
+          accepted.end()) {
+        continue;
+      }
+      BundleParam bp;
+      bp.name = p.name;
+      ModelState ms;
+      ms.chain = st.chain;
+      bp.value = p.ToInterface(ParamValue(ms, p));
+      bp.sigma = std::numeric_limits<double>::quiet_NaN();
+      if (have_cov) {
+        const int size =
+            p.kind == ParamKind::kRow ? kRowBlockSize : kJointErrorBlockSize;
+        const double* blk = p.kind == ParamKind::kRow
+                                ? st.chain.rows[p.block].p.data()
+                                : st.chain.joint_errors[p.block].data();
+        std::vector<double> c(size * size);
+        if (cov.GetCovarianceBlock(blk, blk, c.data())) {
+          const double var = c[p.index * size + p.index] * s2;
+          bp.sigma = std::abs(p.ToInterface(std::sqrt(std::max(0.0, var))));
+        }
+      }
+      res.params.push_back(bp);
+    }
+  }
+
+  // Training and held-out statistics.
+  res.reproj_rms_px =
+      Rms(CornerErrors(&st, train, res.inputs, with_errors, rig));
+  res.corners = 0;
+  for (const Obs& o : train) res.corners += static_cast<int>(o.points.size());
+  const std::vector<Obs> heldout = make_obs(res.heldout, {});
+  res.heldout_reproj_rms_px =
+      Rms(CornerErrors(&st, heldout, res.inputs, with_errors, rig));
+
+  // Results: the tool row from the tip, the refined rig.
+  const Rigid3 ft = FromBlock(st.flange_from_tool);
+  SetToolRow(ft * target.tip_in_tool, &st.chain);
+  if (!with_errors) {
+    for (auto& e : st.chain.joint_errors) e.fill(0.0);
+  }
+  res.chain = st.chain;
+  res.calibrated = st.chain.ToRobot(nominal);
+  res.rig_from_base = st.rig_from_base;
+  res.flange_from_tool = st.flange_from_tool;
+  for (size_t c = 0; c < rig.cameras.size(); ++c) {
+    const int nd =
+        static_cast<int>(rig.cameras[c].intrinsics.distortion.size());
+    CameraIntrinsics k =
+        CameraIntrinsics::FromArray(st.intrinsics[c].data(), nd);
+    k.name = rig.cameras[c].intrinsics.name;
+    k.width = rig.cameras[c].intrinsics.width;
+    k.height = rig.cameras[c].intrinsics.height;
+    res.rig.cameras[c].intrinsics = k;
+    res.rig.cameras[c].cam_from_rig =
+        c == 0 ? rig.cameras[0].cam_from_rig : FromBlock(st.cam_from_rig[c]);
+  }
+  std::vector<double> tip_err;
+  for (int i : res.heldout) {
+    const BundleFrame& f = frames[i];
+    if (!f.tracked || f.tracked_tags < opt.start_min_tags) continue;
+    const Eigen::Vector3d model = ModelRigFromTool(res, i) * target.tip_in_tool;
+    const Eigen::Vector3d seen = f.rig_from_tool * target.tip_in_tool;
+    tip_err.push_back((model - seen).norm());
+  }
+  res.heldout_tips = static_cast<int>(tip_err.size());
+  res.heldout_tip_rms_mm = Rms(tip_err);
+
+  // Names: the two frames and the tool row are determined by construction.
+  const char* fn[6] = {"rx", "ry", "rz", "tx", "ty", "tz"};
+  for (int k = 0; k < 6; ++k) {
+    res.identifiable.push_back(std::string("frame.") + fn[k]);
+  }
+  for (int k = 0; k < 6; ++k) {
+    res.identifiable.push_back(std::string("flange_from_target.") + fn[k]);
+  }
+  for (const std::string& a : accepted) res.identifiable.push_back(a);
+  for (const ParamInfo& p : GeometryParams(st.chain)) {
+    if (p.block != st.chain.tool_row()) continue;
+    const bool position = st.chain.convention == Convention::kMdh
+                              ? p.index >= 1 && p.index <= 3
+                              : p.index < 3;
+    (position ? res.identifiable : res.unidentifiable).push_back(p.name);
+  }
+  res.seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start)
+          .count();
+  return res;
+}
+
+}  // namespace kincal

@@ -1,0 +1,147 @@
+#ifndef KINCAL_BUNDLE_BUNDLE_H_
+#define KINCAL_BUNDLE_BUNDLE_H_
+
+// The image bundle: one Ceres problem from tag corners to robot parameters.
+//
+// For frame f with joint readings q_f, tag corner X (in the tool frame of
+// target.yaml) seen by camera c at pixel u:
+//
+//   u = project_c( cam_from_rig_c * rig_from_base * base_from_flange(q_f)
+//                  * flange_from_tool * X )
+//
+// base_from_flange is the robot's chain without its tool row (calib/chain.h,
+// RowTransform and ModelJointValue, so the joint error models of `diagnose`
+// apply); project_c is camcal's ProjectPoint. Unknowns: the identifiable
+// geometry of the joint rows, rig_from_base, flange_from_tool, optionally
+// extension parameters (e.g. j3.backlash) and the cameras (with priors).
+// The needle tip follows from target.yaml: tip_in_flange = flange_from_tool *
+// tip_in_tool, which fixes the tool row of the calibrated robot.
+//
+// Residuals are pixels with a per-corner Huber loss (applied inside the
+// frame's residual block, so one frame's FK is computed once for all its
+// corners). Identifiability: the pixel Jacobian, columns scaled to unit norm,
+// scanned with Gram-Schmidt in priority order (rig_from_base and
+// flange_from_tool first, then the rows in chain order), as calibrate does on
+// tip residuals (calib/identifiability.h).
+
+#include <Eigen/Core>
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "calib/chain.h"
+#include "calib/model_state.h"
+#include "camcal/rig.h"
+#include "data/robot.h"
+#include "vision/target.h"
+
+namespace kincal {
+
+// One detected tag corner.
+struct BundleCorner {
+  int camera = 0;
+  int tag = 0;     // index into Target::tags
+  int corner = 0;  // 0..3, libapriltag order
+  Eigen::Vector2d px = Eigen::Vector2d::Zero();
+};
+
+// One frame with joint readings and the corners seen in it.
+struct BundleFrame {
+  int frame = 0;                  // frame number in the session
+  std::vector<double> q_reading;  // robot joint order, mm | deg
+  double t_s = 0.0;
+  std::vector<BundleCorner> corners;
+  // The tracker's tool pose of this frame (start values, held-out tips).
+  bool tracked = false;
+  Rigid3 rig_from_tool;
+  double tracked_rms_px = 0.0;
+  int tracked_tags = 0;
+};
+
+struct BundleOptions {
+  double holdout_fraction = 0.2;  // frames held out of the fit
+  uint64_t seed = 1;
+  double huber_px = 1.0;  // per-corner Huber scale
+  // Tag observations whose RMS after the first fit exceeds
+  // max(outlier_px, outlier_ratio * median) are dropped, then the fit redone.
+  double outlier_px = 1.0;
+  double outlier_ratio = 5.0;
+  // Start values: tracked poses with at least this many tags and at most
+  // this RMS take part in the hand-eye start.
+  int start_min_tags = 2;
+  double start_max_rms_px = 1.0;
+  // Gram-Schmidt tolerance (sine of the angle to the span), and the
+  // statistical criterion of calibrate: a parameter whose predicted sigma
+  // given the earlier ones exceeds max_sigma_fraction of its bound is held.
+  double identifiability_tolerance = 1e-6;
+  double max_sigma_fraction = 0.1;
+  // Extension parameters to fit besides the geometry ("j3.backlash", ...).
+  std::vector<std::string> extensions;
+  // Cameras: refine intrinsics (fx, fy, cx, cy, the file's distortion) and
+  // the other cameras' cam_from_rig, with Gaussian priors at rig.yaml.
+  bool refine_cameras = false;
+  double prior_focal_px = 2.0;
+  double prior_principal_px = 2.0;
+  double prior_distortion = 0.005;
+  double prior_rotation_deg = 0.02;
+  double prior_translation_mm = 0.2;
+  int max_iterations = 100;
+  int num_threads = 1;
+};
+
+struct BundleParam {
+  std::string name;
+  double value = 0.0;  // interface units (mm, deg, 1)
+  double sigma = 0.0;  // 1-sigma, interface units; NaN when unknown
+};
+
+struct BundleResult {
+  Chain chain;       // fitted (tool row set from the tip)
+  Robot calibrated;  // chain.ToRobot(nominal)
+  Rig rig;           // refined cameras (= input without refine)
+  std::array<double, 6> rig_from_base{};     // [angle-axis rad, t mm]
+  std::array<double, 6> flange_from_tool{};  // [angle-axis rad, t mm]
+  std::vector<BundleParam> params;           // free parameters with sigma
+  std::vector<std::string> identifiable, unidentifiable;
+  std::vector<std::string> relations;  // why each is unidentifiable
+  int frames = 0;                      // frames given
+  int used_frames = 0;                 // with joints and corners
+  int train_frames = 0, heldout_frames = 0;
+  int corners = 0;                   // training corners in the final fit
+  int dropped_tags = 0;              // tag observations dropped as outliers
+  double start_reproj_rms_px = 0.0;  // after the hand-eye start
+  double reproj_rms_px = 0.0;        // training, final
+  double heldout_reproj_rms_px = 0.0;
+  double heldout_tip_rms_mm = 0.0;  // model tip vs tracked tip
+  int heldout_tips = 0;
+  double sigma0_px = 0.0;           // noise estimate per pixel coordinate
+  std::vector<int> train, heldout;  // indices into the frames given
+  std::vector<PoseInput> inputs;    // per frame given (s, tau for errors)
+  std::string termination;
+  int iterations = 0;
+  double seconds = 0.0;
+};
+
+// Runs the bundle. Throws InputError when the frames cannot determine a
+// start (fewer than 3 tracked frames with distinct rotations) or a name in
+// options.extensions is unknown.
+BundleResult RunBundle(const Robot& nominal, const Rig& rig,
+                       const Target& target,
+                       const std::vector<BundleFrame>& frames,
+                       const BundleOptions& options);
+
+// The model's needle tip / tool pose in the rig frame for one frame.
+Rigid3 ModelRigFromTool(const BundleResult& result, int index);
+
+// Closed-form hand-eye start: X = rig_from_base, Y = flange_from_tool with
+// rig_from_tool_i = X * base_from_flange_i * Y (linear in the rotations,
+// projected onto SO(3), then linear least squares for the translations).
+// False when the rotations do not determine X and Y.
+bool HandEyeStart(const std::vector<Rigid3>& base_from_flange,
+                  const std::vector<Rigid3>& rig_from_tool, Rigid3* x,
+                  Rigid3* y);
+
+}  // namespace kincal
+
+#endif  // KINCAL_BUNDLE_BUNDLE_H_

@@ -1,0 +1,124 @@
+#include "bundle/bundle.h"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+#include "bundle/synthetic.h"
+#include "calib/model_state.h"
+#include "data/error.h"
+#include "data/robot.h"
+#include "synth/render.h"
+#include "synth/simulate.h"
+#include "tests/testing/paths.h"
+
+namespace kincal {
+namespace {
+
+Robot Bh7() {
+  return ReadRobotYaml(testing::SourceDir() + "/data/robots/bh7.yaml");
+}
+
+TEST(HandEye, RecoversBothTransformsFromExactPoses) {
+  std::mt19937_64 rng(3);
+  std::normal_distribution<double> n(0, 1);
+  auto random_rigid = [&] {
+    Rigid3 r;
+    Eigen::Vector3d w(n(rng), n(rng), n(rng));
+    r.R = Eigen::AngleAxisd(w.norm(), w.normalized()).toRotationMatrix();
+    r.t = Eigen::Vector3d(n(rng), n(rng), n(rng)) * 100;
+    return r;
+  };
+  const Rigid3 x = random_rigid(), y = random_rigid();
+  std::vector<Rigid3> bf, rt;
+  for (int i = 0; i < 6; ++i) {
+    bf.push_back(random_rigid());
+    rt.push_back(x * bf.back() * y);
+  }
+  Rigid3 xe, ye;
+  ASSERT_TRUE(HandEyeStart(bf, rt, &xe, &ye));
+  EXPECT_LT((xe.R - x.R).norm(), 1e-9);
+  EXPECT_LT((ye.R - y.R).norm(), 1e-9);
+  EXPECT_LT((xe.t - x.t).norm(), 1e-6);
+  EXPECT_LT((ye.t - y.t).norm(), 1e-6);
+  // All rotations about one axis leave the problem undetermined.
+  std::vector<Rigid3> bf1, rt1;
+  for (int i = 0; i < 6; ++i) {
+    Rigid3 r;
+    r.R =
+        Eigen::AngleAxisd(0.3 * i, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+    r.t = Eigen::Vector3d(i, 2 * i, 0);
+    bf1.push_back(r);
+    rt1.push_back(x * r * y);
+  }
+  EXPECT_FALSE(HandEyeStart(bf1, rt1, &xe, &ye));
+}
+
+// Exact corners (no noise): the bundle must reach the truth's reprojection
+// floor and put the tips where the true robot puts them.
+TEST(Bundle, ExactCornersGiveTheTrueTips) {
+  SyntheticBundleOptions so;
+  so.frames = 60;
+  so.noise_px = 0.0;
+  so.seed = 5;
+  const SyntheticBundle s = MakeSyntheticBundle(Bh7(), so);
+  BundleOptions o;
+  const BundleResult r = RunBundle(s.nominal, s.rig, s.target, s.frames, o);
+  EXPECT_LT(r.reproj_rms_px, 1e-3);
+  EXPECT_LT(r.heldout_reproj_rms_px, 1e-3);
+  EXPECT_EQ(r.dropped_tags, 0);
+  // Tips of the calibrated robot vs the true ones, up to the base frame.
+  EXPECT_LT(TipRmsAgainstTruth(s, r.calibrated, 100, 9), 1e-3);
+}
+
+// Noisy corners: parameter errors against the truth are within 1.5x of the
+// sigma the bundle reports (Monte Carlo over seeds; only the parameters the
+// bundle estimates deviate from nominal, so truth and estimate are the same
+// quantities).
+TEST(Bundle, ReportedSigmaMatchesTheSpreadOverSeeds) {
+  double sum_z2 = 0;
+  int n = 0;
+  for (int seed = 1; seed <= 8; ++seed) {
+    SyntheticBundleOptions so;
+    so.frames = 80;
+    so.noise_px = 0.1;
+    so.seed = 100 + seed;
+    so.only_identifiable = true;
+    const SyntheticBundle s = MakeSyntheticBundle(Bh7(), so);
+    BundleOptions o;
+    o.holdout_fraction = 0.0;
+    const BundleResult r = RunBundle(s.nominal, s.rig, s.target, s.frames, o);
+    ModelState truth;
+    truth.chain = Chain::FromRobot(s.truth);
+    for (const BundleParam& p : r.params) {
+      const ParamInfo info = FindParam(truth, p.name);
+      const double t = info.ToInterface(ParamValue(truth, info));
+      ASSERT_TRUE(std::isfinite(p.sigma)) << p.name;
+      const double z = (p.value - t) / p.sigma;
+      sum_z2 += z * z;
+      ++n;
+    }
+  }
+  ASSERT_GT(n, 20);
+  const double rms_z = std::sqrt(sum_z2 / n);
+  // 1 when the sigma is right; the claim is within 1.5x either way.
+  EXPECT_LT(rms_z, 1.5);
+  EXPECT_GT(rms_z, 1 / 1.5);
+  RecordProperty("rms_z", std::to_string(rms_z));
+  std::printf("RMS of (estimate - truth) / sigma over %d parameters: %.3f\n", n,
+              rms_z);
+}
+
+TEST(Bundle, TooFewTrackedFramesIsBadInput) {
+  SyntheticBundleOptions so;
+  so.frames = 2;
+  const SyntheticBundle s = MakeSyntheticBundle(Bh7(), so);
+  BundleOptions o;
+  o.holdout_fraction = 0;
+  EXPECT_THROW(RunBundle(s.nominal, s.rig, s.target, s.frames, o), InputError);
+}
+
+}  // namespace
+}  // namespace kincal

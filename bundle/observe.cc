@@ -1,0 +1,105 @@
+#include "bundle/observe.h"
+
+#include <chrono>
+#include <opencv2/imgcodecs.hpp>
+#include <sstream>
+#include <thread>
+
+#include "data/error.h"
+
+namespace kincal {
+namespace {
+
+cv::Mat ReadGray(const std::string& path, const CameraIntrinsics& cam) {
+  const cv::Mat im = cv::imread(path, cv::IMREAD_GRAYSCALE);
+  if (im.empty()) {
+    throw InputError(path +
+                     ": cannot read the image (not an image file, or "
+                     "truncated)");
+  }
+  if (im.cols != cam.width || im.rows != cam.height) {
+    std::ostringstream os;
+    os << path << ": image is " << im.cols << "x" << im.rows << " but camera '"
+       << cam.name << "' in the rig is " << cam.width << "x" << cam.height;
+    throw InputError(os.str());
+  }
+  return im;
+}
+
+}  // namespace
+
+SessionObservations ObserveSession(const Session& session, const Rig& rig,
+                                   const Target& target,
+                                   const ObserveOptions& options) {
+  const auto start = std::chrono::steady_clock::now();
+  if (rig.cameras.size() != 2) {
+    throw InputError("a recorded session has two cameras; the rig has " +
+                     std::to_string(rig.cameras.size()));
+  }
+  SessionObservations out;
+  out.session_frames = static_cast<int>(session.frames.size());
+  AprilTagOptions dopt = options.detector;
+  dopt.family = target.family;
+  dopt.Check();
+  AprilTagDetector detectors[2] = {AprilTagDetector(dopt),
+                                   AprilTagDetector(dopt)};
+  int done = 0;
+  const int total = session.CountWithJoints();
+  for (const SessionFrame& sf : session.frames) {
+    if (!sf.HasJoints()) {
+      ++out.without_joints;
+      continue;
+    }
+    std::vector<std::vector<TagDetection>> dets(2);
+    std::string error[2];
+    const std::string* files[2] = {&sf.left_image, &sf.right_image};
+    auto work = [&](int c) {
+      try {
+        dets[c] =
+            detectors[c].Detect(ReadGray(*files[c], rig.cameras[c].intrinsics));
+      } catch (const std::exception& e) {
+        error[c] = e.what();
+      }
+    };
+    std::thread t1(work, 1);
+    work(0);
+    t1.join();
+    for (int c = 0; c < 2; ++c) {
+      if (!error[c].empty()) throw InputError(error[c]);
+    }
+    BundleFrame f;
+    f.frame = sf.frame;
+    f.q_reading = sf.q;
+    f.t_s = sf.t_left;
+    const ToolPoseResult r = EstimateToolPose(rig, target, dets, options.pose);
+    if (r.found) {
+      f.tracked = true;
+      f.rig_from_tool = r.rig_from_tool;
+      f.tracked_rms_px = r.rms_px;
+      f.tracked_tags = r.tags_used;
+      for (const TagObservationResult& t : r.tags) {
+        if (!t.used) continue;
+        int tag_index = -1;
+        for (size_t k = 0; k < target.tags.size(); ++k) {
+          if (target.tags[k].id == t.tag_id) tag_index = static_cast<int>(k);
+        }
+        if (tag_index < 0) continue;
+        for (int k = 0; k < 4; ++k) {
+          if (t.corner_used[k]) {
+            f.corners.push_back({t.camera, tag_index, k, t.corners_px[k]});
+          }
+        }
+      }
+    }
+    if (f.corners.empty()) ++out.without_tags;
+    out.frames.push_back(std::move(f));
+    ++done;
+    if (options.progress) options.progress(done, total);
+  }
+  out.seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start)
+          .count();
+  return out;
+}
+
+}  // namespace kincal

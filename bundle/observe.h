@@ -1,0 +1,46 @@
+#ifndef KINCAL_BUNDLE_OBSERVE_H_
+#define KINCAL_BUNDLE_OBSERVE_H_
+
+// The bundle's observations from a recorded session: every frame with joint
+// readings is read (both cameras in parallel), its tags detected at full
+// frame (vision/apriltag_detector.h) and the tool pose fitted per frame
+// (vision/tool_pose.h) for start values and held-out tips. Tag observations
+// that the per-frame pose fit rejects as outliers are left out.
+
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "bundle/bundle.h"
+#include "camcal/rig.h"
+#include "data/session.h"
+#include "vision/apriltag_detector.h"
+#include "vision/target.h"
+#include "vision/tool_pose.h"
+
+namespace kincal {
+
+struct ObserveOptions {
+  AprilTagOptions detector;  // family is taken from the target
+  ToolPoseOptions pose;
+  // Progress: called after each frame with (done, total).
+  std::function<void(int, int)> progress;
+};
+
+struct SessionObservations {
+  std::vector<BundleFrame> frames;  // frames with joint readings, in order
+  int session_frames = 0;
+  int without_joints = 0;
+  int without_tags = 0;  // frames with joints where no target tag was seen
+  double seconds = 0.0;
+};
+
+// Throws InputError naming an image that cannot be read or whose size
+// differs from its camera's in the rig.
+SessionObservations ObserveSession(const Session& session, const Rig& rig,
+                                   const Target& target,
+                                   const ObserveOptions& options);
+
+}  // namespace kincal
+
+#endif  // KINCAL_BUNDLE_OBSERVE_H_

@@ -1,0 +1,201 @@
+#include "bundle/synthetic.h"
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <random>
+
+#include "calib/evaluate.h"
+#include "data/error.h"
+#include "synth/render.h"
+#include "vision/apriltag_detector.h"
+#include "vision/tool_pose.h"
+
+namespace kincal {
+namespace {
+
+Rigid3 ToRigid(const Eigen::Matrix4d& m) {
+  Rigid3 r;
+  r.R = m.block<3, 3>(0, 0);
+  r.t = m.block<3, 1>(0, 3);
+  return r;
+}
+
+// Tool frame relative to the needle tip frame (as `simulate --render`): the
+// needle (tip z) runs along tool y, tool z (into the tags) along tip x.
+Rigid3 TipFromTool(const Target& target) {
+  Rigid3 r;
+  r.R << 0, 0, 1, 1, 0, 0, 0, 1, 0;
+  r.t = -(r.R * target.tip_in_tool);
+  return r;
+}
+
+// rig_from_base looking at the tips' centroid along the mean tag normal,
+// at a distance where the workspace fills ~80 % of the view.
+Rigid3 PlaceRig(const std::vector<Eigen::Matrix4d>& base_from_tip,
+                const Rig& rig, const Rigid3& tip_from_tool) {
+  Eigen::Vector3d centroid = Eigen::Vector3d::Zero(),
+                  mean_z = Eigen::Vector3d::Zero();
+  for (const Eigen::Matrix4d& m : base_from_tip) {
+    centroid += m.block<3, 1>(0, 3);
+    mean_z += m.block<3, 3>(0, 0) * tip_from_tool.R.col(2);
+  }
+  centroid /= static_cast<double>(base_from_tip.size());
+  const Eigen::Vector3d z =
+      mean_z.norm() > 1e-6 ? mean_z.normalized() : Eigen::Vector3d(0, 0, -1);
+  const Eigen::Vector3d e = std::abs(z.z()) < 0.9 ? Eigen::Vector3d::UnitZ()
+                                                  : Eigen::Vector3d::UnitX();
+  const Eigen::Vector3d x = z.cross(e).normalized();
+  const Eigen::Vector3d y = z.cross(x);
+  const CameraIntrinsics& cam = rig.cameras.at(0).intrinsics;
+  const double tan_half =
+      0.8 * std::min(cam.width / (2.0 * cam.fx), cam.height / (2.0 * cam.fy));
+  double distance = 450;
+  for (const Eigen::Matrix4d& m : base_from_tip) {
+    const Eigen::Vector3d d = m.block<3, 1>(0, 3) - centroid;
+    distance = std::max(distance,
+                        std::hypot(d.dot(x), d.dot(y)) / tan_half - d.dot(z));
+  }
+  Rigid3 base_from_rig;
+  base_from_rig.R.col(0) = x;
+  base_from_rig.R.col(1) = y;
+  base_from_rig.R.col(2) = z;
+  base_from_rig.t = centroid - distance * z;
+  return base_from_rig.Inverse();
+}
+
+}  // namespace
+
+Target ThreeTagHolder(double s, const std::string& family) {
+  Target t;
+  t.family = family;
+  const double turn = 35.0 * M_PI / 180.0;
+  const double gap = 2.0;
+  for (int i = 0; i < 3; ++i) {
+    TargetTag tag;
+    tag.id = i;
+    tag.size_mm = s;
+    // Middle tag flat at the origin; the outer ones hinged at its edges.
+    // The printed squares (black square, white ring, any outer data ring)
+    // touch along the hinge, but for the gap.
+    const double half = 0.5 * s * TagImage(family, 0).cols /
+                        TagBlackSquareCells(family);  // half printed width
+    if (i == 1) {
+      tag.tool_from_tag.t = Eigen::Vector3d::Zero();
+    } else {
+      const double sign = i == 0 ? -1.0 : 1.0;
+      const double a = sign * turn;
+      tag.tool_from_tag.R =
+          Eigen::AngleAxisd(-a, Eigen::Vector3d::UnitY()).toRotationMatrix();
+      // Hinge at x = sign * (half + gap / 2), z = 0; the tag centre lies a
+      // further `half` along the turned x axis.
+      const Eigen::Vector3d hinge(sign * (half + gap / 2), 0, 0);
+      tag.tool_from_tag.t =
+          hinge + tag.tool_from_tag.R * Eigen::Vector3d(sign * half, 0, 0);
+    }
+    t.tags.push_back(tag);
+  }
+  t.tip_in_tool = Eigen::Vector3d(0, 4 * s, 10);
+  return t;
+}
+
+SyntheticBundle MakeSyntheticBundle(const Robot& nominal,
+                                    const SyntheticBundleOptions& o) {
+  SyntheticBundle s;
+  s.nominal = nominal;
+  s.rig = ExampleStereoRig(o.width, o.height);
+  s.target = ThreeTagHolder(o.tag_size_mm);
+  SimulateOptions so;
+  so.poses = std::max(o.frames, 3);
+  so.noise_mm = 0;
+  so.seed = o.seed;
+  so.effects = o.effects;
+  if (o.only_identifiable) {
+    // Which parameters does the bundle identify here? Ask it on exact data.
+    SyntheticBundleOptions probe = o;
+    probe.only_identifiable = false;
+    probe.noise_px = 0;
+    probe.frames = std::max(o.frames, 30);
+    const SyntheticBundle p = MakeSyntheticBundle(nominal, probe);
+    BundleOptions bo;
+    bo.holdout_fraction = 0;
+    const BundleResult r = RunBundle(p.nominal, p.rig, p.target, p.frames, bo);
+    for (const BundleParam& bp : r.params) so.perturbed.push_back(bp.name);
+  }
+  const SimulatedSession sim = Simulate(nominal, so);
+  s.truth = sim.truth;
+  const Rigid3 tip_from_tool = TipFromTool(s.target);
+  s.rig_from_base = PlaceRig(sim.base_from_tip, s.rig, tip_from_tool);
+  // flange_from_tool = flange_from_tip * tip_from_tool, where flange_from_tip
+  // is the truth's tool row.
+  const Chain truth = Chain::FromRobot(s.truth);
+  const ChainRow& tool = truth.rows[truth.tool_row()];
+  const Eigen::Matrix4d flange_from_tip =
+      RowTransform<double>(truth.convention, tool, tool.p.data(), 0.0);
+  s.flange_from_tool = ToRigid(flange_from_tip) * tip_from_tool;
+
+  std::mt19937_64 rng(o.seed * 7919 + 17);
+  std::normal_distribution<double> noise(0.0, 1.0);
+  for (int f = 0; f < o.frames; ++f) {
+    const Observation& row = sim.observations.rows[f];
+    BundleFrame bf;
+    bf.frame = f;
+    bf.q_reading = row.q;
+    bf.t_s = row.HasTime() ? row.t_s : 0.0;
+    const Rigid3 rig_from_tool =
+        s.rig_from_base * ToRigid(sim.base_from_tip[f]) * tip_from_tool;
+    std::vector<std::vector<TagDetection>> dets(s.rig.cameras.size());
+    for (size_t c = 0; c < s.rig.cameras.size(); ++c) {
+      const Camera& cam = s.rig.cameras[c];
+      for (size_t k = 0; k < s.target.tags.size(); ++k) {
+        const TargetTag& tag = s.target.tags[k];
+        const Rigid3 cam_from_tag =
+            cam.cam_from_rig * rig_from_tool * tag.tool_from_tag;
+        if (o.respect_facing && cam_from_tag.Inverse().t.z() >= 0) continue;
+        TagDetection d;
+        d.id = tag.id;
+        bool inside = true;
+        for (int i = 0; i < 4; ++i) {
+          const Eigen::Vector3d p =
+              cam_from_tag * TagCornerInTag(i, tag.size_mm);
+          Eigen::Vector2d px = Project(cam.intrinsics, p);
+          inside = inside && p.z() > 0 && px.allFinite() && px.x() >= 0 &&
+                   px.y() >= 0 && px.x() <= cam.intrinsics.width - 1 &&
+                   px.y() <= cam.intrinsics.height - 1;
+          px += o.noise_px * Eigen::Vector2d(noise(rng), noise(rng));
+          d.corners[i] = px;
+        }
+        if (inside) dets[c].push_back(d);
+      }
+    }
+    const ToolPoseResult r = EstimateToolPose(s.rig, s.target, dets);
+    if (r.found) {
+      bf.tracked = true;
+      bf.rig_from_tool = r.rig_from_tool;
+      bf.tracked_rms_px = r.rms_px;
+      bf.tracked_tags = r.tags_used;
+    }
+    for (size_t c = 0; c < dets.size(); ++c) {
+      for (const TagDetection& d : dets[c]) {
+        for (int i = 0; i < 4; ++i) {
+          bf.corners.push_back({static_cast<int>(c), d.id, i, d.corners[i]});
+        }
+      }
+    }
+    s.frames.push_back(std::move(bf));
+  }
+  return s;
+}
+
+double TipRmsAgainstTruth(const SyntheticBundle& s, const Robot& robot,
+                          int poses, uint64_t seed) {
+  SimulateOptions so;
+  so.poses = poses;
+  so.noise_mm = 0;
+  so.sigma_length_mm = 0;
+  so.sigma_angle_deg = 0;
+  so.seed = seed;
+  const SimulatedSession fresh = Simulate(s.truth, so);
+  return Evaluate(robot, fresh.observations).stats.rms_mm;
+}
+
+}  // namespace kincal

@@ -1,0 +1,116 @@
+#include "synth/recorded_session.h"
+
+#include <cstdio>
+#include <filesystem>
+#include <opencv2/imgcodecs.hpp>
+#include <sstream>
+
+#include "data/atomic_file.h"
+#include "data/error.h"
+#include "data/provenance.h"
+#include "data/yaml_util.h"
+
+namespace kincal {
+
+int RenderRecordedSession(const Rig& rig, const Target& target,
+                          const RecordedSessionInput& input,
+                          const RenderOptions& options, uint64_t seed,
+                          const std::string& dir) {
+  options.Check();
+  const size_t n = input.rig_from_tool.size();
+  if (rig.cameras.size() != 2) {
+    throw InputError("render: a recorded session needs a stereo rig");
+  }
+  if (!input.joints.empty() && input.joints.size() != n) {
+    throw InputError("render: joint readings for " +
+                     std::to_string(input.joints.size()) + " frames, poses " +
+                     std::to_string(n));
+  }
+  std::error_code ec;
+  if (std::filesystem::exists(dir + "/frames.csv", ec)) {
+    throw InputError(dir + ": already holds a session (frames.csv)");
+  }
+  for (const char* side : {"/left", "/right"}) {
+    std::filesystem::create_directories(dir + side, ec);
+    if (ec) {
+      throw InputError(dir + side +
+                       ": cannot create the folder: " + ec.message());
+    }
+  }
+  StereoRenderer renderer(rig, target, options);
+  std::mt19937_64 rng(seed);
+  const std::string header =
+      "# written by " + ToolVersion() + ": " + CommandLine() + "\n";
+  std::ostringstream frames, truth, corners;
+  frames << header << "frame,t_left,t_right,seq_left,seq_right";
+  for (const std::string& j : input.joint_names) frames << "," << j;
+  frames << "\n";
+  truth << header << "# seed " << seed
+        << "; rig_from_tool (R row-major, t mm), tip in rig (mm)\n"
+        << "frame,r00,r01,r02,r10,r11,r12,r20,r21,r22,tx,ty,tz,tip_x,tip_y,"
+           "tip_z\n";
+  corners << header
+          << "# tag corners in px (OpenCV pixel centres, libapriltag order)\n"
+          << "frame,camera,tag,corner,u,v,visible\n";
+  const std::vector<int> png_params = {cv::IMWRITE_PNG_COMPRESSION, 1};
+  for (size_t f = 0; f < n; ++f) {
+    const StereoFrameTruth frame =
+        renderer.Render(input.rig_from_tool[f], &rng);
+    char name[32];
+    std::snprintf(name, sizeof(name), "%06zu.png", f);
+    for (size_t c = 0; c < 2; ++c) {
+      std::vector<uchar> png;
+      cv::imencode(".png", frame.views[c].image, png, png_params);
+      WriteFileAtomic(dir + (c == 0 ? "/left/" : "/right/") + name,
+                      std::string(png.begin(), png.end()));
+      for (const TagTruth& t : frame.views[c].tags) {
+        for (int k = 0; k < 4; ++k) {
+          corners << f << "," << c << "," << t.id << "," << k << ","
+                  << FormatDouble(t.corners[k].x()) << ","
+                  << FormatDouble(t.corners[k].y()) << ","
+                  << (t.visible ? 1 : 0) << "\n";
+        }
+      }
+    }
+    const double t = input.t_s.size() == n ? input.t_s[f] : 0.1 * f;
+    frames << f << "," << FormatDouble(t) << "," << FormatDouble(t) << "," << f
+           << "," << f;
+    const bool has = !input.joints.empty() && !input.joints[f].empty();
+    for (size_t j = 0; j < input.joint_names.size(); ++j) {
+      frames << ",";
+      if (has) frames << FormatDouble(input.joints[f].at(j));
+    }
+    frames << "\n";
+    truth << f;
+    for (int i = 0; i < 9; ++i) {
+      truth << "," << FormatDouble(frame.rig_from_tool.R(i / 3, i % 3));
+    }
+    for (int i = 0; i < 3; ++i) {
+      truth << "," << FormatDouble(frame.rig_from_tool.t(i));
+    }
+    for (int i = 0; i < 3; ++i) {
+      truth << "," << FormatDouble(frame.tip_in_rig(i));
+    }
+    truth << "\n";
+  }
+  WriteFileAtomic(dir + "/truth.csv", truth.str());
+  WriteFileAtomic(dir + "/corners.csv", corners.str());
+  WriteFileAtomic(dir + "/frames.csv", frames.str());
+  std::ostringstream yaml;
+  yaml << "# written by " << ToolVersion() << ": " << CommandLine() << "\n"
+       << "kincal_session: 1\n"
+       << "status: complete\n"
+       << "frames: " << n << "\n"
+       << "source: rendered (kincal synth, seed " << seed << ")\n"
+       << "images: {left: left/*.png, right: right/*.png, format: png}\n"
+       << "frames_csv: frames.csv\n"
+       << "joints: [";
+  for (size_t j = 0; j < input.joint_names.size(); ++j) {
+    yaml << (j ? ", " : "") << input.joint_names[j];
+  }
+  yaml << "]\n";
+  WriteFileAtomic(dir + "/session.yaml", yaml.str());
+  return static_cast<int>(n);
+}
+
+}  // namespace kincal

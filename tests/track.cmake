@@ -1,0 +1,6 @@
+# The tracker on images it was not tuned on: widened renders (three adjacent
+# tags turned 35 deg, up to 70 deg oblique, motion blur, defocus, vignetting,
+# JPEG, tagStandard41h12) against plain libapriltag corners.
+kincal_test(e2e_track_render_test
+  SOURCES ${CMAKE_CURRENT_LIST_DIR}/track_render_test.cc
+  DEPS kincal_bundle kincal_vision kincal_synth)
