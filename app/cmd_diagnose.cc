@@ -83,6 +83,17 @@ int RunModel(const ModelArgs& args) {
                   e.cause.c_str(), FormatJoint(e.joint).c_str(), e.magnitude,
                   e.unit.c_str());
     }
+    if (f.cause == "unexplained") {
+      std::string deps;
+      for (const std::string& d : f.depends_on)
+        deps += (deps.empty() ? "" : ", ") + d;
+      std::printf(
+          "    depends on: %s (smooth correction, k = %d: %.0f %% of the "
+          "residual power in cross-validation; held-out %.4f -> %.4f mm)\n",
+          deps.empty() ? "nothing smooth" : deps.c_str(), f.smooth_k,
+          100.0 * f.cv_explained, f.heldout_rms_before_mm,
+          f.heldout_rms_after_mm);
+    }
   }
   std::printf("  final held-out RMS %.4f mm (%.3f s)\n", r.final_heldout_rms_mm,
               r.seconds);
@@ -173,8 +184,8 @@ void AddDiagnoseCommand(CLI::App& app, Runner* run) {
   CLI::App* model = diag->add_subcommand(
       "model",
       "Fit geometry, test the catalogue of causes (backlash, compliance, "
-      "cyclic, gain, axis_tilt, drift) against held-out poses, report "
-      "findings");
+      "cyclic, gain, axis_tilt, drift, elastostatic, thermal, "
+      "mount_compliance) against held-out poses, report findings");
   model->add_option("--robot", margs->robot, "robot.yaml or .urdf")->required();
   model->add_option("--root", margs->root, "URDF root link");
   model->add_option("--tip", margs->tip, "URDF tip link");
