@@ -21,6 +21,7 @@ namespace {
 
 struct ModelArgs {
   std::string robot, obs, out, residuals, root, tip;
+  std::vector<std::string> validate;
   bool json = false;
   DiagnoseOptions options;
 };
@@ -32,7 +33,10 @@ std::string FormatJoint(const std::string& joint) {
 int RunModel(const ModelArgs& args) {
   const Robot robot = ReadRobot(args.robot, args.root, args.tip);
   const Observations obs = ReadObservationsCsv(args.obs, robot.JointNames());
-  const DiagnosisResult r = DiagnoseModel(robot, obs, args.options);
+  DiagnoseOptions options = args.options;
+  for (const std::string& v : args.validate)
+    options.validation.push_back(ReadObservationsCsv(v, robot.JointNames()));
+  const DiagnosisResult r = DiagnoseModel(robot, obs, options);
   if (!args.out.empty()) {
     std::ostringstream note;
     note << "diagnose model from " << args.obs << ": verdict " << r.verdict
@@ -52,7 +56,7 @@ int RunModel(const ModelArgs& args) {
     WriteFileAtomic(args.residuals, ResidualsCsv(r, obs));
   }
   if (args.json) {
-    nlohmann::json j = DiagnosisJson(r, args.options);
+    nlohmann::json j = DiagnosisJson(r, options);
     if (!args.out.empty()) j["out"] = args.out;
     PrintJson(j);
     return 0;
@@ -97,6 +101,10 @@ int RunModel(const ModelArgs& args) {
   }
   std::printf("  final held-out RMS %.4f mm (%.3f s)\n", r.final_heldout_rms_mm,
               r.seconds);
+  if (!options.validation.empty()) {
+    std::printf("  validation series (frame only): %.4f -> %.4f mm\n",
+                r.nominal_validation_rms_mm, r.final_validation_rms_mm);
+  }
   if (!args.out.empty()) std::printf("  wrote %s\n", args.out.c_str());
   return 0;
 }
@@ -215,6 +223,9 @@ void AddDiagnoseCommand(CLI::App& app, Runner* run) {
                     "restrict the catalogue (e.g. --causes backlash gain)");
   model->add_option("--threads", margs->options.num_threads, "threads")
       ->capture_default_str();
+  model->add_option("--validate", margs->validate,
+                    "other series of the same robot for cross-series "
+                    "validation (observations.csv; repeatable)");
   model->add_flag("--json", margs->json, "print one JSON object");
   model->callback(
       [run, margs] { *run = [margs] { return RunModel(*margs); }; });

@@ -183,6 +183,16 @@ SmoothCorrection SmoothRest(const Observations& obs, const Problem& pb,
   return FitSmoothCorrection(MakeSmoothInputs(obs, pb.train, pb.held), rt, rh);
 }
 
+// RMS on the validation series with the model held fixed and only the
+// measuring frame registered (what `kincal evaluate` does); NaN when none.
+double ValidationRms(const ModelState& state,
+                     const std::vector<Measurement>& validation) {
+  if (validation.empty()) return kNaN;
+  ModelState s = state;
+  InitializeFrameAndPoints(validation, &s);
+  return Rms(s, validation);
+}
+
 ModelState StateWithChain(const Chain& chain) {
   ModelState s;
   s.chain = chain;
@@ -236,6 +246,14 @@ DiagnosisResult DiagnoseModel(const Robot& nominal, const Observations& obs,
   out.nominal_heldout_rms_mm = Rms(current, pb.held);
   double current_rss = Rss(current, pb.train);
   double current_held = out.nominal_heldout_rms_mm;
+  std::vector<Measurement> validation;
+  for (const Observations& v : options.validation) {
+    ModelState scratch = StateWithChain(pb.nominal);
+    for (const Measurement& m : Measurements(pb.nominal, v, &scratch))
+      validation.push_back(m);
+  }
+  out.nominal_validation_rms_mm = ValidationRms(current, validation);
+  double current_validation = out.nominal_validation_rms_mm;
   const int n_res = 3 * static_cast<int>(pb.train.size());
 
   std::vector<Candidate> pool =
@@ -346,7 +364,11 @@ DiagnosisResult DiagnoseModel(const Robot& nominal, const Observations& obs,
           pb.held.empty() || s.heldout_rms_mm < current_held;
       const double explained_mm =
           std::sqrt(drop / static_cast<double>(pb.train.size()));
+      s.validation_rms_mm = ValidationRms(states[c], validation);
+      const bool validation_better =
+          validation.empty() || s.validation_rms_mm < current_validation;
       s.significant = std::log(alpha) > log_p[c] && held_better &&
+                      validation_better &&
                       explained_mm >= options.min_effect_mm;
       const Magnitude mag =
           CandidateMagnitude(cand, states[c], fits[c], scale_of(cand));
@@ -364,8 +386,14 @@ DiagnosisResult DiagnoseModel(const Robot& nominal, const Observations& obs,
     int best = -1;
     for (size_t c = 0; c < pool.size(); ++c) {
       if (!scores[c].significant) continue;
-      if (best < 0 || log_p[c] < log_p[best] ||
-          (log_p[c] == log_p[best] && scores[c].rss < scores[best].rss)) {
+      // With validation series the candidate that predicts them best wins
+      // (the F-test only admits); without, the most significant one.
+      const bool better =
+          validation.empty()
+              ? (log_p[c] < log_p[best] ||
+                 (log_p[c] == log_p[best] && scores[c].rss < scores[best].rss))
+              : scores[c].validation_rms_mm < scores[best].validation_rms_mm;
+      if (best < 0 || better) {
         best = static_cast<int>(c);
       }
     }
@@ -376,6 +404,8 @@ DiagnosisResult DiagnoseModel(const Robot& nominal, const Observations& obs,
     f.joint = b.joint;
     f.heldout_rms_before_mm = current_held;
     f.heldout_rms_after_mm = b.heldout_rms_mm;
+    f.validation_rms_before_mm = current_validation;
+    f.validation_rms_after_mm = b.validation_rms_mm;
     f.train_rms_after_mm = b.train_rms_mm;
     f.f = b.f;
     f.p_value = b.p_value;
@@ -396,10 +426,12 @@ DiagnosisResult DiagnoseModel(const Robot& nominal, const Observations& obs,
     for (const ParamInfo& q : pool[best].params) current_free.push_back(q);
     current_rss = b.rss;
     current_held = b.heldout_rms_mm;
+    current_validation = b.validation_rms_mm;
     pool.erase(pool.begin() + best);
   }
   out.final_train_rms_mm = Rms(current, pb.train);
   out.final_heldout_rms_mm = current_held;
+  out.final_validation_rms_mm = current_validation;
   out.residual_sigma_mm = std::sqrt(
       current_rss / std::max(1, n_res - static_cast<int>(current_free.size())));
 
@@ -451,6 +483,8 @@ DiagnosisResult DiagnoseModel(const Robot& nominal, const Observations& obs,
       u.ci_low = std::sqrt(std::max(0.0, 3.0 * (s2 * (1 - rel) - n2)));
       u.ci_high = std::sqrt(std::max(0.0, 3.0 * (s2 * (1 + rel) - n2)));
       u.heldout_rms_before_mm = u.heldout_rms_after_mm = current_held;
+      u.validation_rms_before_mm = u.validation_rms_after_mm =
+          current_validation;
       u.train_rms_after_mm = out.final_train_rms_mm;
       u.p_value = kNaN;
       u.f = s2 / n2;
@@ -569,18 +603,21 @@ nlohmann::json DiagnosisJson(const DiagnosisResult& r,
                     {"train_rms_mm", Num(e.train_rms_mm)},
                     {"heldout_rms_mm", Num(e.heldout_rms_mm)}});
     }
-    findings.push_back({{"cause", SpecCause(f.cause)},
-                        {"harmonic", HarmonicOrNull(f.cause)},
-                        {"joint", JointOrNull(f.joint)},
-                        {"magnitude", Num(f.magnitude)},
-                        {"unit", f.unit},
-                        {"ci95", {Num(f.ci_low), Num(f.ci_high)}},
-                        {"heldout_rms_before_mm", Num(f.heldout_rms_before_mm)},
-                        {"heldout_rms_after_mm", Num(f.heldout_rms_after_mm)},
-                        {"train_rms_after_mm", Num(f.train_rms_after_mm)},
-                        {"f", Num(f.f)},
-                        {"p_value", Num(f.p_value)},
-                        {"equivalent", eq}});
+    findings.push_back(
+        {{"cause", SpecCause(f.cause)},
+         {"harmonic", HarmonicOrNull(f.cause)},
+         {"joint", JointOrNull(f.joint)},
+         {"magnitude", Num(f.magnitude)},
+         {"unit", f.unit},
+         {"ci95", {Num(f.ci_low), Num(f.ci_high)}},
+         {"heldout_rms_before_mm", Num(f.heldout_rms_before_mm)},
+         {"heldout_rms_after_mm", Num(f.heldout_rms_after_mm)},
+         {"train_rms_after_mm", Num(f.train_rms_after_mm)},
+         {"validation_rms_before_mm", Num(f.validation_rms_before_mm)},
+         {"validation_rms_after_mm", Num(f.validation_rms_after_mm)},
+         {"f", Num(f.f)},
+         {"p_value", Num(f.p_value)},
+         {"equivalent", eq}});
     if (f.cause == "unexplained") {
       nlohmann::json single = nlohmann::json::object();
       for (const auto& kv : f.single_inputs) single[kv.first] = Num(kv.second);
@@ -608,6 +645,7 @@ nlohmann::json DiagnosisJson(const DiagnosisResult& r,
                        {"f", Num(c.f)},
                        {"p_value", Num(c.p_value)},
                        {"significant", c.significant},
+                       {"validation_rms_mm", Num(c.validation_rms_mm)},
                        {"magnitude", Num(c.magnitude)},
                        {"unit", c.unit}});
     }
@@ -618,6 +656,9 @@ nlohmann::json DiagnosisJson(const DiagnosisResult& r,
   j["nominal"] = {{"train_rms_mm", Num(r.nominal_train_rms_mm)},
                   {"heldout_rms_mm", Num(r.nominal_heldout_rms_mm)}};
   j["findings"] = findings;
+  j["validation"] = {{"series", options.validation.size()},
+                     {"nominal_rms_mm", Num(r.nominal_validation_rms_mm)},
+                     {"final_rms_mm", Num(r.final_validation_rms_mm)}};
   j["final"] = {{"heldout_rms_mm", Num(r.final_heldout_rms_mm)},
                 {"train_rms_mm", Num(r.final_train_rms_mm)}};
   j["train_poses"] = r.train_poses;

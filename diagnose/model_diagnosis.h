@@ -60,6 +60,12 @@ struct DiagnoseOptions {
   int num_threads = 2;
   // Restrict candidates to these causes (empty = all of the catalogue).
   std::vector<std::string> causes;
+  // Cross-series validation: other measured series of the same robot that
+  // the fit never sees (e.g. train on UR10 series C, validate on B). Each
+  // candidate's training fit is evaluated there with only the measuring
+  // frame re-registered; with validation data a candidate must also lower
+  // the validation RMS, and the lowest validation RMS wins the step.
+  std::vector<Observations> validation;
 
   void Check() const;  // InputError on invalid values
 };
@@ -73,7 +79,8 @@ struct CandidateScore {
   double rss = 0.0;  // training sum of squared residuals, mm^2
   double f = 0.0, p_value = 1.0;
   bool significant = false;
-  double magnitude = 0.0;  // spec units, from the training fit
+  double validation_rms_mm = 0.0;  // NaN without validation data
+  double magnitude = 0.0;          // spec units, from the training fit
   std::string unit;
 };
 
@@ -91,6 +98,8 @@ struct Finding {
   double ci_low = 0.0, ci_high = 0.0;
   double heldout_rms_before_mm = 0.0, heldout_rms_after_mm = 0.0;
   double train_rms_after_mm = 0.0;
+  // Cross-series validation RMS (NaN without validation data).
+  double validation_rms_before_mm = 0.0, validation_rms_after_mm = 0.0;
   double f = 0.0, p_value = 1.0;
   std::vector<Equivalent> equivalent;
   // `unexplained` only: the inputs the systematic rest depends on, strongest
@@ -109,6 +118,8 @@ struct DiagnosisResult {
   double nominal_train_rms_mm = 0.0, nominal_heldout_rms_mm = 0.0;
   std::vector<Finding> findings;
   double final_train_rms_mm = 0.0, final_heldout_rms_mm = 0.0;
+  // Cross-series validation (options.validation), frame re-registered only.
+  double nominal_validation_rms_mm = 0.0, final_validation_rms_mm = 0.0;
   // Noise per axis (mm) and where it came from: "stated", "repeated poses",
   // "nearest poses (upper bound)", "none".
   double noise_mm = 0.0;
