@@ -130,6 +130,9 @@ std::vector<Candidate> CatalogueCandidates(
   std::vector<Candidate> out;
   const int nj = chain.num_joints();
   const std::vector<int> parallel = ParallelAxisRows(chain);
+  bool has_masses = false;
+  for (const ChainRow& r : chain.rows)
+    has_masses = has_masses || r.mass_kg >= 0;
   for (int j = 0; j < nj; ++j) {
     bool pos = false, neg = false;
     double tau_min = std::numeric_limits<double>::infinity(),
@@ -155,7 +158,10 @@ std::vector<Candidate> CatalogueCandidates(
       }
     }
     if (wanted("gain")) out.push_back(MakeCandidate(chain, "gain", j));
-    if (wanted("elastostatic")) {
+    // Elastostatics needs the robot's link masses: without them the
+    // uniform-beam proxy is the tip-mass compliance again on the last
+    // joints (same torque shape), and the spec's cause must win.
+    if (wanted("elastostatic") && has_masses) {
       double lo = std::numeric_limits<double>::infinity(), hi = -lo;
       for (const Measurement& m : ms) {
         if (m.input.tau_mass.size() != static_cast<size_t>(nj)) continue;
