@@ -17,6 +17,7 @@
 #include "data/error.h"
 #include "data/provenance.h"
 #include "data/yaml_util.h"
+#include "diagnose/free_fit.h"
 #include "diagnose/nonparametric.h"
 
 namespace kincal {
@@ -348,7 +349,14 @@ DiagnosisResult DiagnoseModel(const Robot& nominal, const Observations& obs,
       fo.max_iterations = 100;
       fo.function_tolerance = 1e-10;
       fo.parameter_tolerance = 1e-10;
-      fits[c] = Fit(pb.train, fo, &states[c]);
+      // Differentiated in the free parameters only (diagnose/free_fit.h).
+      FreeFitOptions ffo;
+      ffo.free = fo.free;
+      ffo.bounds_center = fo.bounds_center;
+      ffo.max_iterations = fo.max_iterations;
+      ffo.function_tolerance = fo.function_tolerance;
+      ffo.parameter_tolerance = fo.parameter_tolerance;
+      FreeFit(pb.train, ffo, &states[c]);
       s.rss = Rss(states[c], pb.train);
       s.train_rms_mm = Rms(states[c], pb.train);
       s.heldout_rms_mm = Rms(states[c], pb.held);
