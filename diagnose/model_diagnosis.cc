@@ -356,7 +356,11 @@ DiagnosisResult DiagnoseModel(const Robot& nominal, const Observations& obs,
       ffo.max_iterations = fo.max_iterations;
       ffo.function_tolerance = fo.function_tolerance;
       ffo.parameter_tolerance = fo.parameter_tolerance;
-      FreeFit(pb.train, ffo, &states[c]);
+      if (options.free_parameter_fit) {
+        FreeFit(pb.train, ffo, &states[c]);
+      } else {
+        fits[c] = Fit(pb.train, fo, &states[c]);
+      }
       s.rss = Rss(states[c], pb.train);
       s.train_rms_mm = Rms(states[c], pb.train);
       s.heldout_rms_mm = Rms(states[c], pb.held);

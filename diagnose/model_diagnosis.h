@@ -58,6 +58,10 @@ struct DiagnoseOptions {
   // Residual scatter above this multiple of the noise counts as systematic.
   double unexplained_ratio = 1.5;
   int num_threads = 2;
+  // Candidate refits differentiate only the free parameters
+  // (diagnose/free_fit.h); false = calib/fit.h's Fit (the speed reference
+  // of bench/diagnose_bench --only ur10).
+  bool free_parameter_fit = true;
   // Restrict candidates to these causes (empty = all of the catalogue).
   std::vector<std::string> causes;
   // Cross-series validation: other measured series of the same robot that
