@@ -21,6 +21,7 @@ namespace {
 
 struct ModelArgs {
   std::string robot, obs, out, residuals, root, tip;
+  std::vector<std::string> validate;
   bool json = false;
   DiagnoseOptions options;
 };
@@ -32,7 +33,10 @@ std::string FormatJoint(const std::string& joint) {
 int RunModel(const ModelArgs& args) {
   const Robot robot = ReadRobot(args.robot, args.root, args.tip);
   const Observations obs = ReadObservationsCsv(args.obs, robot.JointNames());
-  const DiagnosisResult r = DiagnoseModel(robot, obs, args.options);
+  DiagnoseOptions options = args.options;
+  for (const std::string& v : args.validate)
+    options.validation.push_back(ReadObservationsCsv(v, robot.JointNames()));
+  const DiagnosisResult r = DiagnoseModel(robot, obs, options);
   if (!args.out.empty()) {
     std::ostringstream note;
     note << "diagnose model from " << args.obs << ": verdict " << r.verdict
@@ -52,7 +56,7 @@ int RunModel(const ModelArgs& args) {
     WriteFileAtomic(args.residuals, ResidualsCsv(r, obs));
   }
   if (args.json) {
-    nlohmann::json j = DiagnosisJson(r, args.options);
+    nlohmann::json j = DiagnosisJson(r, options);
     if (!args.out.empty()) j["out"] = args.out;
     PrintJson(j);
     return 0;
@@ -83,9 +87,24 @@ int RunModel(const ModelArgs& args) {
                   e.cause.c_str(), FormatJoint(e.joint).c_str(), e.magnitude,
                   e.unit.c_str());
     }
+    if (f.cause == "unexplained") {
+      std::string deps;
+      for (const std::string& d : f.depends_on)
+        deps += (deps.empty() ? "" : ", ") + d;
+      std::printf(
+          "    depends on: %s (smooth correction, k = %d: %.0f %% of the "
+          "residual power in cross-validation; held-out %.4f -> %.4f mm)\n",
+          deps.empty() ? "nothing smooth" : deps.c_str(), f.smooth_k,
+          100.0 * f.cv_explained, f.heldout_rms_before_mm,
+          f.heldout_rms_after_mm);
+    }
   }
   std::printf("  final held-out RMS %.4f mm (%.3f s)\n", r.final_heldout_rms_mm,
               r.seconds);
+  if (!options.validation.empty()) {
+    std::printf("  validation series (frame only): %.4f -> %.4f mm\n",
+                r.nominal_validation_rms_mm, r.final_validation_rms_mm);
+  }
   if (!args.out.empty()) std::printf("  wrote %s\n", args.out.c_str());
   return 0;
 }
@@ -173,8 +192,8 @@ void AddDiagnoseCommand(CLI::App& app, Runner* run) {
   CLI::App* model = diag->add_subcommand(
       "model",
       "Fit geometry, test the catalogue of causes (backlash, compliance, "
-      "cyclic, gain, axis_tilt, drift) against held-out poses, report "
-      "findings");
+      "cyclic, gain, axis_tilt, drift, elastostatic, thermal, "
+      "mount_compliance) against held-out poses, report findings");
   model->add_option("--robot", margs->robot, "robot.yaml or .urdf")->required();
   model->add_option("--root", margs->root, "URDF root link");
   model->add_option("--tip", margs->tip, "URDF tip link");
@@ -204,6 +223,9 @@ void AddDiagnoseCommand(CLI::App& app, Runner* run) {
                     "restrict the catalogue (e.g. --causes backlash gain)");
   model->add_option("--threads", margs->options.num_threads, "threads")
       ->capture_default_str();
+  model->add_option("--validate", margs->validate,
+                    "other series of the same robot for cross-series "
+                    "validation (observations.csv; repeatable)");
   model->add_flag("--json", margs->json, "print one JSON object");
   model->callback(
       [run, margs] { *run = [margs] { return RunModel(*margs); }; });

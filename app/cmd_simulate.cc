@@ -287,8 +287,9 @@ void AddSimulateCommand(CLI::App& app, Runner* run) {
       ->capture_default_str();
   sub->add_option("--effect", args->effects,
                   "injected effect cause:joint:magnitude (backlash, "
-                  "compliance, cyclic, gain, axis_tilt) or drift:mm_per_h; "
-                  "repeatable");
+                  "compliance, cyclic, gain, axis_tilt, elastostatic deg, "
+                  "thermal mm_per_h) or drift:mm_per_h or "
+                  "mount_compliance:deg; repeatable");
   sub->add_option("--seed", args->options.seed, "random seed")
       ->capture_default_str();
   sub->add_flag("--no-time", args->no_time, "omit the t column");

@@ -5,6 +5,8 @@
 //   3. the false-alarm rate of `diagnose model` on null data;
 //   4. the seed's Section 4 clearance test: false-positive rate without
 //      clearance and hit rate with clearance in j3.
+//   5. (--only ur10) the UR10 series C timing, reference vs free-parameter
+//      refits, 240 and 2773 poses.
 // Usage: diagnose_bench [--runs N] (N seeds per rate, default 40).
 
 #include <algorithm>
@@ -13,14 +15,17 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <ctime>
+#include <fstream>
 #include <string>
 #include <vector>
 
 #include "calib/calibrate.h"
-#include "synth/simulate.h"
+#include "data/import_ipa.h"
 #include "data/robot.h"
 #include "diagnose/clearance.h"
 #include "diagnose/model_diagnosis.h"
+#include "synth/simulate.h"
 
 namespace kincal {
 namespace {
@@ -70,6 +75,48 @@ void Timing(const Robot& bh7) {
         "  %-18s median %.3f s (min %.3f, max %.3f), %d candidates, %d steps\n",
         effect.empty() ? "null" : effect.c_str(), t[2], t[0], t[4], candidates,
         steps);
+  }
+}
+
+// UR10 series C (../shared/data), if present: wall and CPU time of the full
+// diagnosis at 2773 and at 240 poses, with the free-parameter refits and
+// with the reference path (calib/fit.h Fit for every candidate), and with
+// the catalogue of today (spec causes + harmonics) and the full one.
+void Ur10Timing() {
+  const std::string dir =
+      std::string(KINCAL_SOURCE_DIR) + "/../shared/data/ipa-robot-accuracy/";
+  const std::string file = dir + "Series_C/measurements_random_poses.csv";
+  if (!std::ifstream(file)) {
+    std::printf("== ur10: %s absent, skipped\n", file.c_str());
+    return;
+  }
+  const Robot ur10 =
+      ReadRobotYaml(std::string(KINCAL_SOURCE_DIR) + "/data/robots/ur10.yaml");
+  const Observations all = ReadIpaSeries(file, ur10.JointNames()).observations;
+  std::vector<int> first;
+  for (int i = 0; i < 240; ++i) first.push_back(i * 11);
+  const Observations small = Subset(all, first);
+  const std::vector<std::string> today = {"backlash", "compliance", "cyclic",
+                                          "gain",     "axis_tilt",  "drift"};
+  std::printf("== ur10 series C: diagnose model, wall / CPU seconds\n");
+  for (const Observations* obs : {&small, &all}) {
+    for (int catalogue = 0; catalogue < 2; ++catalogue) {
+      for (int fast = 0; fast < 2; ++fast) {
+        DiagnoseOptions o;
+        if (catalogue == 0) o.causes = today;
+        o.free_parameter_fit = fast == 1;
+        const auto start = std::chrono::steady_clock::now();
+        const std::clock_t c0 = std::clock();
+        const DiagnosisResult r = DiagnoseModel(ur10, *obs, o);
+        const double cpu = double(std::clock() - c0) / CLOCKS_PER_SEC;
+        std::printf(
+            "  %4zu poses, %-8s catalogue, %-14s refits: %6.2f s wall, "
+            "%6.2f s CPU, held-out %.4f -> %.4f mm\n",
+            obs->rows.size(), catalogue == 0 ? "today's" : "full",
+            fast ? "free-parameter" : "reference", Seconds(start), cpu,
+            r.nominal_heldout_rms_mm, r.final_heldout_rms_mm);
+      }
+    }
   }
 }
 
@@ -166,6 +213,7 @@ int main(int argc, char** argv) {
   }
   const kincal::Robot bh7 = kincal::Bh7();
   if (only.empty() || only == "timing") kincal::Timing(bh7);
+  if (only == "ur10") kincal::Ur10Timing();
   if (only.empty() || only == "backlash") kincal::SmallestBacklash(bh7, runs);
   if (only.empty() || only == "null") kincal::FalseAlarms(bh7, runs);
   if (only.empty() || only == "section4") {

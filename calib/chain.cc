@@ -2,6 +2,7 @@
 
 #include <Eigen/Geometry>
 #include <algorithm>
+#include <limits>
 
 #include "data/error.h"
 
@@ -52,19 +53,35 @@ Chain Chain::FromRobot(const Robot& robot) {
     row.type = r.type;
     row.axis = r.axis;
     row.p = RowFromDescription(robot.convention, r);
+    row.mass_kg = r.mass_kg;
+    row.com_mm = r.com_mm;
     c.rows.push_back(row);
   }
   ChainRow tool;
   tool.name = "tool";
   tool.type = JointType::kFixed;
   tool.p = RowFromDescription(robot.convention, robot.tool);
+  tool.mass_kg = robot.tool.mass_kg;
+  tool.com_mm = robot.tool.com_mm;
   c.rows.push_back(tool);
   c.joint_errors.assign(robot.joints.size(), JointErrorBlock{});
   c.bound_length_mm = robot.bound_length_mm;
   c.bound_angle_rad = robot.bound_angle_deg * kDegToRad;
   for (const Extension& e : robot.extensions) {
     if (e.cause == "drift") {
-      c.drift = {e.values.at("vx"), e.values.at("vy"), e.values.at("vz")};
+      c.drift[kDriftX] = e.values.at("vx");
+      c.drift[kDriftY] = e.values.at("vy");
+      c.drift[kDriftZ] = e.values.at("vz");
+      continue;
+    }
+    if (e.cause == "mount_compliance") {
+      // deg per kN m in the file, rad per N m inside.
+      constexpr double kUnit = kDegToRad / 1000.0;
+      c.drift[kMountIso] = e.values.at("iso") * kUnit;
+      const auto cos_it = e.values.find("aniso_cos");
+      const auto sin_it = e.values.find("aniso_sin");
+      if (cos_it != e.values.end()) c.drift[kMountCos] = cos_it->second * kUnit;
+      if (sin_it != e.values.end()) c.drift[kMountSin] = sin_it->second * kUnit;
       continue;
     }
     const int j = robot.JointIndex(e.joint);
@@ -76,6 +93,9 @@ Chain Chain::FromRobot(const Robot& robot) {
     if (e.cause == "compliance")
       err[kCompliance] = e.values.at("per_torque") * unit;
     if (e.cause == "gain") err[kGain] = e.values.at("g");
+    if (e.cause == "elastostatic")  // deg (mm) per kN m (kN) in the file
+      err[kElastostatic] = e.values.at("per_knm") * unit / 1000.0;
+    if (e.cause == "thermal") err[kThermal] = e.values.at("rate");
     if (e.cause == "cyclic") {
       // Harmonic 1: cos, sin; harmonics 2, 3: cos2, sin2, cos3, sin3.
       for (int h = 1; h <= kMaxHarmonic; ++h) {
@@ -129,10 +149,26 @@ Robot Chain::ToRobot(const Robot& description) const {
     }
     if (err[kGain] != 0.0)
       robot.extensions.push_back({"gain", name, {{"g", err[kGain]}}});
+    if (err[kElastostatic] != 0.0)
+      robot.extensions.push_back(
+          {"elastostatic",
+           name,
+           {{"per_knm", err[kElastostatic] / unit * 1000.0}}});
+    if (err[kThermal] != 0.0)
+      robot.extensions.push_back({"thermal", name, {{"rate", err[kThermal]}}});
   }
   if (drift[0] != 0.0 || drift[1] != 0.0 || drift[2] != 0.0) {
     robot.extensions.push_back(
         {"drift", "", {{"vx", drift[0]}, {"vy", drift[1]}, {"vz", drift[2]}}});
+  }
+  if (drift[kMountIso] != 0.0 || drift[kMountCos] != 0.0 ||
+      drift[kMountSin] != 0.0) {
+    constexpr double kUnit = kDegToRad / 1000.0;
+    robot.extensions.push_back({"mount_compliance",
+                                "",
+                                {{"iso", drift[kMountIso] / kUnit},
+                                 {"aniso_cos", drift[kMountCos] / kUnit},
+                                 {"aniso_sin", drift[kMountSin] / kUnit}}});
   }
   return robot;
 }
@@ -152,7 +188,10 @@ bool Chain::HasJointErrors() const {
       if (v != 0.0) return true;
     }
   }
-  return drift[0] != 0.0 || drift[1] != 0.0 || drift[2] != 0.0;
+  for (double v : drift) {
+    if (v != 0.0) return true;
+  }
+  return false;
 }
 
 namespace {
@@ -204,6 +243,17 @@ void JointAxesInBase(const Chain& chain, const std::vector<double>& q,
   }
 }
 
+bool ThermalUsesTemperature(const Observations& obs) {
+  if (obs.rows.empty()) return false;
+  double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+  for (const Observation& o : obs.rows) {
+    if (!o.HasTemp()) return false;
+    lo = std::min(lo, o.temp_c);
+    hi = std::max(hi, o.temp_c);
+  }
+  return hi > lo;
+}
+
 std::vector<PoseInput> MakePoseInputs(const Chain& chain,
                                       const Observations& obs) {
   const int n = chain.num_joints();
@@ -218,6 +268,11 @@ std::vector<PoseInput> MakePoseInputs(const Chain& chain,
       any_time = true;
     }
   }
+  const bool use_temp = ThermalUsesTemperature(obs);
+  // Link masses: the rows' (and the tool's) when any is given, else uniform
+  // beams of 10 kg/m of nominal row length, centre of mass half-way.
+  bool any_mass = false;
+  for (const ChainRow& r : chain.rows) any_mass = any_mass || r.mass_kg >= 0;
   std::vector<PoseInput> out;
   std::vector<double> s(n, 0.0);
   const std::vector<double>* prev = nullptr;
@@ -246,6 +301,39 @@ std::vector<PoseInput> MakePoseInputs(const Chain& chain,
                       ? axes[j].dot(chain.gravity)
                       : axes[j].cross(p_tip - origins[j]).dot(chain.gravity);
     }
+    // Link masses: weight vectors (N) at their centres (base frame, mm).
+    std::vector<Eigen::Vector3d> com(n + 1);
+    std::vector<double> mass(n + 1, 0.0);
+    {
+      Eigen::Matrix4d m = Eigen::Matrix4d::Identity();
+      for (int r = 0; r <= n; ++r) {
+        const ChainRow& row = chain.rows[r];
+        const Eigen::Vector3d start = m.block<3, 1>(0, 3);
+        m = m * RowTransform<double>(chain.convention, row, row.p.data(),
+                                     r < n ? in.q[r] : 0.0);
+        const Eigen::Vector3d end = m.block<3, 1>(0, 3);
+        if (any_mass) {
+          mass[r] = row.mass_kg >= 0 ? row.mass_kg : 0.0;
+          com[r] = (m * row.com_mm.homogeneous()).head<3>();
+        } else {
+          mass[r] = 10.0 * (end - start).norm() / 1000.0;
+          com[r] = 0.5 * (start + end);
+        }
+      }
+    }
+    in.tau_mass.assign(n, 0.0);
+    in.moment.setZero();
+    for (int r = 0; r <= n; ++r) {
+      const Eigen::Vector3d weight = mass[r] * kGravityMps2 * chain.gravity;
+      in.moment += com[r].cross(weight) / 1000.0;
+      for (int j = 0; j < n && j <= r; ++j) {
+        in.tau_mass[j] +=
+            chain.rows[j].type == JointType::kPrismatic
+                ? axes[j].dot(weight)
+                : axes[j].cross(com[r] - origins[j]).dot(weight) / 1000.0;
+      }
+    }
+    in.thermal_x = use_temp ? obs.rows[out.size()].temp_c - 20.0 : in.t_h;
     out.push_back(in);
   }
   return out;

@@ -13,6 +13,7 @@
 #include <Eigen/Geometry>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -25,12 +26,32 @@ namespace kincal {
 //   dh / mdh: [theta_rad, d_mm, a_mm, alpha_rad, beta_rad, (unused)]
 //   urdf:     [x_mm, y_mm, z_mm, roll_rad, pitch_rad, yaw_rad]
 constexpr int kRowBlockSize = 6;
-// Per-joint error block (model extensions), internal units:
+// Cause families of the error model. Each family owns a fixed slice of one
+// of two parameter blocks (the fit's blocks: one per joint and one global),
+// declared here in one place, and one templated hook below:
+//
+//   family         block   entries                      hook
+//   gain           joint   kGain                        JointValue
+//   backlash       joint   kBacklash                    JointValue
+//   compliance     joint   kCompliance (tip-mass tau)   JointValue
+//   cyclic 1..3    joint   kCyclicCos .. kCyclic3Sin    JointValue
+//   elastostatic   joint   kElastostatic (link masses)  JointValue
+//   thermal        joint   kThermal (row length growth) RowLengthScale
+//   drift          global  kDriftX .. kDriftZ           TipOffset
+//   mount          global  kMountIso, kMountCos, ..Sin  TipOffset
+//
+// A new family adds its entries here, its hook in TipInBase, its parameter
+// names in model_state.cc and its catalogue entry in diagnose/catalogue.cc.
+//
+// Per-joint error block, internal units:
 //   [gain (1), backlash (rad|mm, full width), compliance (rad|mm per mm of
 //    unit-mass torque), cyclic_cos, cyclic_sin (rad, first harmonic of the
 //    read angle), cyclic2_cos, cyclic2_sin (second), cyclic3_cos,
-//    cyclic3_sin (third harmonic)]
-constexpr int kJointErrorBlockSize = 9;
+//    cyclic3_sin (third harmonic), elastostatic (rad|mm per N m of the
+//    gravity torque of the link masses about the joint), thermal (relative
+//    growth of the row's lengths per unit of the thermal input: per K when
+//    the data have temp_c, else per hour)]
+constexpr int kJointErrorBlockSize = 11;
 enum JointErrorIndex {
   kGain = 0,
   kBacklash,
@@ -40,18 +61,35 @@ enum JointErrorIndex {
   kCyclic2Cos,
   kCyclic2Sin,
   kCyclic3Cos,
-  kCyclic3Sin
+  kCyclic3Sin,
+  kElastostatic,
+  kThermal
 };
 constexpr int kMaxHarmonic = 3;
 // Index of the cosine term of harmonic h (1..3); the sine term follows it.
 constexpr int CyclicCosIndex(int harmonic) {
   return kCyclicCos + 2 * (harmonic - 1);
 }
-// Drift block: tip drift in the base frame, mm per hour.
-constexpr int kDriftBlockSize = 3;
+// Global block (named drift for history; the fit passes it as one block):
+//   [vx, vy, vz (tip drift in the base frame, mm per hour),
+//    mount_iso, mount_cos, mount_sin (compliance of the mount / stand, rad
+//    per N m: the base tilts by w = C M under the gravity moment M of the
+//    arm's link masses about the base origin, C = [[iso + cos, sin],
+//    [sin, iso - cos]] on the horizontal axes)]
+constexpr int kDriftBlockSize = 6;
+enum GlobalIndex {
+  kDriftX = 0,
+  kDriftY,
+  kDriftZ,
+  kMountIso,
+  kMountCos,
+  kMountSin
+};
 // Measuring frame block (meas_from_base): [rx, ry, rz (angle-axis, rad),
 // tx, ty, tz (mm)].
 constexpr int kFrameBlockSize = 6;
+// Standard gravity, m/s^2: torques of link masses in N m.
+constexpr double kGravityMps2 = 9.80665;
 
 using RowBlock = std::array<double, kRowBlockSize>;
 using JointErrorBlock = std::array<double, kJointErrorBlockSize>;
@@ -61,6 +99,10 @@ struct ChainRow {
   JointType type = JointType::kRevolute;
   Eigen::Vector3d axis = Eigen::Vector3d::UnitZ();  // URDF joints only
   RowBlock p{};                                     // geometry, internal units
+  // Mass (kg) and centre of mass (mm, frame after the row) of the link the
+  // row ends in; NaN mass = not given (robot.yaml mass/com).
+  double mass_kg = std::numeric_limits<double>::quiet_NaN();
+  Eigen::Vector3d com_mm = Eigen::Vector3d::Zero();
 };
 
 struct Chain {
@@ -69,7 +111,7 @@ struct Chain {
   Eigen::Vector3d gravity = Eigen::Vector3d(0, 0, -1);
   std::vector<ChainRow> rows;                   // joints in order, tool last
   std::vector<JointErrorBlock> joint_errors;    // one per joint, zero = none
-  std::array<double, kDriftBlockSize> drift{};  // mm per hour
+  std::array<double, kDriftBlockSize> drift{};  // global block (see above)
   double bound_length_mm = 5.0;
   double bound_angle_rad = 5.0 * M_PI / 180.0;
 
@@ -95,6 +137,15 @@ struct PoseInput {
   std::vector<double> s;    // approach direction per joint: +1, -1, 0 unknown
   std::vector<double> tau;  // gravity torque about each joint axis (see below)
   double t_h = 0.0;         // hours since the first timed row (0 if untimed)
+  // Gravity torque of the arm's link masses about each joint axis (N m;
+  // prismatic: force along the axis, N), nominal geometry and readings.
+  // Masses from the robot file, else a uniform-beam proxy (MakePoseInputs).
+  std::vector<double> tau_mass;
+  // Gravity moment of all link masses about the base origin, base frame, N m.
+  Eigen::Vector3d moment = Eigen::Vector3d::Zero();
+  // Input of the thermal family: temp_c - 20 (K) when every row has a
+  // temperature and it varies, else t_h (h).
+  double thermal_x = 0.0;
 };
 
 // Builds PoseInputs for the rows of `obs` (in visit order). `s` follows the
@@ -103,8 +154,15 @@ struct PoseInput {
 // `tau` is computed with `chain`'s geometry (normally the nominal robot) and
 // the read joint values: for a revolute joint, (z x (p_tip - o)) . g_unit (mm,
 // torque of a unit mass at the tip); for a prismatic joint, z . g_unit.
+// `tau_mass` and `moment` use the rows' masses and centres of mass; when no
+// row has a mass, each row is a uniform beam of 10 kg per metre of its
+// nominal length with its centre of mass half-way (the elastostatic and
+// mount compliances then absorb the scale). `thermal_x` is temp_c - 20 deg C
+// when every row has one and it varies, else t_h.
 std::vector<PoseInput> MakePoseInputs(const Chain& chain,
                                       const Observations& obs);
+// True when the thermal input of these observations is temperature (K).
+bool ThermalUsesTemperature(const Observations& obs);
 
 // ---------------------------------------------------------------------------
 // Templated kinematics.
@@ -223,14 +281,15 @@ Mat4<T> RowTransform(Convention convention, const ChainRow& row, const T* p,
 // The joint value FK uses for a reading (docs/CONVENTIONS.md):
 //   q = (1 + gain) q_read - s backlash / 2 + compliance tau
 //       + sum_h cyclic{h}_cos cos(h q_read) + cyclic{h}_sin sin(h q_read)
+//       + elastostatic tau_mass
 // for harmonics h = 1..3. `err` may be null (no error model). Cyclic terms
 // apply to revolute joints.
 template <typename T>
 T ModelJointValue(JointType type, double q_read, double s, double tau,
-                  const T* err) {
+                  const T* err, double tau_mass = 0.0) {
   if (err == nullptr) return T(q_read);
   T q = (T(1) + err[kGain]) * q_read - T(0.5 * s) * err[kBacklash] +
-        err[kCompliance] * tau;
+        err[kCompliance] * tau + err[kElastostatic] * tau_mass;
   if (type == JointType::kRevolute) {
     for (int h = 1; h <= kMaxHarmonic; ++h) {
       const int k = CyclicCosIndex(h);
@@ -336,21 +395,68 @@ Vec3<T> TipPosition(const Chain& chain, const T* const* rows, const T* q) {
   return p;
 }
 
-// The needle tip in the base frame for one pose: error model, FK, drift.
-// `joint_errors` (one block per joint) and `drift` may be null.
+// Thermal family hook: the row's lengths scaled by (1 + thermal x):
+// dh / mdh d and a, urdf x, y, z.
+template <typename T>
+void ScaleRowLengths(Convention convention, const T& factor, T* p) {
+  if (convention == Convention::kUrdf) {
+    for (int k = 0; k < 3; ++k) p[k] *= factor;
+  } else {
+    p[1] *= factor;
+    p[2] *= factor;
+  }
+}
+
+// Mount family hook: the base tilts by w = C M (see kMountIso) about the
+// base origin; returns the tip moved by w x p.
+template <typename T>
+Vec3<T> MountTilt(const T* global, const Eigen::Vector3d& moment,
+                  const Vec3<T>& p) {
+  const T wx = (global[kMountIso] + global[kMountCos]) * moment.x() +
+               global[kMountSin] * moment.y();
+  const T wy = global[kMountSin] * moment.x() +
+               (global[kMountIso] - global[kMountCos]) * moment.y();
+  const Vec3<T> w(wx, wy, T(0));
+  return p + w.cross(p);
+}
+
+// The needle tip in the base frame for one pose: error model, FK, drift,
+// mount tilt. `joint_errors` (one block per joint) and `drift` (the global
+// block) may be null.
 template <typename T>
 Vec3<T> TipInBase(const Chain& chain, const T* const* rows,
                   const T* const* joint_errors, const T* drift,
                   const PoseInput& in) {
   constexpr int kMaxJoints = 16;
   T q[kMaxJoints];
+  const bool masses =
+      static_cast<int>(in.tau_mass.size()) == chain.num_joints();
   for (int j = 0; j < chain.num_joints(); ++j) {
     q[j] = ModelJointValue<T>(chain.rows[j].type, in.q[j], in.s[j], in.tau[j],
-                              joint_errors ? joint_errors[j] : nullptr);
+                              joint_errors ? joint_errors[j] : nullptr,
+                              masses ? in.tau_mass[j] : 0.0);
   }
-  Vec3<T> p = TipPosition(chain, rows, q);
+  Vec3<T> p;
+  if (joint_errors != nullptr && in.thermal_x != 0.0) {
+    // Thermal growth: rows with their lengths scaled (copies).
+    T buf[kMaxJoints + 1][kRowBlockSize];
+    const T* scaled[kMaxJoints + 1];
+    for (int r = 0; r <= chain.num_joints(); ++r) {
+      for (int k = 0; k < kRowBlockSize; ++k) buf[r][k] = rows[r][k];
+      if (r < chain.num_joints()) {
+        ScaleRowLengths(chain.convention,
+                        T(1) + joint_errors[r][kThermal] * in.thermal_x,
+                        buf[r]);
+      }
+      scaled[r] = buf[r];
+    }
+    p = TipPosition(chain, scaled, q);
+  } else {
+    p = TipPosition(chain, rows, q);
+  }
   if (drift != nullptr) {
     for (int k = 0; k < 3; ++k) p[k] += drift[k] * in.t_h;
+    p = MountTilt(drift, in.moment, p);
   }
   return p;
 }

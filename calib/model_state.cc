@@ -8,8 +8,9 @@ namespace kincal {
 namespace {
 constexpr double kRadToDeg = 180.0 / M_PI;
 const char* kJointErrorNames[kJointErrorBlockSize] = {
-    "gain",        "backlash",    "compliance",  "cyclic_cos", "cyclic_sin",
-    "cyclic2_cos", "cyclic2_sin", "cyclic3_cos", "cyclic3_sin"};
+    "gain",        "backlash",     "compliance",  "cyclic_cos",
+    "cyclic_sin",  "cyclic2_cos",  "cyclic2_sin", "cyclic3_cos",
+    "cyclic3_sin", "elastostatic", "thermal"};
 }  // namespace
 
 int ModelState::PointIndex(const std::string& label) const {
@@ -104,8 +105,8 @@ std::vector<ParamInfo> PointParams(const ModelState& state) {
 ParamInfo JointErrorParam(const Chain& chain, int joint, int index) {
   // Revolute: backlash and cyclic terms are angles, compliance is an angle
   // per mm of torque; all shown in degrees. Gain is dimensionless.
-  const bool angle =
-      chain.rows.at(joint).type == JointType::kRevolute && index != kGain;
+  const bool angle = chain.rows.at(joint).type == JointType::kRevolute &&
+                     index != kGain && index != kThermal;
   return {chain.rows[joint].name + "." + kJointErrorNames[index],
           ParamKind::kJointError, joint, index, angle};
 }
@@ -116,11 +117,18 @@ std::vector<ParamInfo> DriftParams() {
           {"drift.vz", ParamKind::kDrift, 0, 2, false}};
 }
 
+std::vector<ParamInfo> MountParams() {
+  return {{"mount.iso", ParamKind::kDrift, 0, kMountIso, true},
+          {"mount.aniso_cos", ParamKind::kDrift, 0, kMountCos, true},
+          {"mount.aniso_sin", ParamKind::kDrift, 0, kMountSin, true}};
+}
+
 ParamInfo FindParam(const ModelState& state, const std::string& name) {
   std::vector<ParamInfo> all = GeometryParams(state.chain);
   for (const auto& p : FrameParams()) all.push_back(p);
   for (const auto& p : PointParams(state)) all.push_back(p);
   for (const auto& p : DriftParams()) all.push_back(p);
+  for (const auto& p : MountParams()) all.push_back(p);
   for (int j = 0; j < state.chain.num_joints(); ++j) {
     for (int k = 0; k < kJointErrorBlockSize; ++k) {
       all.push_back(JointErrorParam(state.chain, j, k));

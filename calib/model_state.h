@@ -57,6 +57,9 @@ std::vector<ParamInfo> PointParams(const ModelState& state);
 // Joint error model parameters (index: JointErrorIndex) and drift.
 ParamInfo JointErrorParam(const Chain& chain, int joint, int index);
 std::vector<ParamInfo> DriftParams();
+// Mount compliance (global block kMountIso, kMountCos, kMountSin), rad per
+// N m (shown as deg per N m).
+std::vector<ParamInfo> MountParams();
 
 // Finds a parameter by name among all parameters the state has; throws
 // InputError listing close names when unknown.

@@ -152,6 +152,7 @@ IpaSeries ParseIpaSeries(const std::string& text, const std::string& file,
       }
     }
     out.temperature_c.push_back(side(temp_col, "temperature", 1.0));
+    row.temp_c = out.temperature_c.back();  // spec v2 column temp_c
     Eigen::Vector3d sd, rot, goal;
     for (int k = 0; k < 3; ++k) {
       sd[k] = side(std_col[k], "tracker std, mm", 1.0);

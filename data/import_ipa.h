@@ -17,7 +17,8 @@
 //                             point calibration): tracker_from_tmac =
 //                             Rx(rx) Ry(ry) Rz(rz) (IpaRotation)
 //   measurement_std_x/y/z     tracker standard deviation, mm (B, C only)
-//   measurement_temperature   environment temperature, deg C
+//   measurement_temperature   environment temperature, deg C -> temp_c of
+//                             every observation row (spec v2 column)
 //   Goal x/y/z                commanded TCP (109 mm out of the flange) in
 //                             the ROS base frame, m
 //

@@ -84,6 +84,7 @@ TEST(ImportIpaTest, ReadsSeriesCRow) {
   EXPECT_FALSE(r.HasTime());  // truncated timestamps are not times
   EXPECT_FALSE(s.has_time);
   EXPECT_DOUBLE_EQ(s.temperature_c[1], 21.68000031);
+  EXPECT_DOUBLE_EQ(s.observations.rows[1].temp_c, 21.68000031);  // temp_c
   EXPECT_DOUBLE_EQ(s.std_mm[0].x(), 0.041565);
   EXPECT_DOUBLE_EQ(s.rotation_deg[1].z(), -88.245609);
   EXPECT_NEAR(s.goal_mm[0].y(), -365.141, 1e-9);  // m -> mm

@@ -31,6 +31,13 @@ bool Observations::AnyTime() const {
   return false;
 }
 
+bool Observations::AnyTemp() const {
+  for (const auto& r : rows) {
+    if (r.HasTemp()) return true;
+  }
+  return false;
+}
+
 namespace {
 std::string JoinNames(const std::vector<std::string>& names) {
   std::string s;
@@ -49,7 +56,7 @@ Observations ParseObservationsCsv(const std::string& text,
                          JoinNames(joint_names) + ",x,y,z' and rows");
   }
   // Header: map each column to its role.
-  enum Role { kPose, kJoint, kX, kY, kZ, kFixed, kTime };
+  enum Role { kPose, kJoint, kX, kY, kZ, kFixed, kTime, kTemp };
   struct Column {
     Role role;
     int joint = -1;
@@ -82,6 +89,8 @@ Observations ParseObservationsCsv(const std::string& text,
       c.role = kFixed;
     } else if (name == "t") {
       c.role = kTime;
+    } else if (name == "temp_c") {
+      c.role = kTemp;
     } else {
       c.role = kJoint;
       for (size_t j = 0; j < joint_names.size(); ++j) {
@@ -92,7 +101,7 @@ Observations ParseObservationsCsv(const std::string& text,
                          "unknown column '" + name +
                              "': expected pose, the robot's joints (" +
                              JoinNames(joint_names) +
-                             "), x, y, z, fixed_point or t");
+                             "), x, y, z, fixed_point, t or temp_c");
       }
     }
     columns.push_back(c);
@@ -189,6 +198,16 @@ Observations ParseObservationsCsv(const std::string& text,
           }
           o.t_s = v;
           break;
+        case kTemp:
+          if (f.text.empty()) break;
+          if (!ParseFiniteDouble(f.text, &v) || v < -273.15 || v > 1000.0) {
+            throw InputError(file, line.line, f.column,
+                             "column 'temp_c': expected a temperature in deg "
+                             "C (-273.15..1000) or empty, got '" +
+                                 f.text + "'");
+          }
+          o.temp_c = v;
+          break;
       }
     }
     if (xyz_given != 0 && xyz_given != 3) {
@@ -212,11 +231,12 @@ Observations ReadObservationsCsv(const std::string& path,
 
 std::string FormatObservationsCsv(const Observations& obs,
                                   const std::vector<std::string>& comment) {
-  bool points = false, fixed = false, time = false;
+  bool points = false, fixed = false, time = false, temp = false;
   for (const auto& r : obs.rows) {
     points = points || r.has_point;
     fixed = fixed || !r.fixed_point.empty();
     time = time || r.HasTime();
+    temp = temp || r.HasTemp();
   }
   std::ostringstream os;
   os << "# written by " << ToolVersion() << ": " << CommandLine() << "\n";
@@ -226,6 +246,7 @@ std::string FormatObservationsCsv(const Observations& obs,
   if (points) os << ",x,y,z";
   if (fixed) os << ",fixed_point";
   if (time) os << ",t";
+  if (temp) os << ",temp_c";
   os << "\n";
   for (const auto& r : obs.rows) {
     os << CsvQuote(r.pose);
@@ -239,6 +260,7 @@ std::string FormatObservationsCsv(const Observations& obs,
     }
     if (fixed) os << "," << CsvQuote(r.fixed_point);
     if (time) os << "," << (r.HasTime() ? FormatDouble(r.t_s) : "");
+    if (temp) os << "," << (r.HasTemp() ? FormatDouble(r.temp_c) : "");
     os << "\n";
   }
   return os.str();

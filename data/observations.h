@@ -18,9 +18,13 @@ struct Observation {
   Eigen::Vector3d p_in_meas = Eigen::Vector3d::Zero();    // mm
   std::string fixed_point;                                // "" = none
   double t_s = std::numeric_limits<double>::quiet_NaN();  // NaN = unknown
+  // Temperature at the measurement (spec v2 column temp_c), deg C; NaN =
+  // unknown.
+  double temp_c = std::numeric_limits<double>::quiet_NaN();
   int line = 0;  // line in the source file (1-based), for messages
 
   bool HasTime() const { return t_s == t_s; }
+  bool HasTemp() const { return temp_c == temp_c; }
 };
 
 struct Observations {
@@ -31,6 +35,7 @@ struct Observations {
   int CountWithPoints() const;
   int CountWithFixedPoint() const;
   bool AnyTime() const;
+  bool AnyTemp() const;
 };
 
 // Reads observations.csv (../shared/spec/formats.md) for a robot with the
@@ -43,8 +48,8 @@ Observations ParseObservationsCsv(const std::string& text,
                                   const std::vector<std::string>& joint_names);
 
 // Writes the rows as observations.csv; `comment` lines become "# ..." lines
-// after the provenance line. Columns x,y,z / fixed_point / t appear when any
-// row has them.
+// after the provenance line. Columns x,y,z / fixed_point / t / temp_c appear
+// when any row has them.
 std::string FormatObservationsCsv(const Observations& obs,
                                   const std::vector<std::string>& comment = {});
 

@@ -121,5 +121,28 @@ TEST(ObservationsTest, FormatThenParseIsIdentity) {
   }
 }
 
+// Spec v2: optional temp_c column (deg C), empty cells allowed, kept on
+// output.
+TEST(ObservationsTest, ReadsAndWritesTempC) {
+  const Observations obs = ParseObservationsCsv(
+      "pose,j1,j2,j3,j4,j5,x,y,z,temp_c\n"
+      "0,1,2,3,4,5,1,2,3,21.5\n"
+      "1,1,2,3,4,6,1,2,3,\n",
+      "o.csv", kJoints);
+  ASSERT_EQ(obs.rows.size(), 2u);
+  EXPECT_DOUBLE_EQ(obs.rows[0].temp_c, 21.5);
+  EXPECT_FALSE(obs.rows[1].HasTemp());
+  EXPECT_TRUE(obs.AnyTemp());
+  const std::string text = FormatObservationsCsv(obs);
+  EXPECT_THAT(text, HasSubstr(",temp_c\n"));
+  const Observations back = ParseObservationsCsv(text, "back.csv", kJoints);
+  EXPECT_DOUBLE_EQ(back.rows[0].temp_c, 21.5);
+  EXPECT_FALSE(back.rows[1].HasTemp());
+  EXPECT_THAT(ErrorOf("pose,j1,j2,j3,j4,j5,temp_c\n0,1,2,3,4,5,warm\n"),
+              HasSubstr("column 'temp_c'"));
+  EXPECT_THAT(ErrorOf("pose,j1,j2,j3,j4,j5,temp_c\n0,1,2,3,4,5,-300\n"),
+              HasSubstr("column 'temp_c'"));
+}
+
 }  // namespace
 }  // namespace kincal

@@ -53,11 +53,10 @@ namespace {
 // Fields every extension cause may carry (interface units, see robot.h).
 const std::map<std::string, std::vector<std::string>>& ExtensionFields() {
   static const std::map<std::string, std::vector<std::string>> fields = {
-      {"backlash", {"width"}},
-      {"compliance", {"per_torque"}},
-      {"cyclic", {"cos", "sin"}},
-      {"gain", {"g"}},
-      {"drift", {"vx", "vy", "vz"}}};
+      {"backlash", {"width"}},       {"compliance", {"per_torque"}},
+      {"cyclic", {"cos", "sin"}},    {"gain", {"g"}},
+      {"drift", {"vx", "vy", "vz"}}, {"elastostatic", {"per_knm"}},
+      {"thermal", {"rate"}},         {"mount_compliance", {"iso"}}};
   return fields;
 }
 
@@ -65,7 +64,9 @@ const std::map<std::string, std::vector<std::string>>& ExtensionFields() {
 const std::vector<std::string>& OptionalFields(const std::string& cause) {
   static const std::vector<std::string> cyclic = {"cos2", "sin2", "cos3",
                                                   "sin3"};
+  static const std::vector<std::string> mount = {"aniso_cos", "aniso_sin"};
   static const std::vector<std::string> none;
+  if (cause == "mount_compliance") return mount;
   return cause == "cyclic" ? cyclic : none;
 }
 
@@ -189,8 +190,9 @@ Robot ParseRobotYaml(const std::string& text, const std::string& file) {
       const auto c = r.Numbers(j["com"], what + ".com", 3, 3);
       row.com_mm = Eigen::Vector3d(c[0], c[1], c[2]);
       if (!(row.com_mm.norm() <= 1e5)) {
-        r.Fail(j["com"], what + ".com: expected a centre of mass in mm, "
-                                "within 100 m of the link frame");
+        r.Fail(j["com"], what +
+                             ".com: expected a centre of mass in mm, "
+                             "within 100 m of the link frame");
       }
     }
     robot.joints.push_back(row);
@@ -225,11 +227,13 @@ Robot ParseRobotYaml(const std::string& text, const std::string& file) {
       x.cause = r.String(r.Required(e, "cause", what), what + ".cause");
       const auto it = ExtensionFields().find(x.cause);
       if (it == ExtensionFields().end()) {
-        r.Fail(e["cause"], what + ".cause: unknown cause '" + x.cause +
-                               "' (expected backlash, compliance, cyclic, gain "
-                               "or drift; axis tilt is a row's beta)");
+        r.Fail(e["cause"],
+               what + ".cause: unknown cause '" + x.cause +
+                   "' (expected backlash, compliance, cyclic, gain, "
+                   "elastostatic, thermal, drift or "
+                   "mount_compliance; axis tilt is a row's beta)");
       }
-      if (x.cause != "drift") {
+      if (x.cause != "drift" && x.cause != "mount_compliance") {
         x.joint = r.String(r.Required(e, "joint", what), what + ".joint");
         if (robot.JointIndex(x.joint) < 0) {
           r.Fail(e["joint"], what + ".joint: no joint named '" + x.joint + "'");

@@ -52,6 +52,12 @@ struct RobotRow {
 //           optional {cos2, sin2, cos3, sin3} for the 2nd and 3rd harmonics
 //   gain: {g}                    dimensionless, q = (1 + g) q_read
 //   drift: {vx, vy, vz}          mm per hour, tip drift in the base frame
+//   elastostatic: {per_knm}      deg (mm) per kN m (kN) of the gravity torque
+//                                of the link masses about the joint
+//   thermal: {rate}              relative growth of the row's lengths per K
+//                                of temp_c - 20 (data with temp_c) or per h
+//   mount_compliance: {iso}      deg per kN m: base tilt under the arm's
+//           optional {aniso_cos, aniso_sin}  gravity moment (no joint)
 // axis_tilt is not an extension entry: it is the row's `beta`.
 struct Extension {
   std::string cause;

@@ -17,24 +17,16 @@
 #include "data/error.h"
 #include "data/provenance.h"
 #include "data/yaml_util.h"
+#include "diagnose/free_fit.h"
+#include "diagnose/nonparametric.h"
 
 namespace kincal {
 namespace {
 
-constexpr double kRadToDeg = 180.0 / M_PI;
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 // 97.5 % point of the standard normal and 95 % point of chi-square(1).
 constexpr double kZ95 = 1.959963984540054;
 constexpr double kChi2One95 = 3.841458820694124;
-// sin(angle) of a candidate column against the span of the model's columns
-// below which the candidate is structurally equivalent to the model.
-constexpr double kIdentifiableSine = 1e-5;
-
-const std::vector<std::string>& AllCauses() {
-  static const std::vector<std::string> causes = {
-      "backlash", "compliance", "cyclic", "gain", "axis_tilt", "drift"};
-  return causes;
-}
 
 std::vector<Measurement> Pick(const std::vector<Measurement>& ms,
                               const std::vector<int>& idx) {
@@ -56,110 +48,6 @@ double Rms(const ModelState& state, const std::vector<Measurement>& ms) {
   return std::sqrt(Rss(state, ms) / static_cast<double>(ms.size()));
 }
 
-double MaxAbsTau(const std::vector<Measurement>& ms, int joint) {
-  double m = 0.0;
-  for (const Measurement& x : ms) m = std::max(m, std::abs(x.input.tau[joint]));
-  return m;
-}
-
-// Log of the regularized incomplete beta I_x(a, b) (Numerical Recipes'
-// continued fraction, evaluated where it converges fast).
-double BetaContinuedFraction(double a, double b, double x) {
-  const double tiny = 1e-300;
-  double c = 1.0, d = 1.0 - (a + b) * x / (a + 1.0);
-  if (std::abs(d) < tiny) d = tiny;
-  d = 1.0 / d;
-  double h = d;
-  for (int m = 1; m <= 500; ++m) {
-    const double m2 = 2.0 * m;
-    double aa = m * (b - m) * x / ((a + m2 - 1.0) * (a + m2));
-    d = 1.0 + aa * d;
-    if (std::abs(d) < tiny) d = tiny;
-    c = 1.0 + aa / c;
-    if (std::abs(c) < tiny) c = tiny;
-    d = 1.0 / d;
-    h *= d * c;
-    aa = -(a + m) * (a + b + m) * x / ((a + m2) * (a + m2 + 1.0));
-    d = 1.0 + aa * d;
-    if (std::abs(d) < tiny) d = tiny;
-    c = 1.0 + aa / c;
-    if (std::abs(c) < tiny) c = tiny;
-    d = 1.0 / d;
-    const double del = d * c;
-    h *= del;
-    if (std::abs(del - 1.0) < 1e-15) break;
-  }
-  return h;
-}
-
-double LogIncompleteBeta(double a, double b, double x) {
-  if (x <= 0.0) return -std::numeric_limits<double>::infinity();
-  if (x >= 1.0) return 0.0;
-  const double log_front = std::lgamma(a + b) - std::lgamma(a) -
-                           std::lgamma(b) + a * std::log(x) +
-                           b * std::log1p(-x);
-  if (x < (a + 1.0) / (a + b + 2.0)) {
-    return log_front + std::log(BetaContinuedFraction(a, b, x)) - std::log(a);
-  }
-  const double rest = std::exp(
-      log_front + std::log(BetaContinuedFraction(b, a, 1.0 - x)) - std::log(b));
-  return std::log1p(-std::min(rest, 1.0));
-}
-
-// log P(F > f) for F(d1, d2).
-double LogFUpperTail(double f, double d1, double d2) {
-  if (!(f > 0)) return 0.0;
-  return LogIncompleteBeta(0.5 * d2, 0.5 * d1, d2 / (d2 + d1 * f));
-}
-
-// Column-normalised Jacobian columns; zero columns stay zero.
-Eigen::MatrixXd Normalized(Eigen::MatrixXd j) {
-  for (int c = 0; c < j.cols(); ++c) {
-    const double n = j.col(c).norm();
-    if (n > 0) j.col(c) /= n;
-  }
-  return j;
-}
-
-// Orthonormal basis of the column span of `a` (rank-revealing QR).
-Eigen::MatrixXd Basis(const Eigen::MatrixXd& a) {
-  if (a.cols() == 0) return Eigen::MatrixXd(a.rows(), 0);
-  Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(a);
-  qr.setThreshold(1e-10);
-  const int rank = static_cast<int>(qr.rank());
-  Eigen::MatrixXd q =
-      qr.householderQ() * Eigen::MatrixXd::Identity(a.rows(), rank);
-  return q;
-}
-
-// Which columns of `cand` (normalised) keep a part outside the span of
-// `basis` and of the candidate's earlier accepted columns.
-std::vector<bool> IndependentColumns(const Eigen::MatrixXd& basis,
-                                     Eigen::MatrixXd cand) {
-  cand = Normalized(cand);
-  Eigen::MatrixXd q = basis;
-  std::vector<bool> out(cand.cols(), false);
-  for (int c = 0; c < cand.cols(); ++c) {
-    Eigen::VectorXd rest = cand.col(c);
-    if (rest.norm() == 0) continue;
-    for (int pass = 0; pass < 2 && q.cols() > 0; ++pass) {
-      rest -= q * (q.transpose() * rest);
-    }
-    if (rest.norm() < kIdentifiableSine) continue;
-    out[c] = true;
-    q.conservativeResize(q.rows(), q.cols() + 1);
-    q.col(q.cols() - 1) = rest / rest.norm();
-  }
-  return out;
-}
-
-// True when every column of `cand` is independent of `basis`.
-bool IdentifiableAgainst(const Eigen::MatrixXd& basis,
-                         const Eigen::MatrixXd& cand) {
-  const std::vector<bool> ok = IndependentColumns(basis, cand);
-  return std::all_of(ok.begin(), ok.end(), [](bool b) { return b; });
-}
-
 // The candidate reduced to what the data can determine against `basis`:
 // drift keeps its identifiable components (a drift along a direction that
 // geometry already explains is that geometry); other causes need all their
@@ -176,99 +64,6 @@ bool ReduceToIdentifiable(const Eigen::MatrixXd& basis,
   }
   c->params = kept;
   return !kept.empty();
-}
-
-int IndexOf(const FitSummary& fit, const std::string& name) {
-  for (size_t i = 0; i < fit.params.size(); ++i) {
-    if (fit.params[i].name == name) return static_cast<int>(i);
-  }
-  return -1;
-}
-
-// Runs `work(i)` for i in [0, n) on up to `threads` threads.
-template <typename F>
-void ParallelFor(int n, int threads, const F& work) {
-  threads = std::max(1, std::min(threads, n));
-  if (threads == 1) {
-    for (int i = 0; i < n; ++i) work(i);
-    return;
-  }
-  std::atomic<int> next(0);
-  std::vector<std::thread> pool;
-  for (int t = 0; t < threads; ++t) {
-    pool.emplace_back([&] {
-      for (int i = next++; i < n; i = next++) work(i);
-    });
-  }
-  for (std::thread& t : pool) t.join();
-}
-
-// The per-axis noise from rows with identical joint readings; 0 when there
-// are too few repeats (fewer than 6 degrees of freedom).
-double RepeatedPoseNoise(const std::vector<Measurement>& ms) {
-  std::map<std::vector<double>, std::vector<int>> groups;
-  for (size_t i = 0; i < ms.size(); ++i) {
-    groups[ms[i].input.q].push_back(static_cast<int>(i));
-  }
-  double sum = 0.0;
-  int dof = 0;
-  for (const auto& kv : groups) {
-    if (kv.second.size() < 2) continue;
-    Eigen::Vector3d mean = Eigen::Vector3d::Zero();
-    for (int i : kv.second) mean += ms[i].p_in_meas;
-    mean /= static_cast<double>(kv.second.size());
-    for (int i : kv.second) sum += (ms[i].p_in_meas - mean).squaredNorm();
-    dof += 3 * (static_cast<int>(kv.second.size()) - 1);
-  }
-  return dof >= 6 ? std::sqrt(sum / dof) : 0.0;
-}
-
-// An upper bound on the per-axis noise from the model residuals of pose
-// pairs that are nearest neighbours in joint space (each joint scaled by its
-// spread): 0.5 E|r_i - r_j|^2 / 3 over the closest quarter of the pairs. A
-// systematic error that varies smoothly with the pose adds to it, so it
-// bounds the noise from above.
-double NearestPoseNoise(const ModelState& state,
-                        const std::vector<Measurement>& ms) {
-  const int n = static_cast<int>(ms.size());
-  if (n < 8) return 0.0;
-  const int nj = static_cast<int>(ms[0].input.q.size());
-  std::vector<double> scale(nj, 1.0);
-  for (int j = 0; j < nj; ++j) {
-    double mean = 0, sq = 0;
-    for (const Measurement& m : ms) mean += m.input.q[j];
-    mean /= n;
-    for (const Measurement& m : ms) sq += std::pow(m.input.q[j] - mean, 2);
-    const double sd = std::sqrt(sq / n);
-    scale[j] = sd > 1e-12 ? 1.0 / sd : 0.0;
-  }
-  std::vector<Eigen::Vector3d> r(n);
-  for (int i = 0; i < n; ++i) r[i] = Residual(state, ms[i]);
-  std::vector<std::pair<double, double>> pairs;  // distance, half sq diff
-  for (int i = 0; i < n; ++i) {
-    double best = std::numeric_limits<double>::infinity();
-    int arg = -1;
-    for (int k = 0; k < n; ++k) {
-      if (k == i) continue;
-      double d = 0;
-      for (int j = 0; j < nj; ++j) {
-        d += std::pow((ms[i].input.q[j] - ms[k].input.q[j]) * scale[j], 2);
-      }
-      if (d < best) {
-        best = d;
-        arg = k;
-      }
-    }
-    if (arg >= 0 && best > 0) {
-      pairs.emplace_back(best, 0.5 * (r[i] - r[arg]).squaredNorm() / 3.0);
-    }
-  }
-  if (pairs.size() < 4) return 0.0;
-  std::sort(pairs.begin(), pairs.end());
-  const size_t use = std::max<size_t>(4, pairs.size() / 4);
-  double sum = 0;
-  for (size_t i = 0; i < use; ++i) sum += pairs[i].second;
-  return std::sqrt(sum / use);
 }
 
 struct Problem {
@@ -359,27 +154,44 @@ std::vector<Measurement> Measurements(const Chain& nominal,
   return measured;
 }
 
-Candidate MakeCandidate(const Chain& chain, const std::string& cause,
-                        int joint) {
-  Candidate c;
-  c.cause = cause;
-  c.joint = joint;
-  if (cause == "backlash") {
-    c.params = {JointErrorParam(chain, joint, kBacklash)};
-  } else if (cause == "compliance") {
-    c.params = {JointErrorParam(chain, joint, kCompliance)};
-  } else if (CyclicHarmonic(cause) > 0) {
-    const int k = CyclicCosIndex(CyclicHarmonic(cause));
-    c.params = {JointErrorParam(chain, joint, k),
-                JointErrorParam(chain, joint, k + 1)};
-  } else if (cause == "gain") {
-    c.params = {JointErrorParam(chain, joint, kGain)};
-  } else if (cause == "axis_tilt") {
-    c.params = {AxisTiltParam(chain, joint - 1)};
-  } else if (cause == "drift") {
-    c.params = DriftParams();
-  }
-  return c;
+// The inputs of the smooth correction: every joint reading, t and temp_c
+// when they vary.
+SmoothInputs MakeSmoothInputs(const Observations& obs,
+                              const std::vector<Measurement>& train,
+                              const std::vector<Measurement>& held) {
+  SmoothInputs in;
+  in.names = obs.joint_names;
+  const bool time = obs.AnyTime(), temp = obs.AnyTemp();
+  if (time) in.names.push_back("t");
+  if (temp) in.names.push_back("temp_c");
+  auto row = [&](const Measurement& m) {
+    const Observation& o = obs.rows[m.row];
+    std::vector<double> x = o.q;
+    if (time) x.push_back(o.HasTime() ? o.t_s : 0.0);
+    if (temp) x.push_back(o.HasTemp() ? o.temp_c : 0.0);
+    return x;
+  };
+  for (const Measurement& m : train) in.train.push_back(row(m));
+  for (const Measurement& m : held) in.held.push_back(row(m));
+  return in;
+}
+
+SmoothCorrection SmoothRest(const Observations& obs, const Problem& pb,
+                            const ModelState& state) {
+  std::vector<Eigen::Vector3d> rt, rh;
+  for (const Measurement& m : pb.train) rt.push_back(Residual(state, m));
+  for (const Measurement& m : pb.held) rh.push_back(Residual(state, m));
+  return FitSmoothCorrection(MakeSmoothInputs(obs, pb.train, pb.held), rt, rh);
+}
+
+// RMS on the validation series with the model held fixed and only the
+// measuring frame registered (what `kincal evaluate` does); NaN when none.
+double ValidationRms(const ModelState& state,
+                     const std::vector<Measurement>& validation) {
+  if (validation.empty()) return kNaN;
+  ModelState s = state;
+  InitializeFrameAndPoints(validation, &s);
+  return Rms(s, validation);
 }
 
 ModelState StateWithChain(const Chain& chain) {
@@ -403,144 +215,12 @@ void DiagnoseOptions::Check() const {
           "min effect must be >= 0 mm");
   Require(unexplained_ratio > 1, "unexplained ratio must be > 1");
   for (const std::string& c : causes) {
-    Require(std::find(AllCauses().begin(), AllCauses().end(), c) !=
-                AllCauses().end(),
+    Require(std::find(CatalogueCauses().begin(), CatalogueCauses().end(), c) !=
+                CatalogueCauses().end(),
             "unknown cause '" + c +
-                "' (backlash, compliance, cyclic, gain, axis_tilt, drift)");
+                "' (backlash, compliance, cyclic, gain, axis_tilt, drift, "
+                "elastostatic, thermal, mount_compliance)");
   }
-}
-
-int CyclicHarmonic(const std::string& cause) {
-  if (cause == "cyclic") return 1;
-  for (int h = 2; h <= kMaxHarmonic; ++h) {
-    if (cause == CyclicCause(h)) return h;
-  }
-  return 0;
-}
-
-std::string CyclicCause(int harmonic) {
-  return harmonic == 1 ? "cyclic" : "cyclic" + std::to_string(harmonic);
-}
-
-std::string Candidate::Label(const Chain& chain) const {
-  return joint < 0 ? cause : cause + ":" + chain.rows[joint].name;
-}
-
-std::vector<Candidate> CatalogueCandidates(
-    const Chain& chain, const std::vector<Measurement>& ms,
-    const std::vector<std::string>& causes_in) {
-  const std::vector<std::string>& causes =
-      causes_in.empty() ? AllCauses() : causes_in;
-  auto wanted = [&](const std::string& c) {
-    return std::find(causes.begin(), causes.end(), c) != causes.end();
-  };
-  std::vector<Candidate> out;
-  const int nj = chain.num_joints();
-  const std::vector<int> parallel = ParallelAxisRows(chain);
-  for (int j = 0; j < nj; ++j) {
-    bool pos = false, neg = false;
-    double tau_min = std::numeric_limits<double>::infinity(),
-           tau_max = -tau_min;
-    for (const Measurement& m : ms) {
-      pos = pos || m.input.s[j] > 0;
-      neg = neg || m.input.s[j] < 0;
-      tau_min = std::min(tau_min, m.input.tau[j]);
-      tau_max = std::max(tau_max, m.input.tau[j]);
-    }
-    const bool revolute = chain.rows[j].type == JointType::kRevolute;
-    if (wanted("backlash") && pos && neg)
-      out.push_back(MakeCandidate(chain, "backlash", j));
-    if (wanted("compliance") &&
-        tau_max - tau_min > 1e-6 * std::max(1.0, std::abs(tau_max))) {
-      out.push_back(MakeCandidate(chain, "compliance", j));
-    }
-    if (wanted("cyclic") && revolute) {
-      // First harmonic (the spec's cyclic), then the higher ones, which pay
-      // where a transmission error is not a pure eccentricity.
-      for (int h = 1; h <= kMaxHarmonic; ++h) {
-        out.push_back(MakeCandidate(chain, CyclicCause(h), j));
-      }
-    }
-    if (wanted("gain")) out.push_back(MakeCandidate(chain, "gain", j));
-    if (wanted("axis_tilt") && j >= 1 &&
-        std::find(parallel.begin(), parallel.end(), j - 1) != parallel.end()) {
-      out.push_back(MakeCandidate(chain, "axis_tilt", j));
-    }
-  }
-  if (wanted("drift")) {
-    double t_min = std::numeric_limits<double>::infinity(), t_max = -t_min;
-    for (const Measurement& m : ms) {
-      t_min = std::min(t_min, m.input.t_h);
-      t_max = std::max(t_max, m.input.t_h);
-    }
-    if (t_max - t_min > 1e-9) out.push_back(MakeCandidate(chain, "drift", -1));
-  }
-  return out;
-}
-
-Magnitude CandidateMagnitude(const Candidate& c, const ModelState& state,
-                             const FitSummary& fit, double max_abs_tau) {
-  Magnitude m;
-  const Chain& chain = state.chain;
-  const bool revolute =
-      c.joint >= 0 && chain.rows[c.joint].type == JointType::kRevolute;
-  const double angle_unit = revolute ? kRadToDeg : 1.0;
-  // Values (internal) and their covariance (internal, from the fit).
-  const int k = static_cast<int>(c.params.size());
-  Eigen::VectorXd v(k);
-  Eigen::MatrixXd cov = Eigen::MatrixXd::Constant(k, k, kNaN);
-  std::vector<int> idx(k);
-  for (int a = 0; a < k; ++a) {
-    v[a] = ParamValue(state, c.params[a]);
-    idx[a] = IndexOf(fit, c.params[a].name);
-  }
-  const bool have_cov =
-      fit.covariance.rows() == static_cast<int>(fit.params.size()) &&
-      fit.covariance.rows() > 0;
-  for (int a = 0; a < k; ++a) {
-    for (int b = 0; b < k; ++b) {
-      if (have_cov && idx[a] >= 0 && idx[b] >= 0) {
-        cov(a, b) = fit.covariance(idx[a], idx[b]);
-      }
-    }
-  }
-  // magnitude = g(v); gradient for the delta method.
-  Eigen::VectorXd grad = Eigen::VectorXd::Zero(k);
-  if (c.cause == "backlash") {
-    m.unit = revolute ? "deg" : "mm";
-    m.value = v[0] * angle_unit;
-    grad[0] = angle_unit;
-  } else if (c.cause == "compliance") {
-    m.unit = revolute ? "deg" : "mm";
-    m.value = v[0] * max_abs_tau * angle_unit;
-    grad[0] = max_abs_tau * angle_unit;
-  } else if (c.cause == "gain") {
-    m.unit = "1";
-    m.value = v[0];
-    grad[0] = 1.0;
-  } else if (c.cause == "axis_tilt") {
-    m.unit = "deg";
-    m.value = v[0] * kRadToDeg;
-    grad[0] = kRadToDeg;
-  } else {  // cyclic (deg amplitude) and drift (mm/h norm)
-    const bool cyclic = CyclicHarmonic(c.cause) > 0;
-    const double unit = cyclic ? kRadToDeg : 1.0;
-    m.unit = cyclic ? "deg" : "mm/h";
-    const double norm = v.norm();
-    m.value = norm * unit;
-    if (norm > 0) grad = v / norm * unit;
-  }
-  const double var = grad.dot(cov * grad);
-  m.sigma = var >= 0 ? std::sqrt(var) : kNaN;
-  m.ci_low = m.value - kZ95 * m.sigma;
-  m.ci_high = m.value + kZ95 * m.sigma;
-  if (CyclicHarmonic(c.cause) > 0 || c.cause == "drift")
-    m.ci_low = std::max(0.0, m.ci_low);
-  return m;
-}
-
-double FDistributionUpperTail(double f, double d1, double d2) {
-  return std::exp(LogFUpperTail(f, d1, d2));
 }
 
 DiagnosisResult DiagnoseModel(const Robot& nominal, const Observations& obs,
@@ -567,14 +247,26 @@ DiagnosisResult DiagnoseModel(const Robot& nominal, const Observations& obs,
   out.nominal_heldout_rms_mm = Rms(current, pb.held);
   double current_rss = Rss(current, pb.train);
   double current_held = out.nominal_heldout_rms_mm;
+  std::vector<Measurement> validation;
+  for (const Observations& v : options.validation) {
+    ModelState scratch = StateWithChain(pb.nominal);
+    for (const Measurement& m : Measurements(pb.nominal, v, &scratch))
+      validation.push_back(m);
+  }
+  out.nominal_validation_rms_mm = ValidationRms(current, validation);
+  double current_validation = out.nominal_validation_rms_mm;
   const int n_res = 3 * static_cast<int>(pb.train.size());
 
   std::vector<Candidate> pool =
       CatalogueCandidates(pb.nominal, pb.all, options.causes);
   std::vector<Candidate> accepted;
-  std::vector<double> max_tau(pb.nominal.num_joints());
-  for (int j = 0; j < pb.nominal.num_joints(); ++j)
-    max_tau[j] = MaxAbsTau(pb.all, j);
+  const bool thermal_kelvin = ThermalUsesTemperature(obs);
+  auto scale_of = [&](const Candidate& c) {
+    return MagnitudeScale(c.cause, c.joint, pb.nominal, pb.all);
+  };
+  auto unit_of = [&](const Candidate& c, const std::string& unit) {
+    return c.cause == "thermal" && thermal_kelvin ? std::string("mm/K") : unit;
+  };
 
   // Residuals below this (mm per axis) are numerically exact data: nothing
   // measurable is left to explain.
@@ -657,7 +349,18 @@ DiagnosisResult DiagnoseModel(const Robot& nominal, const Observations& obs,
       fo.max_iterations = 100;
       fo.function_tolerance = 1e-10;
       fo.parameter_tolerance = 1e-10;
-      fits[c] = Fit(pb.train, fo, &states[c]);
+      // Differentiated in the free parameters only (diagnose/free_fit.h).
+      FreeFitOptions ffo;
+      ffo.free = fo.free;
+      ffo.bounds_center = fo.bounds_center;
+      ffo.max_iterations = fo.max_iterations;
+      ffo.function_tolerance = fo.function_tolerance;
+      ffo.parameter_tolerance = fo.parameter_tolerance;
+      if (options.free_parameter_fit) {
+        FreeFit(pb.train, ffo, &states[c]);
+      } else {
+        fits[c] = Fit(pb.train, fo, &states[c]);
+      }
       s.rss = Rss(states[c], pb.train);
       s.train_rms_mm = Rms(states[c], pb.train);
       s.heldout_rms_mm = Rms(states[c], pb.held);
@@ -673,13 +376,16 @@ DiagnosisResult DiagnoseModel(const Robot& nominal, const Observations& obs,
           pb.held.empty() || s.heldout_rms_mm < current_held;
       const double explained_mm =
           std::sqrt(drop / static_cast<double>(pb.train.size()));
+      s.validation_rms_mm = ValidationRms(states[c], validation);
+      const bool validation_better =
+          validation.empty() || s.validation_rms_mm < current_validation;
       s.significant = std::log(alpha) > log_p[c] && held_better &&
+                      validation_better &&
                       explained_mm >= options.min_effect_mm;
-      s.magnitude =
-          CandidateMagnitude(cand, states[c], fits[c],
-                             cand.joint >= 0 ? max_tau[cand.joint] : 0.0)
-              .value;
-      s.unit = CandidateMagnitude(cand, states[c], fits[c], 1.0).unit;
+      const Magnitude mag =
+          CandidateMagnitude(cand, states[c], fits[c], scale_of(cand));
+      s.magnitude = mag.value;
+      s.unit = unit_of(cand, mag.unit);
     });
     out.steps.push_back(scores);
     if (step == 0) {
@@ -692,8 +398,14 @@ DiagnosisResult DiagnoseModel(const Robot& nominal, const Observations& obs,
     int best = -1;
     for (size_t c = 0; c < pool.size(); ++c) {
       if (!scores[c].significant) continue;
-      if (best < 0 || log_p[c] < log_p[best] ||
-          (log_p[c] == log_p[best] && scores[c].rss < scores[best].rss)) {
+      // With validation series the candidate that predicts them best wins
+      // (the F-test only admits); without, the most significant one.
+      const bool better =
+          validation.empty()
+              ? (log_p[c] < log_p[best] ||
+                 (log_p[c] == log_p[best] && scores[c].rss < scores[best].rss))
+              : scores[c].validation_rms_mm < scores[best].validation_rms_mm;
+      if (best < 0 || better) {
         best = static_cast<int>(c);
       }
     }
@@ -704,6 +416,8 @@ DiagnosisResult DiagnoseModel(const Robot& nominal, const Observations& obs,
     f.joint = b.joint;
     f.heldout_rms_before_mm = current_held;
     f.heldout_rms_after_mm = b.heldout_rms_mm;
+    f.validation_rms_before_mm = current_validation;
+    f.validation_rms_after_mm = b.validation_rms_mm;
     f.train_rms_after_mm = b.train_rms_mm;
     f.f = b.f;
     f.p_value = b.p_value;
@@ -724,10 +438,12 @@ DiagnosisResult DiagnoseModel(const Robot& nominal, const Observations& obs,
     for (const ParamInfo& q : pool[best].params) current_free.push_back(q);
     current_rss = b.rss;
     current_held = b.heldout_rms_mm;
+    current_validation = b.validation_rms_mm;
     pool.erase(pool.begin() + best);
   }
   out.final_train_rms_mm = Rms(current, pb.train);
   out.final_heldout_rms_mm = current_held;
+  out.final_validation_rms_mm = current_validation;
   out.residual_sigma_mm = std::sqrt(
       current_rss / std::max(1, n_res - static_cast<int>(current_free.size())));
 
@@ -740,10 +456,10 @@ DiagnosisResult DiagnoseModel(const Robot& nominal, const Observations& obs,
   const FitSummary final_fit = Fit(pb.all, fo, &final_state);
   for (size_t i = 0; i < accepted.size(); ++i) {
     const Candidate& c = accepted[i];
-    const Magnitude m = CandidateMagnitude(
-        c, final_state, final_fit, c.joint >= 0 ? max_tau[c.joint] : 0.0);
+    const Magnitude m =
+        CandidateMagnitude(c, final_state, final_fit, scale_of(c));
     out.findings[i].magnitude = m.value;
-    out.findings[i].unit = m.unit;
+    out.findings[i].unit = unit_of(c, m.unit);
     out.findings[i].ci_low = m.ci_low;
     out.findings[i].ci_high = m.ci_high;
   }
@@ -779,9 +495,19 @@ DiagnosisResult DiagnoseModel(const Robot& nominal, const Observations& obs,
       u.ci_low = std::sqrt(std::max(0.0, 3.0 * (s2 * (1 - rel) - n2)));
       u.ci_high = std::sqrt(std::max(0.0, 3.0 * (s2 * (1 + rel) - n2)));
       u.heldout_rms_before_mm = u.heldout_rms_after_mm = current_held;
+      u.validation_rms_before_mm = u.validation_rms_after_mm =
+          current_validation;
       u.train_rms_after_mm = out.final_train_rms_mm;
       u.p_value = kNaN;
       u.f = s2 / n2;
+      // What the rest depends on: a smooth correction over the pose inputs,
+      // chosen by cross-validation, tested on the held-out poses.
+      const SmoothCorrection sc = SmoothRest(obs, pb, current);
+      u.depends_on = sc.depends_on;
+      u.cv_explained = sc.cv_explained;
+      u.smooth_k = sc.k;
+      u.single_inputs = sc.single;
+      if (!pb.held.empty()) u.heldout_rms_after_mm = sc.heldout_rms_after_mm;
       out.findings.push_back(u);
     }
   }
@@ -851,7 +577,7 @@ std::vector<Magnitude> FitCandidates(const Robot& nominal,
     }
     const Candidate& c = chosen[i];
     out.push_back(CandidateMagnitude(
-        c, state, fit, c.joint >= 0 ? MaxAbsTau(pb.all, c.joint) : 0.0));
+        c, state, fit, MagnitudeScale(c.cause, c.joint, pb.nominal, pb.all)));
   }
   return out;
 }
@@ -889,18 +615,33 @@ nlohmann::json DiagnosisJson(const DiagnosisResult& r,
                     {"train_rms_mm", Num(e.train_rms_mm)},
                     {"heldout_rms_mm", Num(e.heldout_rms_mm)}});
     }
-    findings.push_back({{"cause", SpecCause(f.cause)},
-                        {"harmonic", HarmonicOrNull(f.cause)},
-                        {"joint", JointOrNull(f.joint)},
-                        {"magnitude", Num(f.magnitude)},
-                        {"unit", f.unit},
-                        {"ci95", {Num(f.ci_low), Num(f.ci_high)}},
-                        {"heldout_rms_before_mm", Num(f.heldout_rms_before_mm)},
-                        {"heldout_rms_after_mm", Num(f.heldout_rms_after_mm)},
-                        {"train_rms_after_mm", Num(f.train_rms_after_mm)},
-                        {"f", Num(f.f)},
-                        {"p_value", Num(f.p_value)},
-                        {"equivalent", eq}});
+    findings.push_back(
+        {{"cause", SpecCause(f.cause)},
+         {"harmonic", HarmonicOrNull(f.cause)},
+         {"joint", JointOrNull(f.joint)},
+         {"magnitude", Num(f.magnitude)},
+         {"unit", f.unit},
+         {"ci95", {Num(f.ci_low), Num(f.ci_high)}},
+         {"heldout_rms_before_mm", Num(f.heldout_rms_before_mm)},
+         {"heldout_rms_after_mm", Num(f.heldout_rms_after_mm)},
+         {"train_rms_after_mm", Num(f.train_rms_after_mm)},
+         {"validation_rms_before_mm", Num(f.validation_rms_before_mm)},
+         {"validation_rms_after_mm", Num(f.validation_rms_after_mm)},
+         {"f", Num(f.f)},
+         {"p_value", Num(f.p_value)},
+         {"equivalent", eq}});
+    if (f.cause == "unexplained") {
+      nlohmann::json single = nlohmann::json::object();
+      for (const auto& kv : f.single_inputs) single[kv.first] = Num(kv.second);
+      findings.back()["depends_on"] = f.depends_on;
+      findings.back()["smooth_correction"] = {
+          {"method",
+           "k-nearest-neighbour regression, k and inputs by 5-fold "
+           "cross-validation"},
+          {"k", f.smooth_k},
+          {"cv_explained", Num(f.cv_explained)},
+          {"single_input_cv_explained", single}};
+    }
   }
   nlohmann::json steps = nlohmann::json::array();
   for (const auto& step : r.steps) {
@@ -916,6 +657,7 @@ nlohmann::json DiagnosisJson(const DiagnosisResult& r,
                        {"f", Num(c.f)},
                        {"p_value", Num(c.p_value)},
                        {"significant", c.significant},
+                       {"validation_rms_mm", Num(c.validation_rms_mm)},
                        {"magnitude", Num(c.magnitude)},
                        {"unit", c.unit}});
     }
@@ -926,6 +668,9 @@ nlohmann::json DiagnosisJson(const DiagnosisResult& r,
   j["nominal"] = {{"train_rms_mm", Num(r.nominal_train_rms_mm)},
                   {"heldout_rms_mm", Num(r.nominal_heldout_rms_mm)}};
   j["findings"] = findings;
+  j["validation"] = {{"series", options.validation.size()},
+                     {"nominal_rms_mm", Num(r.nominal_validation_rms_mm)},
+                     {"final_rms_mm", Num(r.final_validation_rms_mm)}};
   j["final"] = {{"heldout_rms_mm", Num(r.final_heldout_rms_mm)},
                 {"train_rms_mm", Num(r.final_train_rms_mm)}};
   j["train_poses"] = r.train_poses;

@@ -36,6 +36,8 @@
 #include "calib/model_state.h"
 #include "data/observations.h"
 #include "data/robot.h"
+#include "diagnose/catalogue.h"
+#include "diagnose/statistics.h"
 
 namespace kincal {
 
@@ -56,42 +58,21 @@ struct DiagnoseOptions {
   // Residual scatter above this multiple of the noise counts as systematic.
   double unexplained_ratio = 1.5;
   int num_threads = 2;
+  // Candidate refits differentiate only the free parameters
+  // (diagnose/free_fit.h); false = calib/fit.h's Fit (the speed reference
+  // of bench/diagnose_bench --only ur10).
+  bool free_parameter_fit = true;
   // Restrict candidates to these causes (empty = all of the catalogue).
   std::vector<std::string> causes;
+  // Cross-series validation: other measured series of the same robot that
+  // the fit never sees (e.g. train on UR10 series C, validate on B). Each
+  // candidate's training fit is evaluated there with only the measuring
+  // frame re-registered; with validation data a candidate must also lower
+  // the validation RMS, and the lowest validation RMS wins the step.
+  std::vector<Observations> validation;
 
   void Check() const;  // InputError on invalid values
 };
-
-// One catalogue candidate: a cause on a joint (joint -1 for drift).
-// Cyclic candidates carry their harmonic in the cause name: "cyclic" (first,
-// the spec's cause), "cyclic2", "cyclic3". CyclicHarmonic returns 1..3 for
-// them and 0 for any other cause.
-int CyclicHarmonic(const std::string& cause);
-std::string CyclicCause(int harmonic);
-
-struct Candidate {
-  std::string cause;
-  int joint = -1;
-  std::vector<ParamInfo> params;
-  std::string Label(const Chain& chain) const;  // "backlash:j3", "drift"
-};
-
-// All catalogue candidates that apply to this chain and data (before the
-// identifiability check). `measurements` give s, tau and t.
-std::vector<Candidate> CatalogueCandidates(
-    const Chain& chain, const std::vector<Measurement>& measurements,
-    const std::vector<std::string>& causes = {});
-
-// A candidate's magnitude in the spec's units with its 95 % interval, from a
-// fitted state and its FitSummary covariance (NaN interval when absent).
-struct Magnitude {
-  double value = 0.0;
-  double sigma = 0.0;
-  double ci_low = 0.0, ci_high = 0.0;
-  std::string unit;
-};
-Magnitude CandidateMagnitude(const Candidate& c, const ModelState& state,
-                             const FitSummary& fit, double max_abs_tau);
 
 // Score of one candidate in one selection step.
 struct CandidateScore {
@@ -102,7 +83,8 @@ struct CandidateScore {
   double rss = 0.0;  // training sum of squared residuals, mm^2
   double f = 0.0, p_value = 1.0;
   bool significant = false;
-  double magnitude = 0.0;  // spec units, from the training fit
+  double validation_rms_mm = 0.0;  // NaN without validation data
+  double magnitude = 0.0;          // spec units, from the training fit
   std::string unit;
 };
 
@@ -120,8 +102,18 @@ struct Finding {
   double ci_low = 0.0, ci_high = 0.0;
   double heldout_rms_before_mm = 0.0, heldout_rms_after_mm = 0.0;
   double train_rms_after_mm = 0.0;
+  // Cross-series validation RMS (NaN without validation data).
+  double validation_rms_before_mm = 0.0, validation_rms_after_mm = 0.0;
   double f = 0.0, p_value = 1.0;
   std::vector<Equivalent> equivalent;
+  // `unexplained` only: the inputs the systematic rest depends on, strongest
+  // first, and the smooth correction's cross-validated share of the residual
+  // power (diagnose/nonparametric.h); heldout_rms_after_mm is then the
+  // held-out RMS after that correction.
+  std::vector<std::string> depends_on;
+  double cv_explained = 0.0;
+  int smooth_k = 0;
+  std::vector<std::pair<std::string, double>> single_inputs;
 };
 
 struct DiagnosisResult {
@@ -130,6 +122,8 @@ struct DiagnosisResult {
   double nominal_train_rms_mm = 0.0, nominal_heldout_rms_mm = 0.0;
   std::vector<Finding> findings;
   double final_train_rms_mm = 0.0, final_heldout_rms_mm = 0.0;
+  // Cross-series validation (options.validation), frame re-registered only.
+  double nominal_validation_rms_mm = 0.0, final_validation_rms_mm = 0.0;
   // Noise per axis (mm) and where it came from: "stated", "repeated poses",
   // "nearest poses (upper bound)", "none".
   double noise_mm = 0.0;
@@ -168,9 +162,6 @@ nlohmann::json DiagnosisJson(const DiagnosisResult& result,
 // CSV of the final residuals: pose,set,dx_mm,dy_mm,dz_mm,error_mm.
 std::string ResidualsCsv(const DiagnosisResult& result,
                          const Observations& obs);
-
-// Upper tail of the F(d1, d2) distribution: P(F > f).
-double FDistributionUpperTail(double f, double d1, double d2);
 
 }  // namespace kincal
 

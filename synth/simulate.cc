@@ -49,6 +49,8 @@ Vec3<Jet> TipJet(const Chain& chain, const PoseInput& in, const Jet* q_read) {
     const JointErrorBlock& e = chain.joint_errors[j];
     q[j] = (1.0 + e[kGain]) * q_read[j] - Jet(0.5 * in.s[j] * e[kBacklash]) +
            Jet(e[kCompliance] * in.tau[j]);
+    if (in.tau_mass.size() == chain.rows.size() - 1)
+      q[j] += Jet(e[kElastostatic] * in.tau_mass[j]);
     if (chain.rows[j].type == JointType::kRevolute) {
       for (int h = 1; h <= kMaxHarmonic; ++h) {
         const int k = CyclicCosIndex(h);
@@ -125,10 +127,12 @@ Effect ParseEffect(const std::string& text, const Robot& robot) {
   const std::string usage =
       "--effect '" + text +
       "': expected cause:joint:magnitude (backlash, compliance, cyclic, gain, "
-      "axis_tilt) or drift:magnitude";
-  if (parts.size() == 2 && parts[0] == "drift" &&
+      "axis_tilt, elastostatic, thermal) or drift:magnitude or "
+      "mount_compliance:magnitude";
+  if (parts.size() == 2 &&
+      (parts[0] == "drift" || parts[0] == "mount_compliance") &&
       ParseFiniteDouble(parts[1], &value)) {
-    e.cause = "drift";
+    e.cause = parts[0];
     e.magnitude = value;
     return e;
   }
@@ -141,7 +145,8 @@ Effect ParseEffect(const std::string& text, const Robot& robot) {
   const bool cyclic =
       e.cause == "cyclic" || e.cause == "cyclic2" || e.cause == "cyclic3";
   if (e.cause != "backlash" && e.cause != "compliance" && !cyclic &&
-      e.cause != "gain" && e.cause != "axis_tilt") {
+      e.cause != "gain" && e.cause != "axis_tilt" &&
+      e.cause != "elastostatic" && e.cause != "thermal") {
     throw InputError(usage);
   }
   const int j = robot.JointIndex(e.joint);
@@ -173,7 +178,7 @@ SimulatedSession Simulate(const Robot& nominal, const SimulateOptions& opt) {
   const Chain nominal_chain = Chain::FromRobot(nominal);
   Chain truth = nominal_chain;
   truth.joint_errors.assign(truth.num_joints(), JointErrorBlock{});
-  truth.drift = {0, 0, 0};
+  truth.drift = {};
   for (const ParamInfo& p : GeometryParams(truth)) {
     if (!opt.perturbed.empty() &&
         std::find(opt.perturbed.begin(), opt.perturbed.end(), p.name) ==
@@ -280,6 +285,19 @@ SimulatedSession Simulate(const Robot& nominal, const SimulateOptions& opt) {
       out.effect_notes.push_back(note.str());
       continue;
     }
+    if (e.cause == "mount_compliance") {
+      // Isotropic: the tilt at the largest gravity moment of the poses.
+      double max_m = 0;
+      for (const auto& in : inputs)
+        max_m = std::max(max_m, in.moment.head<2>().norm());
+      Require(max_m > 1e-9,
+              "mount_compliance: no gravity moment in these poses");
+      truth.drift[kMountIso] = e.magnitude * kDegToRad / max_m;
+      note << "iso " << truth.drift[kMountIso] << " rad/Nm (max |M| " << max_m
+           << " N m)";
+      out.effect_notes.push_back(note.str());
+      continue;
+    }
     const int j = nominal.JointIndex(e.joint);
     const double unit =
         nominal.joints[j].type == JointType::kRevolute ? kDegToRad : 1.0;
@@ -305,6 +323,29 @@ SimulatedSession Simulate(const Robot& nominal, const SimulateOptions& opt) {
       err[kCompliance] = e.magnitude * unit / max_tau;
       note << "per_torque " << err[kCompliance] / unit << " (max |tau| "
            << max_tau << ")";
+    } else if (e.cause == "elastostatic") {
+      double max_tau = 0;
+      for (const auto& in : inputs)
+        max_tau = std::max(max_tau, std::abs(in.tau_mass[j]));
+      Require(max_tau > 1e-9,
+              "elastostatic on joint '" + e.joint +
+                  "': the link masses have no torque about it in these poses");
+      err[kElastostatic] = e.magnitude * unit / max_tau;
+      note << "per N m " << err[kElastostatic] / unit << " (max |tau| "
+           << max_tau << " N m)";
+    } else if (e.cause == "thermal") {
+      // Magnitude: growth of the row's length, mm per unit of the thermal
+      // input (h here: simulated sessions have no temperature).
+      const RowBlock& p = nominal_chain.rows[j].p;
+      const double length =
+          nominal_chain.convention == Convention::kUrdf
+              ? std::sqrt(p[0] * p[0] + p[1] * p[1] + p[2] * p[2])
+              : std::hypot(p[1], p[2]);
+      Require(length > 1e-6, "thermal on joint '" + e.joint +
+                                 "': its row has no length to grow");
+      err[kThermal] = e.magnitude / length;
+      note << "rate " << err[kThermal] << " per h (row length " << length
+           << " mm)";
     } else if (e.cause == "axis_tilt") {
       truth.rows[j - 1].p[4] += e.magnitude * kDegToRad;
       note << "beta on row " << truth.rows[j - 1].name;
@@ -347,9 +388,9 @@ SimulatedSession Simulate(const Robot& nominal, const SimulateOptions& opt) {
   for (size_t i = 0; i < obs.rows.size(); ++i) {
     std::vector<double> q(n);
     for (int j = 0; j < n; ++j) {
-      q[j] = ModelJointValue<double>(truth.rows[j].type, inputs[i].q[j],
-                                     inputs[i].s[j], inputs[i].tau[j],
-                                     truth.joint_errors[j].data());
+      q[j] = ModelJointValue<double>(
+          truth.rows[j].type, inputs[i].q[j], inputs[i].s[j], inputs[i].tau[j],
+          truth.joint_errors[j].data(), inputs[i].tau_mass[j]);
     }
     Eigen::Matrix4d m = BaseFromTipAt(truth, q);
     for (int k = 0; k < 3; ++k) m(k, 3) += truth.drift[k] * inputs[i].t_h;

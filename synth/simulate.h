@@ -25,7 +25,10 @@ namespace kincal {
 //   the poses), cyclic (deg amplitude, random phase; cyclic2 / cyclic3 for
 //   the 2nd / 3rd harmonic of the joint angle), gain (1), axis_tilt
 //   (deg, Hayati beta of the row before `joint`), drift (mm per hour, random
-//   direction).
+//   direction), elastostatic (deg at the largest |link-mass torque| of the
+//   poses), thermal (mm per hour growth of the joint's row length),
+//   mount_compliance (deg base tilt at the largest gravity moment, isotropic).
+//   The fixed-point IK and the rendered tip pose ignore thermal and mount.
 struct Effect {
   std::string cause;
   std::string joint;  // empty for drift

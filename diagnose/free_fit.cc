@@ -1,0 +1,137 @@
+#include "diagnose/free_fit.h"
+
+#include <ceres/ceres.h>
+
+#include <algorithm>
+#include <array>
+
+namespace kincal {
+namespace {
+
+constexpr int kMaxJoints = 16;
+
+// Where each free parameter goes: its block kind, block and index.
+struct Slot {
+  ParamKind kind;
+  int block, index;
+};
+
+class FreeResidual {
+ public:
+  FreeResidual(const ModelState& state, const std::vector<Slot>& slots,
+               const Measurement& m)
+      : state_(state), slots_(slots), m_(m) {}
+
+  template <typename T>
+  bool operator()(T const* const* params, T* residual) const {
+    const Chain& chain = state_.chain;
+    const int n = chain.num_joints();
+    std::array<std::array<T, kRowBlockSize>, kMaxJoints + 1> rows;
+    std::array<std::array<T, kJointErrorBlockSize>, kMaxJoints> errs;
+    std::array<T, kDriftBlockSize> global;
+    std::array<T, kFrameBlockSize> frame;
+    for (int r = 0; r <= n; ++r)
+      for (int k = 0; k < kRowBlockSize; ++k)
+        rows[r][k] = T(chain.rows[r].p[k]);
+    for (int j = 0; j < n; ++j)
+      for (int k = 0; k < kJointErrorBlockSize; ++k)
+        errs[j][k] = T(chain.joint_errors[j][k]);
+    for (int k = 0; k < kDriftBlockSize; ++k) global[k] = T(chain.drift[k]);
+    for (int k = 0; k < kFrameBlockSize; ++k)
+      frame[k] = T(state_.meas_from_base[k]);
+    const T* x = params[0];
+    for (size_t i = 0; i < slots_.size(); ++i) {
+      const Slot& s = slots_[i];
+      switch (s.kind) {
+        case ParamKind::kRow:
+          rows[s.block][s.index] = x[i];
+          break;
+        case ParamKind::kJointError:
+          errs[s.block][s.index] = x[i];
+          break;
+        case ParamKind::kDrift:
+          global[s.index] = x[i];
+          break;
+        case ParamKind::kFrame:
+          frame[s.index] = x[i];
+          break;
+        case ParamKind::kPoint:
+          break;  // not used by the diagnosis (measured rows only)
+      }
+    }
+    const T* row_ptrs[kMaxJoints + 1];
+    const T* err_ptrs[kMaxJoints];
+    for (int r = 0; r <= n; ++r) row_ptrs[r] = rows[r].data();
+    for (int j = 0; j < n; ++j) err_ptrs[j] = errs[j].data();
+    const Vec3<T> tip =
+        TipInBase<T>(chain, row_ptrs, err_ptrs, global.data(), m_.input);
+    const Vec3<T> p = ApplyFrame(frame.data(), tip);
+    for (int k = 0; k < 3; ++k) residual[k] = p[k] - m_.p_in_meas[k];
+    return true;
+  }
+
+ private:
+  const ModelState& state_;
+  const std::vector<Slot>& slots_;
+  const Measurement& m_;
+};
+
+}  // namespace
+
+double FreeFit(const std::vector<Measurement>& measurements,
+               const FreeFitOptions& options, ModelState* state) {
+  const int k = static_cast<int>(options.free.size());
+  std::vector<Slot> slots;
+  std::vector<double> x(k);
+  for (int i = 0; i < k; ++i) {
+    const ParamInfo& p = options.free[i];
+    slots.push_back({p.kind, p.block, p.index});
+    x[i] = ParamValue(*state, p);
+  }
+  // The functors read the frozen values from this copy.
+  const ModelState frozen = *state;
+  ceres::Problem::Options po;
+  ceres::Problem problem(po);
+  std::vector<std::unique_ptr<FreeResidual>> keep;
+  for (const Measurement& m : measurements) {
+    if (m.kind != Measurement::kMeasured) continue;
+    auto* cost = new ceres::DynamicAutoDiffCostFunction<FreeResidual, 8>(
+        new FreeResidual(frozen, slots, m));
+    cost->AddParameterBlock(k);
+    cost->SetNumResiduals(3);
+    problem.AddResidualBlock(cost, nullptr, x.data());
+  }
+  if (k > 0 && problem.NumResidualBlocks() > 0) {
+    if (options.bounds_center != nullptr) {
+      const Chain& c = *options.bounds_center;
+      for (int i = 0; i < k; ++i) {
+        const ParamInfo& p = options.free[i];
+        if (p.kind != ParamKind::kRow) continue;
+        const bool angle = c.convention == Convention::kUrdf
+                               ? p.index >= 3
+                               : (p.index == 0 || p.index >= 3);
+        const double center = c.rows.at(p.block).p.at(p.index);
+        const double bound = angle ? c.bound_angle_rad : c.bound_length_mm;
+        x[i] = std::min(std::max(x[i], center - bound), center + bound);
+        problem.SetParameterLowerBound(x.data(), i, center - bound);
+        problem.SetParameterUpperBound(x.data(), i, center + bound);
+      }
+    }
+    ceres::Solver::Options solver;
+    solver.linear_solver_type = ceres::DENSE_QR;
+    solver.max_num_iterations = options.max_iterations;
+    solver.function_tolerance = options.function_tolerance;
+    solver.parameter_tolerance = options.parameter_tolerance;
+    solver.gradient_tolerance = 1e-14;
+    solver.logging_type = ceres::SILENT;
+    ceres::Solver::Summary summary;
+    ceres::Solve(solver, &problem, &summary);
+  }
+  for (int i = 0; i < k; ++i) *ParamAddress(state, options.free[i]) = x[i];
+  double rss = 0.0;
+  for (const Measurement& m : measurements)
+    rss += Residual(*state, m).squaredNorm();
+  return rss;
+}
+
+}  // namespace kincal

@@ -1,0 +1,34 @@
+#ifndef KINCAL_DIAGNOSE_FREE_FIT_H_
+#define KINCAL_DIAGNOSE_FREE_FIT_H_
+
+// The candidate refits of `diagnose model`, differentiated only in the free
+// parameters: one compact Ceres parameter block holds just the parameters a
+// fit may change; every frozen entry of the chain stays a plain double.
+// calib/fit.h's Fit differentiates every entry of every block (~120 for a
+// 6-joint arm) and masks the frozen ones afterwards; a candidate fit frees
+// ~25, so autodiff does ~5x less work. Same model (calib/chain.h TipInBase),
+// same bounds (+-delta about the nominal geometry), no covariance.
+
+#include <vector>
+
+#include "calib/fit.h"
+#include "calib/model_state.h"
+
+namespace kincal {
+
+struct FreeFitOptions {
+  std::vector<ParamInfo> free;
+  const Chain* bounds_center = nullptr;
+  int max_iterations = 100;
+  double function_tolerance = 1e-10;
+  double parameter_tolerance = 1e-10;
+};
+
+// Fits the free parameters of `state` to the measured rows (kMeasured
+// only); returns the final sum of squared residuals, mm^2.
+double FreeFit(const std::vector<Measurement>& measurements,
+               const FreeFitOptions& options, ModelState* state);
+
+}  // namespace kincal
+
+#endif  // KINCAL_DIAGNOSE_FREE_FIT_H_

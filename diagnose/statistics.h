@@ -1,0 +1,63 @@
+#ifndef KINCAL_DIAGNOSE_STATISTICS_H_
+#define KINCAL_DIAGNOSE_STATISTICS_H_
+
+// Statistics of the model selection (diagnose/model_diagnosis.cc): the F
+// distribution, column spans for identifiability, noise estimators, and a
+// small thread pool for independent candidate fits.
+
+#include <Eigen/Core>
+#include <algorithm>
+#include <atomic>
+#include <thread>
+#include <vector>
+
+#include "calib/fit.h"
+#include "calib/model_state.h"
+
+namespace kincal {
+
+// log P(F > f) for F(d1, d2) (in logs so that strong effects still rank).
+double LogFUpperTail(double f, double d1, double d2);
+// Upper tail of the F(d1, d2) distribution: P(F > f).
+double FDistributionUpperTail(double f, double d1, double d2);
+
+// Column-normalised Jacobian columns; zero columns stay zero.
+Eigen::MatrixXd Normalized(Eigen::MatrixXd j);
+// Orthonormal basis of the column span of `a` (rank-revealing QR).
+Eigen::MatrixXd Basis(const Eigen::MatrixXd& a);
+// Which columns of `cand` (normalised) keep a part outside the span of
+// `basis` and of the candidate's earlier accepted columns (sine > 1e-5).
+std::vector<bool> IndependentColumns(const Eigen::MatrixXd& basis,
+                                     Eigen::MatrixXd cand);
+// True when every column of `cand` is independent of `basis`.
+bool IdentifiableAgainst(const Eigen::MatrixXd& basis,
+                         const Eigen::MatrixXd& cand);
+
+// The per-axis noise from rows with identical joint readings; 0 when there
+// are too few repeats (fewer than 6 degrees of freedom).
+double RepeatedPoseNoise(const std::vector<Measurement>& ms);
+// An upper bound on the per-axis noise from the model residuals of pose
+// pairs that are nearest neighbours in joint space (docs/DIAGNOSE.md).
+double NearestPoseNoise(const ModelState& state,
+                        const std::vector<Measurement>& ms);
+
+// Runs `work(i)` for i in [0, n) on up to `threads` threads.
+template <typename F>
+void ParallelFor(int n, int threads, const F& work) {
+  threads = std::max(1, std::min(threads, n));
+  if (threads == 1) {
+    for (int i = 0; i < n; ++i) work(i);
+    return;
+  }
+  std::atomic<int> next(0);
+  std::vector<std::thread> pool;
+  for (int t = 0; t < threads; ++t) {
+    pool.emplace_back([&] {
+      for (int i = next++; i < n; i = next++) work(i);
+    });
+  }
+  for (std::thread& t : pool) t.join();
+}
+}  // namespace kincal
+
+#endif  // KINCAL_DIAGNOSE_STATISTICS_H_
