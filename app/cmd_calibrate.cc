@@ -19,6 +19,7 @@ namespace {
 
 struct CalibrateArgs {
   std::string robot, obs, out, method = "lsq", root, tip;
+  double bound_length_mm = 0, bound_angle_deg = 0;  // 0: the robot file's
   std::vector<std::string> distances, free;
   CalibrateOptions options;
   bool json = false;
@@ -40,7 +41,9 @@ FixedDistance ParseDistance(const std::string& text) {
 }
 
 int RunCalibrate(CalibrateArgs args) {
-  const Robot nominal = ReadRobot(args.robot, args.root, args.tip);
+  Robot nominal = ReadRobot(args.robot, args.root, args.tip);
+  if (args.bound_length_mm > 0) nominal.bound_length_mm = args.bound_length_mm;
+  if (args.bound_angle_deg > 0) nominal.bound_angle_deg = args.bound_angle_deg;
   const Observations obs = ReadObservationsCsv(args.obs, nominal.JointNames());
   if (args.method == "paper") {
     args.options.method = CalibrateOptions::kPaper;
@@ -71,8 +74,7 @@ int RunCalibrate(CalibrateArgs args) {
     for (const auto& name : r.identifiability.UnidentifiableNames()) {
       held += (held.empty() ? "" : ", ") + name;
     }
-    if (!held.empty())
-      comment.push_back("held at nominal (not identifiable): " + held);
+    if (!held.empty()) comment.push_back("held (not identifiable): " + held);
     WriteFileAtomic(args.out, FormatRobotYaml(r.calibrated, comment));
   }
 
@@ -87,6 +89,18 @@ int RunCalibrate(CalibrateArgs args) {
   j["unidentifiable"] = id.UnidentifiableNames();
   j["weakly_identifiable"] = id.weak;
   j["relations"] = id.relations;
+  j["identifiability_passes"] = static_cast<int>(r.passes.size());
+  j["freed"] = r.freed;
+  j["held"] = r.held;
+  nlohmann::json passes = nlohmann::json::array();
+  for (const IdentifiabilityPass& p : r.passes) {
+    passes.push_back({{"free", p.num_free},
+                      {"freed", p.freed},
+                      {"held", p.held},
+                      {"train_rms_mm", Number(p.train_rms_mm)},
+                      {"undone", p.undone}});
+  }
+  j["passes"] = passes;
   j["condition_number"] = Number(id.condition);
   j["parameters"] = ParametersJson(r.fit, [&] {
     ModelState s;
@@ -131,6 +145,12 @@ int RunCalibrate(CalibrateArgs args) {
   std::printf("  %zu identifiable parameters, %zu held at nominal; %s\n",
               id.identifiable.size(), id.unidentifiable.size(),
               r.fit.termination.c_str());
+  std::printf("  %zu identifiability pass(es)", r.passes.size());
+  if (!r.freed.empty())
+    std::printf(", freed at the solution: %zu", r.freed.size());
+  if (!r.held.empty())
+    std::printf(", held at the solution: %zu", r.held.size());
+  std::printf("\n");
   for (const auto& rel : id.relations) std::printf("    %s\n", rel.c_str());
   std::printf("  %-14s %12s %12s %10s\n", "parameter", "nominal", "value",
               "sigma");
@@ -176,6 +196,18 @@ void AddCalibrateCommand(CLI::App& app, Runner* run) {
       ->capture_default_str();
   sub->add_option("--rank-tol", args->options.identifiability.tolerance,
                   "identifiability threshold (sine of the angle to the span)")
+      ->capture_default_str();
+  sub->add_option("--bound-length", args->bound_length_mm,
+                  "admissible deviation of lengths from nominal, mm "
+                  "(default: the robot file's bounds, 5 for a URDF)")
+      ->check(CLI::Range(1e-6, 1e4));
+  sub->add_option("--bound-angle", args->bound_angle_deg,
+                  "admissible deviation of angles from nominal, deg")
+      ->check(CLI::Range(1e-6, 180.0));
+  sub->add_option("--id-passes", args->options.max_identifiability_passes,
+                  "most passes of fit -> identifiability at the solution -> "
+                  "fit (1 = decide once, at the start values)")
+      ->check(CLI::Range(1, 20))
       ->capture_default_str();
   sub->add_option("--fixed-distance", args->distances,
                   "known distance between fixed points: A,B,MM (repeatable)");

@@ -1,6 +1,7 @@
 // kincal evaluate: fit only the base-to-measuring-frame transform, then report
 // the position error of a (calibrated) robot model on new data.
 
+#include <cmath>
 #include <cstdio>
 #include <memory>
 #include <sstream>
@@ -39,6 +40,42 @@ int RunEvaluate(const EvaluateArgs& args) {
   if (args.json) {
     nlohmann::json j = StatsJson(r.stats);
     j["extensions"] = robot.extensions.size();
+    // Single-point data: per fixed point, the scatter about its fitted
+    // position, and the distances between the fitted points (the model's
+    // prediction of a known distance, e.g. two sockets 50 mm apart).
+    const ModelState& st = r.state;
+    if (!st.point_labels.empty()) {
+      nlohmann::json points = nlohmann::json::object();
+      for (size_t k = 0; k < st.point_labels.size(); ++k) {
+        double sum = 0;
+        int n = 0;
+        for (size_t i = 0; i < r.rows.size(); ++i) {
+          if (obs.rows[r.rows[i]].fixed_point != st.point_labels[k]) continue;
+          sum += r.errors_mm[i] * r.errors_mm[i];
+          ++n;
+        }
+        const auto& p = st.points_in_base[k];
+        points[st.point_labels[k]] = {
+            {"n", n},
+            {"rms_mm", Number(n > 0 ? std::sqrt(sum / n) : NAN)},
+            {"in_base_mm", {p[0], p[1], p[2]}}};
+      }
+      j["fixed_points"] = points;
+      nlohmann::json dist = nlohmann::json::array();
+      for (size_t a = 0; a < st.point_labels.size(); ++a) {
+        for (size_t b = a + 1; b < st.point_labels.size(); ++b) {
+          const auto& pa = st.points_in_base[a];
+          const auto& pb = st.points_in_base[b];
+          const double d = std::sqrt((pa[0] - pb[0]) * (pa[0] - pb[0]) +
+                                     (pa[1] - pb[1]) * (pa[1] - pb[1]) +
+                                     (pa[2] - pb[2]) * (pa[2] - pb[2]));
+          dist.push_back({{"a", st.point_labels[a]},
+                          {"b", st.point_labels[b]},
+                          {"distance_mm", d}});
+        }
+      }
+      j["point_distances"] = dist;
+    }
     PrintJson(j);
     return 0;
   }

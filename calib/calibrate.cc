@@ -4,6 +4,8 @@
 #include <chrono>
 #include <map>
 #include <random>
+#include <set>
+#include <stdexcept>
 
 #include "calib/paper_method.h"
 #include "data/error.h"
@@ -127,7 +129,7 @@ CalibrateResult Calibrate(const Robot& nominal, const Observations& obs,
   frame_only.free = nuisance;
   frame_only.compute_covariance = false;
   frame_only.distances = distances;
-  Fit(train, frame_only, &state);
+  const FitSummary registered = Fit(train, frame_only, &state);
 
   std::vector<ParamInfo> candidates = nuisance;
   if (options.fit_geometry) {
@@ -137,8 +139,19 @@ CalibrateResult Calibrate(const Robot& nominal, const Observations& obs,
       candidates.push_back(FindParam(state, name));
     }
   }
-  result.identifiability = AnalyzeIdentifiability(
-      train, state, candidates, options.identifiability, distances);
+  // First look, at the start values: structural redundancy (the sine test)
+  // and, with a noise level of a fraction of the registered misfit, the
+  // parameters so weakly determined that a first fit would send them
+  // across the admissible range (a Panda's joint-7 tilt with single-point
+  // data) and into another minimum.
+  IdentifiabilityOptions first_look = options.identifiability;
+  if (options.fit_geometry && options.first_look_noise_fraction > 0 &&
+      first_look.noise_sigma_mm <= 0) {
+    first_look.noise_sigma_mm =
+        options.first_look_noise_fraction * registered.sigma0_mm;
+  }
+  result.identifiability =
+      AnalyzeIdentifiability(train, state, candidates, first_look, distances);
   const int robot_params = result.identifiability.RobotParameterCount();
   if (options.fit_geometry && robot_params == 0) {
     throw InputError(obs.source, 0, 0,
@@ -182,28 +195,89 @@ CalibrateResult Calibrate(const Robot& nominal, const Observations& obs,
     }
     return Fit(train, fit, &state);
   };
-  result.fit = run_fit(result.identifiability.identifiable);
+  // Least squares for the passes; eq. (9) once on the final set.
+  auto lsq_fit = [&](const std::vector<ParamInfo>& free) {
+    fit.free = free;
+    return Fit(train, fit, &state);
+  };
+  auto names_of = [](const std::vector<ParamInfo>& ps) {
+    std::set<std::string> out;
+    for (const ParamInfo& p : ps) out.insert(p.name);
+    return out;
+  };
+  result.fit = lsq_fit(result.identifiability.identifiable);
+  {
+    IdentifiabilityPass pass;
+    pass.num_free = num_free;
+    pass.train_rms_mm = result.fit.final_rms_mm;
+    result.passes.push_back(pass);
+  }
 
-  // Second look at the solution, with the noise level the fit found: drop
-  // parameters the data cannot pin down within a tenth of their admissible
-  // range, reset them to nominal and refit.
-  if (options.fit_geometry && result.fit.sigma0_mm > 0) {
-    IdentifiabilityOptions second = options.identifiability;
-    second.noise_sigma_mm = result.fit.sigma0_mm;
-    Identifiability at_solution =
-        AnalyzeIdentifiability(train, state, candidates, second, distances);
-    if (at_solution.identifiable.size() <
-        result.identifiability.identifiable.size()) {
-      for (const ParamInfo& p : at_solution.unidentifiable) {
-        if (p.kind == ParamKind::kRow) {
-          *ParamAddress(&state, p) = nominal_chain.rows[p.block].p[p.index];
-        }
+  // Identifiability at the solution, not at the guess: a nominal model with
+  // exactly perpendicular or parallel axes hides parameters that the real
+  // robot's data determine (and the reverse), so decide the free set again
+  // where the model fits, with the noise level the fit found, refit from
+  // there, and repeat until the set is stable. A parameter that leaves the
+  // set keeps its value (a jump back to nominal would throw away the fit
+  // and can land LM in another minimum) and may come back in a later pass.
+  // A pass whose fit ends worse than the one before is undone.
+  const std::set<std::string> first_set =
+      names_of(result.identifiability.identifiable);
+  std::vector<std::set<std::string>> seen = {first_set};
+  if (options.fit_geometry) {
+    for (int k = 1; k < options.max_identifiability_passes; ++k) {
+      if (!(result.fit.sigma0_mm > 0)) break;
+      IdentifiabilityOptions at = options.identifiability;
+      at.noise_sigma_mm = result.fit.sigma0_mm;
+      Identifiability next =
+          AnalyzeIdentifiability(train, state, candidates, at, distances);
+      const std::set<std::string> now =
+          names_of(result.identifiability.identifiable);
+      const std::set<std::string> then = names_of(next.identifiable);
+      if (then == now) {
+        result.identifiability = next;
+        break;
       }
-      result.identifiability = at_solution;
-      result.fit = run_fit(result.identifiability.identifiable);
-    } else {
-      result.identifiability = at_solution;
+      IdentifiabilityPass pass;
+      for (const ParamInfo& p : next.identifiable)
+        if (!now.count(p.name)) pass.freed.push_back(p.name);
+      for (const ParamInfo& p : result.identifiability.identifiable)
+        if (!then.count(p.name)) pass.held.push_back(p.name);
+      const bool cycle =
+          std::find(seen.begin(), seen.end(), then) != seen.end();
+      seen.push_back(then);
+      const ModelState before_state = state;
+      const FitSummary before_fit = result.fit;
+      FitSummary refit = lsq_fit(next.identifiable);
+      pass.num_free = static_cast<int>(next.identifiable.size());
+      pass.train_rms_mm = refit.final_rms_mm;
+      if (!(refit.final_rms_mm <=
+            before_fit.final_rms_mm * (1 + 1e-6) + 1e-9)) {
+        pass.undone = true;
+        result.passes.push_back(pass);
+        state = before_state;
+        result.fit = before_fit;
+        break;
+      }
+      result.passes.push_back(pass);
+      result.identifiability = next;
+      result.fit = refit;
+      if (cycle) break;  // a set seen before: stop on this fit
     }
+  }
+  const std::set<std::string> final_set =
+      names_of(result.identifiability.identifiable);
+  for (const std::string& n : final_set)
+    if (!first_set.count(n)) result.freed.push_back(n);
+  for (const std::string& n : first_set)
+    if (!final_set.count(n)) result.held.push_back(n);
+  if (options.method == CalibrateOptions::kPaper) {
+    result.fit = run_fit(result.identifiability.identifiable);
+  }
+  if (!std::isfinite(result.fit.final_rms_mm)) {
+    throw std::runtime_error(
+        "the fit ended in a non-finite state (NaN or infinity): the data or "
+        "the model carry values out of any physical range");
   }
 
   result.train = ComputeErrorStats(Norms(state, train));

@@ -40,12 +40,33 @@ struct CalibrateOptions {
   std::vector<std::string> extra_params;
   // Fit the geometry (false: only the frame / fixed points, as `evaluate`).
   bool fit_geometry = true;
+  // Passes of fit -> identifiability at the solution -> fit, until the free
+  // set is stable (1 = decide once, at the start values).
+  int max_identifiability_passes = 6;
+  // The first look (at the start values) also holds parameters whose
+  // predicted 1-sigma, for a noise level of this fraction of the misfit
+  // after registering the frame, exceeds IdentifiabilityOptions::
+  // max_sigma_fraction of their admissible range. 0 = sine test only.
+  double first_look_noise_fraction = 0.1;
+};
+
+// One pass of fit -> identifiability: parameters that entered (freed) or
+// left (held) the free set compared with the pass before, and the fit.
+struct IdentifiabilityPass {
+  int num_free = 0;
+  std::vector<std::string> freed, held;
+  double train_rms_mm = 0.0;
+  bool undone = false;  // its fit ended worse: the pass before was kept
 };
 
 struct CalibrateResult {
   Robot calibrated;  // nominal description with fitted values
   ModelState state;
-  Identifiability identifiability;
+  Identifiability identifiability;  // of the final pass
+  // Passes run (the first decides at the start values); freed / held: the
+  // final set against the first one.
+  std::vector<IdentifiabilityPass> passes;
+  std::vector<std::string> freed, held;
   FitSummary fit;
   std::vector<int> train_rows, heldout_rows;  // indices in observations
   ErrorStats train, heldout;                  // |residual| statistics, mm

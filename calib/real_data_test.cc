@@ -9,6 +9,7 @@
 #include <Eigen/Dense>
 #include <cmath>
 #include <map>
+#include <random>
 
 #include "calib/calibrate.h"
 #include "calib/evaluate.h"
@@ -278,6 +279,73 @@ TEST(RealDataTest, MukcaPandaSinglePointWithKnownDistance) {
   EXPECT_LE(eps, lsq.epsilon.mean_mm + 0.01);
   EXPECT_LT(eps, 0.2);
   EXPECT_GT(before_socket.at("hole_0"), 0.1);  // real seating scatter
+}
+
+// Issue 7: from the NOMINAL Panda (urdf/panda.urdf, what the MUKCa authors
+// start from) on panda_6 "front" with the 50 mm distance. Identifiability
+// decided again at the solution (fit -> identifiability -> fit) reaches the
+// authors' level: measured 0.1942 mm training, 31 parameters (2 passes: 32
+// free at the start, one held at the solution), where deciding once at the
+// nominal point with 5 mm / 5 deg bounds stopped at 0.649 mm. Held-out on the other
+// recordings: not above the authors' calibrated model on the same poses
+// (+0.01 mm tolerance for the seating scatter).
+TEST(RealDataTest, MukcaPandaFromNominalModel) {
+  KINCAL_REQUIRE_SHARED_DATA("mukca");
+  const Robot nominal = ReadRobot(Mukca("urdf/panda.urdf"), "", "ball_link");
+  const Robot authors =
+      ReadRobot(Mukca("calibrated_urdf/panda_6/panda.urdf"), "", "ball_link");
+  const Observations front = ReadMukcaDir(Mukca("data/panda_6/front"));
+  CalibrateOptions opt;
+  opt.holdout_fraction = 0.0;
+  opt.distances.push_back({"hole_0", "hole_1", 50.0});
+  const CalibrateResult r = Calibrate(nominal, front, opt);
+  RecordProperty("train_rms_mm", std::to_string(r.train.rms_mm));
+  EXPECT_LT(r.train.rms_mm, 0.20);
+  EXPECT_GE(r.passes.size(), 2u);
+  EXPECT_LT(std::abs(r.distance_errors_mm.at(0)), 0.003);
+  for (const char* test : {"left", "right"}) {
+    const Observations obs =
+        ReadMukcaDir(Mukca(std::string("data/panda_6/") + test));
+    const double ours = Evaluate(r.calibrated, obs).stats.rms_mm;
+    const double theirs = Evaluate(authors, obs).stats.rms_mm;
+    RecordProperty(std::string(test) + "_mm", std::to_string(ours));
+    EXPECT_LE(ours, theirs + 0.01) << test;
+  }
+}
+
+// Start values far from the truth (every joint origin moved 10 mm and 3 deg
+// in a seeded random direction, the ball by 10 mm) converge to the same
+// optimum as a start at the authors' answer: same training scatter, same
+// predictions on another recording.
+TEST(RealDataTest, MukcaPandaFarStartConvergesToTheSameOptimum) {
+  KINCAL_REQUIRE_SHARED_DATA("mukca");
+  const Robot answer =
+      ReadRobot(Mukca("calibrated_urdf/panda_6/panda.urdf"), "", "ball_link");
+  const Observations front = ReadMukcaDir(Mukca("data/panda_6/front"));
+  const Observations left = ReadMukcaDir(Mukca("data/panda_6/left"));
+  CalibrateOptions opt;
+  opt.holdout_fraction = 0.0;
+  opt.distances.push_back({"hole_0", "hole_1", 50.0});
+  const CalibrateResult at_answer = Calibrate(answer, front, opt);
+  std::mt19937_64 rng(7);
+  std::normal_distribution<double> normal;
+  auto direction = [&] {
+    Eigen::Vector3d v(normal(rng), normal(rng), normal(rng));
+    return Eigen::Vector3d(v.normalized());
+  };
+  for (int trial = 0; trial < 2; ++trial) {
+    Robot far = answer;
+    for (RobotRow& row : far.joints) {
+      row.xyz_mm += 10.0 * direction();
+      row.rpy_deg += 3.0 * direction();
+    }
+    far.tool.xyz_mm += 10.0 * direction();
+    const CalibrateResult r = Calibrate(far, front, opt);
+    EXPECT_NEAR(r.train.rms_mm, at_answer.train.rms_mm, 0.005) << trial;
+    EXPECT_NEAR(Evaluate(r.calibrated, left).stats.rms_mm,
+                Evaluate(at_answer.calibrated, left).stats.rms_mm, 0.01)
+        << trial;
+  }
 }
 
 }  // namespace

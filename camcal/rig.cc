@@ -2,6 +2,7 @@
 
 #include <Eigen/SVD>
 #include <cctype>
+#include <cmath>
 #include <set>
 #include <sstream>
 
@@ -34,6 +35,10 @@ Rigid3 ParsePose(const YamlReader& y, const YAML::Node& node,
   pose.R =
       Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(r.data());
   pose.t = Eigen::Vector3d(t[0], t[1], t[2]);
+  // Physical range: cameras of one rig within 100 m of each other.
+  if (!(pose.t.cwiseAbs().maxCoeff() <= 1e5)) {
+    y.Fail(node["t"], what + ".t: expected each coordinate within +-1e5 mm");
+  }
   const double ortho =
       (pose.R.transpose() * pose.R - Eigen::Matrix3d::Identity()).norm();
   if (ortho > 1e-4 || pose.R.determinant() <= 0) {
@@ -112,7 +117,9 @@ Rig ParseRigYaml(const std::string& text, const std::string& file) {
     auto positive_int = [&](const char* key) {
       const YAML::Node n = y.Required(c, key, what);
       const int v = y.Integer(n, what + "." + key);
-      if (v <= 0) y.Fail(n, what + "." + key + ": expected a positive integer");
+      if (v <= 0 || v > 100000) {
+        y.Fail(n, what + "." + key + ": expected a size in px, 1 to 100000");
+      }
       return v;
     };
     in.width = positive_int("width");
@@ -120,8 +127,13 @@ Rig ParseRigYaml(const std::string& text, const std::string& file) {
     auto number = [&](const char* key, bool positive) {
       const YAML::Node n = y.Required(c, key, what);
       const double v = y.Number(n, what + "." + key);
-      if (positive && v <= 0) {
-        y.Fail(n, what + "." + key + ": expected a positive number (px)");
+      if (positive && !(v >= 1 && v <= 1e6)) {
+        y.Fail(n,
+               what + "." + key + ": expected a focal length in px, 1 to 1e6");
+      }
+      if (!positive && !(std::abs(v) <= 1e6)) {
+        y.Fail(n,
+               what + "." + key + ": expected a position in px within +-1e6");
       }
       return v;
     };
@@ -132,6 +144,11 @@ Rig ParseRigYaml(const std::string& text, const std::string& file) {
     const YAML::Node dist = y.Required(c, "distortion", what);
     in.distortion = y.Numbers(dist, what + ".distortion", 0, 8);
     const size_t nd = in.distortion.size();
+    for (double k : in.distortion) {
+      if (!(std::abs(k) <= 1e4)) {
+        y.Fail(dist, what + ".distortion: expected coefficients within +-1e4");
+      }
+    }
     if (nd != 0 && nd != 4 && nd != 5 && nd != 8) {
       y.Fail(dist, what +
                        ".distortion: expected 0, 4, 5 or 8 numbers (OpenCV "

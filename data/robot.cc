@@ -70,6 +70,24 @@ const std::vector<std::string>& OptionalFields(const std::string& cause) {
   return cause == "cyclic" ? cyclic : none;
 }
 
+// Physical ranges: a robot link is shorter than 100 m; angles are within
+// one turn.
+constexpr double kMaxLengthMm = 1e5;
+constexpr double kMaxAngleDeg = 360.0;
+
+void CheckRange(const YamlReader& r, const YAML::Node& at,
+                const std::string& what, const std::vector<double>& values,
+                double max_abs, const char* unit) {
+  for (double v : values) {
+    if (!(std::abs(v) <= max_abs)) {
+      std::ostringstream os;
+      os << what << ": expected values within +-" << max_abs << " " << unit
+         << ", got " << v;
+      r.Fail(at, os.str());
+    }
+  }
+}
+
 void ReadGeometry(const YamlReader& r, const YAML::Node& node,
                   Convention convention, const std::string& what,
                   RobotRow* row) {
@@ -78,6 +96,8 @@ void ReadGeometry(const YamlReader& r, const YAML::Node& node,
         r.Numbers(r.Required(node, "xyz", what), what + ".xyz", 3, 3);
     const auto rpy =
         r.Numbers(r.Required(node, "rpy", what), what + ".rpy", 3, 3);
+    CheckRange(r, node["xyz"], what + ".xyz", xyz, kMaxLengthMm, "mm");
+    CheckRange(r, node["rpy"], what + ".rpy", rpy, kMaxAngleDeg, "deg");
     row->xyz_mm = Eigen::Vector3d(xyz[0], xyz[1], xyz[2]);
     row->rpy_deg = Eigen::Vector3d(rpy[0], rpy[1], rpy[2]);
     if (row->type != JointType::kFixed) {
@@ -95,6 +115,18 @@ void ReadGeometry(const YamlReader& r, const YAML::Node& node,
   row->a_mm = r.Number(r.Required(node, "a", what), what + ".a");
   row->theta_deg = r.Number(r.Required(node, "theta", what), what + ".theta");
   row->beta_deg = r.NumberOr(node, "beta", 0.0, what);
+  for (const char* key : {"d", "a"}) {
+    CheckRange(r, node[key], what + "." + key, {r.Number(node[key], what)},
+               kMaxLengthMm, "mm");
+  }
+  for (const char* key : {"alpha", "theta"}) {
+    CheckRange(r, node[key], what + "." + key, {r.Number(node[key], what)},
+               kMaxAngleDeg, "deg");
+  }
+  if (node["beta"]) {
+    CheckRange(r, node["beta"], what + ".beta", {row->beta_deg}, kMaxAngleDeg,
+               "deg");
+  }
 }
 
 }  // namespace
@@ -172,6 +204,8 @@ Robot ParseRobotYaml(const std::string& text, const std::string& file) {
     ReadGeometry(r, j, robot.convention, what, &row);
     if (j["limits"]) {
       const auto lim = r.Numbers(j["limits"], what + ".limits", 2, 2);
+      CheckRange(r, j["limits"], what + ".limits", lim, kMaxLengthMm,
+                 "(mm or deg)");
       if (!(lim[0] < lim[1])) {
         r.Fail(j["limits"],
                what + ".limits: expected [lower, upper] with lower < upper");
@@ -212,8 +246,11 @@ Robot ParseRobotYaml(const std::string& text, const std::string& file) {
     r.CheckKeys(b, {"length", "angle"}, "bounds");
     robot.bound_length_mm = r.NumberOr(b, "length", 5.0, "bounds");
     robot.bound_angle_deg = r.NumberOr(b, "angle", 5.0, "bounds");
-    if (robot.bound_length_mm <= 0 || robot.bound_angle_deg <= 0) {
-      r.Fail(b, "bounds: length and angle must be positive");
+    if (!(robot.bound_length_mm > 0 && robot.bound_length_mm <= 1e4 &&
+          robot.bound_angle_deg > 0 && robot.bound_angle_deg <= 180)) {
+      r.Fail(b,
+             "bounds: expected length in (0, 10000] mm and angle in "
+             "(0, 180] deg");
     }
   }
   if (root["extensions"] && !root["extensions"].IsNull()) {

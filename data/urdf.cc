@@ -189,6 +189,13 @@ Robot ParseUrdfChain(const std::string& xml, const std::string& file,
   robot.name =
       robot_el->Attribute("name") ? robot_el->Attribute("name") : "urdf";
   robot.convention = Convention::kUrdf;
+  // A URDF carries no admissible deviation. Its nominal values come from
+  // CAD, and the tool at its end (a ball, a probe, a gripper finger) is
+  // often mounted several millimetres off: MUKCa's Panda balls sit 7 mm
+  // from the nominal one. 20 mm / 10 deg keeps the fit physical without
+  // pinning such a tool to the bound.
+  robot.bound_length_mm = 20.0;
+  robot.bound_angle_deg = 10.0;
   Eigen::Isometry3d pending = Eigen::Isometry3d::Identity();
   for (const UrdfJoint& uj : path) {
     if (uj.type == "fixed") {

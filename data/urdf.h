@@ -12,7 +12,8 @@ namespace kincal {
 // root; empty tip = the deepest leaf when the path is unique (a chain).
 // Fixed joints are folded into the next movable joint's origin; those after
 // the last movable joint become the tool row. URDF metres and radians become
-// mm and degrees; `continuous` joints are revolute without limits.
+// mm and degrees; `continuous` joints are revolute without limits. Bounds
+// (admissible deviation from nominal): 20 mm and 10 degrees.
 // Throws InputError (file:line) on malformed files or a broken path.
 Robot ReadUrdfChain(const std::string& path, const std::string& root_link = "",
                     const std::string& tip_link = "");

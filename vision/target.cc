@@ -25,6 +25,10 @@ const TargetTag* Target::FindTag(int id) const {
 
 namespace {
 
+// Physical ranges of a target file (mm).
+constexpr double kMaxToolMm = 1e4;
+constexpr double kMinTagMm = 0.5, kMaxTagMm = 5000.0;
+
 Rigid3 ReadPose(const YamlReader& r, const YAML::Node& node,
                 const std::string& what) {
   r.ExpectMap(node, what);
@@ -34,6 +38,12 @@ Rigid3 ReadPose(const YamlReader& r, const YAML::Node& node,
   Rigid3 pose;
   pose.R << R[0], R[1], R[2], R[3], R[4], R[5], R[6], R[7], R[8];
   pose.t = Eigen::Vector3d(t[0], t[1], t[2]);
+  // Physical range: a tag on a tool sits within a metre of the tool origin
+  // (10 m allowed); beyond that the solver's arithmetic loses the tag.
+  if (!(pose.t.cwiseAbs().maxCoeff() <= kMaxToolMm)) {
+    r.Fail(node["t"], what + ".t: expected each coordinate within +-" +
+                          FormatDouble(kMaxToolMm) + " mm of the tool origin");
+  }
   const double err =
       (pose.R.transpose() * pose.R - Eigen::Matrix3d::Identity()).norm();
   if (err > 1e-3 || pose.R.determinant() <= 0) {
@@ -101,8 +111,10 @@ Target ParseTargetYaml(const std::string& text, const std::string& file) {
     }
     const YAML::Node size = r.Required(t, "size", what);
     tag.size_mm = r.Number(size, what + ".size");
-    if (!(tag.size_mm > 0)) {
-      r.Fail(size, what + ".size: expected a positive edge length in mm");
+    if (!(tag.size_mm >= kMinTagMm && tag.size_mm <= kMaxTagMm)) {
+      r.Fail(size, what + ".size: expected an edge length in mm between " +
+                       FormatDouble(kMinTagMm) + " and " +
+                       FormatDouble(kMaxTagMm));
     }
     tag.tool_from_tag = ReadPose(r, r.Required(t, "tool_from_tag", what),
                                  what + ".tool_from_tag");
@@ -111,6 +123,11 @@ Target ParseTargetYaml(const std::string& text, const std::string& file) {
   const auto tip = r.Numbers(r.Required(root, "tip_in_tool", "target file"),
                              "tip_in_tool", 3, 3);
   target.tip_in_tool = Eigen::Vector3d(tip[0], tip[1], tip[2]);
+  if (!(target.tip_in_tool.cwiseAbs().maxCoeff() <= kMaxToolMm)) {
+    r.Fail(root["tip_in_tool"],
+           "tip_in_tool: expected each coordinate within +-" +
+               FormatDouble(kMaxToolMm) + " mm of the tool origin");
+  }
   return target;
 }
 

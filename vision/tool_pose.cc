@@ -218,6 +218,19 @@ bool FitPose(const Rig& rig, const std::vector<TagObs>& obs,
   double q[4] = {q0.w(), q0.x(), q0.y(), q0.z()};
   double t[3] = {rig_from_tool->t.x(), rig_from_tool->t.y(),
                  rig_from_tool->t.z()};
+  // Non-finite guard: nothing non-finite may reach Ceres (its manifold
+  // CHECKs abort the process instead of failing the solve).
+  for (double v : q) if (!std::isfinite(v)) return false;
+  for (double v : t) if (!std::isfinite(v)) return false;
+  for (size_t i = 0; i < obs.size(); ++i) {
+    if (!used[i]) continue;
+    for (int k = 0; k < 4; ++k) {
+      if (!obs[i].tag->CornerInTool(k).allFinite() ||
+          !obs[i].det->corners[k].allFinite()) {
+        return false;
+      }
+    }
+  }
   ceres::Problem problem;
   for (size_t i = 0; i < obs.size(); ++i) {
     if (!used[i]) continue;

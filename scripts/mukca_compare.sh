@@ -1,0 +1,47 @@
+#!/bin/bash
+# Honest comparison on the MUKCa Panda recordings (docs/REAL_DATA.md): for
+# every recording, calibrate from the NOMINAL Panda (urdf/panda.urdf) with
+# the 50 mm socket distance, then evaluate on the robot's other recordings;
+# the authors' calibrated URDF is evaluated on the same poses.
+# Usage: scripts/mukca_compare.sh [kincal binary] [mukca dir] > table.tsv
+set -euo pipefail
+K=${1:-build/bin/kincal}
+M=${2:-../shared/data/mukca}
+W=$(mktemp -d)
+trap 'rm -rf "$W"' EXIT
+authors_of() {  # recording folder -> calibrated_urdf folder
+  case $1 in
+    panda_2_clean) echo panda_2 ;; panda_3 | panda_3_bis) echo panda_3 ;;
+    panda_4_clean) echo panda_4 ;; *) echo "$1" ;;
+  esac
+}
+stats() {  # evaluate JSON -> "rms hole_0 hole_1 distance_error"
+  python3 -c '
+import json,sys
+j=json.load(sys.stdin); f=j["fixed_points"]; d=j["point_distances"][0]["distance_mm"]-50
+print("%.4f\t%.4f\t%.4f\t%+.4f" % (j["rms_mm"], f["hole_0"]["rms_mm"], f["hole_1"]["rms_mm"], d))'
+}
+printf "robot\ttrain\ttest\tkincal_rms\tkincal_h0\tkincal_h1\tkincal_dist_err\tauthors_rms\tauthors_h0\tauthors_h1\tauthors_dist_err\tkincal_train_rms\tfree\tpasses\n"
+for robot_dir in "$M"/data/panda_*; do
+  robot=$(basename "$robot_dir")
+  authors="$M/calibrated_urdf/$(authors_of "$robot")/panda.urdf"
+  recs=()
+  for rec in "$robot_dir"/*/; do
+    r=$(basename "$rec")
+    "$K" import mukca --dir "$rec" --out "$W/$robot.$r.csv" >/dev/null
+    recs+=("$r")
+  done
+  for train in "${recs[@]}"; do
+    cal=$(
+      "$K" calibrate --robot "$M/urdf/panda.urdf" --tip ball_link \
+        --obs "$W/$robot.$train.csv" --fixed-distance hole_0,hole_1,50 \
+        --holdout 0 --out "$W/cal.yaml" --json |
+        python3 -c 'import json,sys; j=json.load(sys.stdin); print("%.4f\t%d\t%d" % (j["train_rms_mm"], len(j["identifiable"]), j["identifiability_passes"]))')
+    for test in "${recs[@]}"; do
+      [ "$test" = "$train" ] && continue
+      ours=$("$K" evaluate --robot "$W/cal.yaml" --obs "$W/$robot.$test.csv" --json | stats)
+      theirs=$("$K" evaluate --robot "$authors" --tip ball_link --obs "$W/$robot.$test.csv" --json | stats)
+      printf "%s\t%s\t%s\t%s\t%s\t%s\n" "$robot" "$train" "$test" "$ours" "$theirs" "$cal"
+    done
+  done
+done
