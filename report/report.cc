@@ -503,6 +503,8 @@ ReportResult BuildReport(
                                     jr.joints[pair_a].name + " x " +
                                     jr.joints[pair_b].name);
       std::vector<Plot> maps;
+      double cell_hi = 1.0;
+      int grid_bins = 12;
       for (const ResidualSet* s : sets) {
         Plot p;
         p.title = s->label + ": |mean error vector| per cell (mm)";
@@ -518,8 +520,19 @@ ReportResult BuildReport(
           xa.push_back(in.obs.rows[row].q[pair_a]);
           xb.push_back(in.obs.rows[row].q[pair_b]);
         }
-        MeanVectorGrid(xa, xb, s->e_in_base, 12, 3, &cells.x, &cells.y,
+        // About 6 poses per cell on average, 4 to 12 cells a side.
+        const int bins =
+            std::clamp(static_cast<int>(std::sqrt(xa.size() / 6.0)), 4, 12);
+        MeanVectorGrid(xa, xb, s->e_in_base, bins, 3, &cells.x, &cells.y,
                        &cells.color, &cells.cell_w, &cells.cell_h);
+        if (maps.empty()) {
+          cell_hi = cells.color.empty() ? 1.0
+                                        : *std::max_element(cells.color.begin(),
+                                                            cells.color.end());
+          grid_bins = bins;
+        }
+        cells.color_lo = 0.0;  // one colour scale for both maps
+        cells.color_hi = cell_hi;
         p.series.push_back(cells);
         PlotSeries poses;
         poses.points = true;
@@ -534,10 +547,13 @@ ReportResult BuildReport(
       page.FigureRow(maps,
                      struct_words.str() +
                          " Colour: length of the mean error vector of the "
-                         "poses in each cell of a 12 x 12 grid (cells "
-                         "with 3 or more poses; blue small, red large): "
-                         "the systematic part the model misses. Grey "
-                         "dots: the poses." +
+                         "poses in each cell of a " +
+                         std::to_string(grid_bins) + " x " +
+                         std::to_string(grid_bins) +
+                         " grid (cells with 3 or more poses; blue small, red "
+                         "large; one scale from 0 for both maps): the "
+                         "systematic part the model misses. Grey dots: the "
+                         "poses." +
                          ThinNote(res_geo.rows.size(), opt.max_points / 2));
     }
 
