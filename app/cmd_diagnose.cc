@@ -11,6 +11,7 @@
 #include "app/command.h"
 #include "data/atomic_file.h"
 #include "data/error.h"
+#include "data/progress.h"
 #include "data/urdf.h"
 #include "diagnose/clearance.h"
 #include "diagnose/compare.h"
@@ -32,7 +33,11 @@ std::string FormatJoint(const std::string& joint) {
 int RunModel(const ModelArgs& args) {
   const Robot robot = ReadRobot(args.robot, args.root, args.tip);
   const Observations obs = ReadObservationsCsv(args.obs, robot.JointNames());
+  Progress progress("kincal diagnose model", args.json);
+  progress.Stage("fitting candidate extensions with the geometry, " +
+                 std::to_string(obs.rows.size()) + " poses");
   const DiagnosisResult r = DiagnoseModel(robot, obs, args.options);
+  progress.Done();
   if (!args.out.empty()) {
     std::ostringstream note;
     note << "diagnose model from " << args.obs << ": verdict " << r.verdict
@@ -205,6 +210,15 @@ void AddDiagnoseCommand(CLI::App& app, Runner* run) {
   model->add_option("--threads", margs->options.num_threads, "threads")
       ->capture_default_str();
   model->add_flag("--json", margs->json, "print one JSON object");
+  model->footer(
+      "Example (the demo session):\n  kincal diagnose model --robot "
+      "data/sessions/bh7_demo/robot.yaml --obs "
+      "data/sessions/bh7_demo/observations.csv --out extended.yaml --json > "
+      "diag.json\n  kincal report --robot data/sessions/bh7_demo/robot.yaml "
+      "--obs data/sessions/bh7_demo/observations.csv --calibrated "
+      "extended.yaml --diagnosis diag.json --out report.html\nUnits: lengths "
+      "mm, angles deg, time s (pixels px). Defaults are shown beside each "
+      "option.");
   model->callback(
       [run, margs] { *run = [margs] { return RunModel(*margs); }; });
 
@@ -234,6 +248,12 @@ void AddDiagnoseCommand(CLI::App& app, Runner* run) {
   clear->add_option("--plot", cargs->plot, "write an SVG of Fig. 4 and Fig. 5");
   clear->add_option("--csv", cargs->csv, "write deviations and curves as CSV");
   clear->add_flag("--json", cargs->json, "print one JSON object");
+  clear->footer(
+      "Example (seed Section 4, sweep +-3 deg | mm):\n  kincal diagnose "
+      "clearance --robot cal.yaml --obs "
+      "data/sessions/bh7_demo/observations.csv --gamma 3 --plot clearance.svg "
+      "--csv clearance.csv\nUnits: lengths mm, angles deg, time s (pixels px). "
+      "Defaults are shown beside each option.");
   clear->callback(
       [run, cargs] { *run = [cargs] { return RunClearance(*cargs); }; });
 
@@ -248,6 +268,11 @@ void AddDiagnoseCommand(CLI::App& app, Runner* run) {
   cmp->add_option("--root", pargs->root, "URDF root link");
   cmp->add_option("--tip", pargs->tip, "URDF tip link");
   cmp->add_flag("--json", pargs->json, "print one JSON object");
+  cmp->footer(
+      "Example: errors before and after a repair, same poses:\n  kincal "
+      "diagnose compare before.csv after.csv --robot cal.yaml --json\nUnits: "
+      "lengths mm, angles deg, time s (pixels px). Defaults are shown beside "
+      "each option.");
   cmp->callback(
       [run, pargs] { *run = [pargs] { return RunCompare(*pargs); }; });
 }

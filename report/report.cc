@@ -368,8 +368,12 @@ ReportResult BuildReport(
     try {
       ClearanceOptions co;
       co.gamma = opt.gamma;
-      co.calibrate_geometry = false;  // the geometric model is calibrated
-      clear = DiagnoseClearance(geometric, in.obs, co);
+      // As `kincal diagnose clearance` does by default: calibrate the
+      // nominal geometry on the same data first (without a nominal robot,
+      // the geometric model as given).
+      co.calibrate_geometry = in.has_robot;
+      clear =
+          DiagnoseClearance(in.has_robot ? in.robot : geometric, in.obs, co);
       has_clear = true;
       verdict.push_back(
           "Section 4 test (sweep +-" + Fmt(opt.gamma, 3) +
