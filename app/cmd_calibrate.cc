@@ -12,6 +12,7 @@
 #include "data/atomic_file.h"
 #include "data/csv.h"
 #include "data/error.h"
+#include "data/progress.h"
 #include "data/urdf.h"
 
 namespace kincal::app {
@@ -61,7 +62,11 @@ int RunCalibrate(CalibrateArgs args) {
     args.options.distances.push_back(ParseDistance(d));
   }
   args.options.extra_params = args.free;
+  Progress progress("kincal calibrate", args.json || obs.rows.size() < 500);
+  progress.Stage("fitting " + std::to_string(obs.rows.size()) +
+                 " poses (Ceres LM, identifiability, covariance)");
   const CalibrateResult r = Calibrate(nominal, obs, args.options);
+  progress.Done();
 
   if (!args.out.empty()) {
     std::ostringstream note;
@@ -214,6 +219,14 @@ void AddCalibrateCommand(CLI::App& app, Runner* run) {
   sub->add_option("--free", args->free,
                   "extra parameters to fit, e.g. j2.beta (repeatable)");
   sub->add_flag("--json", args->json, "print one JSON object");
+  sub->footer(
+      "Example (the demo session):\n  kincal calibrate --robot "
+      "data/sessions/bh7_demo/robot.yaml --obs "
+      "data/sessions/bh7_demo/observations.csv --out cal.yaml --json\n  "
+      "Single-point data with a known 50 mm between two sockets:\n  kincal "
+      "calibrate --robot panda.urdf --tip ball_link --obs panda.csv "
+      "--fixed-distance hole_0,hole_1,50 --out cal.yaml\nUnits: lengths mm, "
+      "angles deg, time s (pixels px). Defaults are shown beside each option.");
   sub->callback([run, args] { *run = [args] { return RunCalibrate(*args); }; });
 }
 

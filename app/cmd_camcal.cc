@@ -15,6 +15,7 @@
 #include "camcal/rig.h"
 #include "data/error.h"
 #include "data/glob.h"
+#include "data/progress.h"
 #include "vision/calib_target.h"
 
 namespace kincal::app {
@@ -89,7 +90,10 @@ int RunCamcal(const CamcalArgs& args) {
   }
   CalibTargetDetector detector(spec);
   std::vector<int> found(nc, 0);
+  Progress progress("kincal camcal", args.json);
   for (size_t v = 0; v < nv; ++v) {
+    progress.Update(static_cast<long>(v + 1), static_cast<long>(nv),
+                    "detecting the target: view");
     CalibrationView view;
     view.label = files[0][v];
     for (size_t c = 0; c < nc; ++c) {
@@ -122,7 +126,9 @@ int RunCamcal(const CamcalArgs& args) {
     }
   }
 
+  progress.Stage("calibrating (OpenCV start, Ceres refinement, covariance)");
   const CalibrationSummary sum = CalibrateCameras(problem, options);
+  progress.Done();
   WriteRigYaml(args.out, sum.rig);
 
   if (args.json) {
@@ -269,6 +275,12 @@ void AddCamcalCommand(CLI::App& app, Runner* run) {
   sub->add_option("--loss-scale", args->loss_scale_px,
                   "robust loss scale, px (default 3)");
   sub->add_flag("--json", args->json, "print one JSON object");
+  sub->footer(
+      "Example: stereo rig from a 9x6 chessboard with 25 mm squares:\n  kincal "
+      "camcal --left 'calib/left*.png' --right 'calib/right*.png' --target "
+      "chessboard:9x6:25 --out rig.yaml --json > rig.json\n  (rig.json beside "
+      "rig.yaml feeds the camera section of kincal report)\nUnits: lengths mm, "
+      "angles deg, time s (pixels px). Defaults are shown beside each option.");
   sub->callback([run, args] { *run = [args] { return RunCamcal(*args); }; });
 }
 

@@ -652,6 +652,12 @@ void AddCaptureCommand(CLI::App& app, Runner* run) {
                   "writer threads encoding PNGs (default 2)")
       ->check(CLI::Range(1, 64));
   sub->add_flag("--json", args->json, "print one JSON object");
+  sub->footer(
+      "Example: replay two image folders as a session (no camera needed):\n  "
+      "kincal capture --left 'folder:left/*.png?fps=30' --right "
+      "'folder:right/*.png?fps=30' --out session --frames 100\nUnits: lengths "
+      "mm, angles deg, time s (pixels px). Defaults are shown beside each "
+      "option.");
   sub->callback([run, args] { *run = [args] { return RunCapture(*args); }; });
 }
 

@@ -11,6 +11,7 @@
 #include "app/command.h"
 #include "data/atomic_file.h"
 #include "data/error.h"
+#include "data/progress.h"
 #include "data/urdf.h"
 #include "diagnose/clearance.h"
 #include "diagnose/compare.h"
@@ -36,7 +37,11 @@ int RunModel(const ModelArgs& args) {
   DiagnoseOptions options = args.options;
   for (const std::string& v : args.validate)
     options.validation.push_back(ReadObservationsCsv(v, robot.JointNames()));
+  Progress progress("kincal diagnose model", args.json);
+  progress.Stage("fitting candidate extensions with the geometry, " +
+                 std::to_string(obs.rows.size()) + " poses");
   const DiagnosisResult r = DiagnoseModel(robot, obs, options);
+  progress.Done();
   if (!args.out.empty()) {
     std::ostringstream note;
     note << "diagnose model from " << args.obs << ": verdict " << r.verdict
@@ -227,6 +232,15 @@ void AddDiagnoseCommand(CLI::App& app, Runner* run) {
                     "other series of the same robot for cross-series "
                     "validation (observations.csv; repeatable)");
   model->add_flag("--json", margs->json, "print one JSON object");
+  model->footer(
+      "Example (the demo session):\n  kincal diagnose model --robot "
+      "data/sessions/bh7_demo/robot.yaml --obs "
+      "data/sessions/bh7_demo/observations.csv --out extended.yaml --json > "
+      "diag.json\n  kincal report --robot data/sessions/bh7_demo/robot.yaml "
+      "--obs data/sessions/bh7_demo/observations.csv --calibrated "
+      "extended.yaml --diagnosis diag.json --out report.html\nUnits: lengths "
+      "mm, angles deg, time s (pixels px). Defaults are shown beside each "
+      "option.");
   model->callback(
       [run, margs] { *run = [margs] { return RunModel(*margs); }; });
 
@@ -256,6 +270,12 @@ void AddDiagnoseCommand(CLI::App& app, Runner* run) {
   clear->add_option("--plot", cargs->plot, "write an SVG of Fig. 4 and Fig. 5");
   clear->add_option("--csv", cargs->csv, "write deviations and curves as CSV");
   clear->add_flag("--json", cargs->json, "print one JSON object");
+  clear->footer(
+      "Example (seed Section 4, sweep +-3 deg | mm):\n  kincal diagnose "
+      "clearance --robot cal.yaml --obs "
+      "data/sessions/bh7_demo/observations.csv --gamma 3 --plot clearance.svg "
+      "--csv clearance.csv\nUnits: lengths mm, angles deg, time s (pixels px). "
+      "Defaults are shown beside each option.");
   clear->callback(
       [run, cargs] { *run = [cargs] { return RunClearance(*cargs); }; });
 
@@ -270,6 +290,11 @@ void AddDiagnoseCommand(CLI::App& app, Runner* run) {
   cmp->add_option("--root", pargs->root, "URDF root link");
   cmp->add_option("--tip", pargs->tip, "URDF tip link");
   cmp->add_flag("--json", pargs->json, "print one JSON object");
+  cmp->footer(
+      "Example: errors before and after a repair, same poses:\n  kincal "
+      "diagnose compare before.csv after.csv --robot cal.yaml --json\nUnits: "
+      "lengths mm, angles deg, time s (pixels px). Defaults are shown beside "
+      "each option.");
   cmp->callback(
       [run, pargs] { *run = [pargs] { return RunCompare(*pargs); }; });
 }

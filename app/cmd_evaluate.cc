@@ -101,6 +101,10 @@ void AddEvaluateCommand(CLI::App& app, Runner* run) {
   sub->add_option("--residuals", args->residuals,
                   "write per-pose errors to this CSV");
   sub->add_flag("--json", args->json, "print one JSON object");
+  sub->footer(
+      "Example: the calibrated model on new poses:\n  kincal evaluate --robot "
+      "cal.yaml --obs new_poses.csv --residuals errors.csv\nUnits: lengths mm, "
+      "angles deg, time s (pixels px). Defaults are shown beside each option.");
   sub->callback([run, args] { *run = [args] { return RunEvaluate(*args); }; });
 }
 

@@ -106,6 +106,12 @@ void AddImportCommand(CLI::App& app, Runner* run) {
       "UR10 laser-tracker series of ipa-robot-accuracy (';', decimal commas)");
   s1->add_option("--in", ipa->in, "Series_X/measurements_*.csv")->required();
   CommonOptions(s1, ipa.get());
+  s1->footer(
+      "Example:\n  kincal import ipa-ur10 --in "
+      "../shared/data/ipa-robot-accuracy/Series_C/"
+      "measurements_random_poses.csv --robot data/robots/ur10.yaml --out "
+      "ur10_C.csv\nUnits: lengths mm, angles deg, time s (pixels px). Defaults "
+      "are shown beside each option.");
   s1->callback([run, ipa] { *run = [ipa] { return RunIpa(*ipa); }; });
 
   auto mukca = std::make_shared<ImportArgs>();
@@ -114,6 +120,11 @@ void AddImportCommand(CLI::App& app, Runner* run) {
   s2->add_option("--dir", mukca->dir, "folder with hole_0.csv and hole_1.csv")
       ->required();
   CommonOptions(s2, mukca.get());
+  s2->footer(
+      "Example:\n  kincal import mukca --dir "
+      "../shared/data/mukca/data/panda_6/front --out panda_front.csv\nUnits: "
+      "lengths mm, angles deg, time s (pixels px). Defaults are shown beside "
+      "each option.");
   s2->callback([run, mukca] { *run = [mukca] { return RunMukca(*mukca); }; });
 }
 

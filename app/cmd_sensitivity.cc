@@ -149,6 +149,13 @@ void AddSensitivityCommand(CLI::App& app, Runner* run) {
   sub->add_option("--out-csv", args->out_csv, "curves as CSV");
   sub->add_option("--plot", args->plot, "curves as an SVG image");
   sub->add_flag("--json", args->json, "print one JSON object");
+  sub->footer(
+      "Example (seed Section 3 on fixed-point data):\n  kincal simulate "
+      "--robot data/robots/bh7.yaml --out fp --mode fixed-point\n  kincal "
+      "calibrate --robot data/robots/bh7.yaml --obs fp/observations.csv "
+      "--method paper --out cal.yaml\n  kincal sensitivity --robot cal.yaml "
+      "--obs fp/observations.csv --plot curves.svg\nUnits: lengths mm, angles "
+      "deg, time s (pixels px). Defaults are shown beside each option.");
   sub->callback(
       [run, args] { *run = [args] { return RunSensitivity(*args); }; });
 }

@@ -16,6 +16,7 @@
 #include "data/error.h"
 #include "data/glob.h"
 #include "data/observations.h"
+#include "data/progress.h"
 #include "data/provenance.h"
 #include "data/session.h"
 #include "data/urdf.h"
@@ -170,7 +171,8 @@ int RunTrack(const TrackArgs& args) {
   int found = 0, merged_count = 0;
   std::vector<int> failed_gate;  // found, but not good
   std::vector<double> rms_values;
-  auto last_progress = start;
+  // On a terminal only; silent with --json, --quiet or when piped.
+  Progress progress("kincal track", args.json || args.quiet);
   for (size_t f = 0; f < n; ++f) {
     std::vector<std::vector<TagDetection>> dets(2);
     const std::string* files[2] = {&left[f], &right[f]};
@@ -227,17 +229,8 @@ int RunTrack(const TrackArgs& args) {
                   ? 1
                   : 0)
           << "\n";
-    const auto now = std::chrono::steady_clock::now();
-    if (!args.quiet && n >= 20 &&
-        (now - last_progress > std::chrono::milliseconds(500) || f + 1 == n)) {
-      last_progress = now;
-      const int width = 30;
-      const int done = static_cast<int>(width * (f + 1) / n);
-      std::fprintf(stderr, "\rkincal track [%s%s] %zu/%zu frames, %d found",
-                   std::string(done, '#').c_str(),
-                   std::string(width - done, '.').c_str(), f + 1, n, found);
-      if (f + 1 == n) std::fprintf(stderr, "\n");
-    }
+    progress.Update(static_cast<long>(f + 1), static_cast<long>(n),
+                    "frames (" + std::to_string(found) + " with a tip)");
   }
   WriteFileAtomic(args.out, points.str());
   const std::string poses_path = PosesPath(args.out);
@@ -339,6 +332,12 @@ void AddTrackCommand(CLI::App& app, Runner* run) {
                   "merge a tip only if its pose fits within this RMS, px")
       ->capture_default_str();
   sub->add_flag("--json", args->json, "print one JSON object");
+  sub->footer(
+      "Example:\n  kincal track --rig rig.yaml --target target.yaml --left "
+      "'session/left/*.png' --right 'session/right/*.png' --out "
+      "session/points.csv\n  kincal report --rig rig.yaml --session session "
+      "--out tracking.html\nUnits: lengths mm, angles deg, time s (pixels px). "
+      "Defaults are shown beside each option.");
   sub->callback([run, args] { *run = [args] { return RunTrack(*args); }; });
 }
 

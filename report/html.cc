@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 
 namespace kincal {
 namespace {
@@ -12,8 +13,8 @@ body{font-family:system-ui,-apple-system,"Segoe UI",Roboto,sans-serif;max-width:
 h1{font-size:1.6em;margin-bottom:.2em} h2{border-bottom:2px solid #ddd;padding-bottom:.2em;margin-top:1.6em}
 nav{font-size:.9em;color:#555} nav a{margin-right:.8em}
 .verdict{font-size:1.15em;background:#f4f8fb;border-left:5px solid #1f77b4;padding:.6em 1em}
-table{border-collapse:collapse;font-size:.88em;margin:.6em 0} th,td{border:1px solid #ccc;padding:2px 8px;text-align:right}
-th{background:#f0f0f0} td:first-child,th:first-child{text-align:left}
+table{border-collapse:collapse;font-size:.88em;margin:.6em 0} th,td{border:1px solid #ccc;padding:2px 8px;text-align:left} td.num{text-align:right}
+th{background:#f0f0f0}
 figure{margin:1em 0;page-break-inside:avoid;break-inside:avoid} figure svg{width:100%;height:auto;border:1px solid #eee}
 figure.row{display:grid;grid-template-columns:repeat(auto-fill,minmax(330px,1fr));gap:6px}
 figure.row figcaption{grid-column:1/-1}
@@ -70,7 +71,13 @@ void HtmlReport::Table(const std::vector<std::string>& header,
   body_ += "</tr>\n";
   for (const auto& r : rows) {
     body_ += "<tr>";
-    for (const auto& c : r) body_ += "<td>" + XmlEscape(c) + "</td>";
+    for (const auto& c : r) {
+      // Numbers right-aligned, words left.
+      char* end = nullptr;
+      std::strtod(c.c_str(), &end);
+      const bool num = (!c.empty() && end && *end == '\0') || c == "-";
+      body_ += (num ? "<td class='num'>" : "<td>") + XmlEscape(c) + "</td>";
+    }
     body_ += "</tr>\n";
   }
   body_ += "</table>\n";

@@ -368,8 +368,12 @@ ReportResult BuildReport(
     try {
       ClearanceOptions co;
       co.gamma = opt.gamma;
-      co.calibrate_geometry = false;  // the geometric model is calibrated
-      clear = DiagnoseClearance(geometric, in.obs, co);
+      // As `kincal diagnose clearance` does by default: calibrate the
+      // nominal geometry on the same data first (without a nominal robot,
+      // the geometric model as given).
+      co.calibrate_geometry = in.has_robot;
+      clear =
+          DiagnoseClearance(in.has_robot ? in.robot : geometric, in.obs, co);
       has_clear = true;
       verdict.push_back(
           "Section 4 test (sweep +-" + Fmt(opt.gamma, 3) +
@@ -503,6 +507,8 @@ ReportResult BuildReport(
                                     jr.joints[pair_a].name + " x " +
                                     jr.joints[pair_b].name);
       std::vector<Plot> maps;
+      double cell_hi = 1.0;
+      int grid_bins = 12;
       for (const ResidualSet* s : sets) {
         Plot p;
         p.title = s->label + ": |mean error vector| per cell (mm)";
@@ -518,8 +524,19 @@ ReportResult BuildReport(
           xa.push_back(in.obs.rows[row].q[pair_a]);
           xb.push_back(in.obs.rows[row].q[pair_b]);
         }
-        MeanVectorGrid(xa, xb, s->e_in_base, 12, 3, &cells.x, &cells.y,
+        // About 6 poses per cell on average, 4 to 12 cells a side.
+        const int bins =
+            std::clamp(static_cast<int>(std::sqrt(xa.size() / 6.0)), 4, 12);
+        MeanVectorGrid(xa, xb, s->e_in_base, bins, 3, &cells.x, &cells.y,
                        &cells.color, &cells.cell_w, &cells.cell_h);
+        if (maps.empty()) {
+          cell_hi = cells.color.empty() ? 1.0
+                                        : *std::max_element(cells.color.begin(),
+                                                            cells.color.end());
+          grid_bins = bins;
+        }
+        cells.color_lo = 0.0;  // one colour scale for both maps
+        cells.color_hi = cell_hi;
         p.series.push_back(cells);
         PlotSeries poses;
         poses.points = true;
@@ -534,10 +551,13 @@ ReportResult BuildReport(
       page.FigureRow(maps,
                      struct_words.str() +
                          " Colour: length of the mean error vector of the "
-                         "poses in each cell of a 12 x 12 grid (cells "
-                         "with 3 or more poses; blue small, red large): "
-                         "the systematic part the model misses. Grey "
-                         "dots: the poses." +
+                         "poses in each cell of a " +
+                         std::to_string(grid_bins) + " x " +
+                         std::to_string(grid_bins) +
+                         " grid (cells with 3 or more poses; blue small, red "
+                         "large; one scale from 0 for both maps): the "
+                         "systematic part the model misses. Grey dots: the "
+                         "poses." +
                          ThinNote(res_geo.rows.size(), opt.max_points / 2));
     }
 

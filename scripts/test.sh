@@ -3,7 +3,11 @@
 # tests read ../shared/data and skip with a message when it is absent.
 set -euo pipefail
 cd "$(dirname "$0")/.."
+. scripts/progress.sh
+step "Set-up: Debian packages (scripts/setup.sh; a no-op when present)"
 scripts/setup.sh
-scripts/build.sh
+step "Build (cmake + make; log in build.log)"
+build_quietly
+step "Tests (ctest; real-data tests skip when ../shared/data is absent)"
 cd build
 ctest --output-on-failure -j "${JOBS:-$(nproc)}" "$@"
