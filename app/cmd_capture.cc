@@ -546,6 +546,7 @@ int RunCapture(const CaptureArgs& args) {
     j["dropped_right"] = grabber.dropped_right();
     j["dropped_pairs"] = dropped_pairs;
     j["max_queue_depth"] = writer.max_queue_depth();
+    j["fast_pairs"] = writer.fast_pairs();
     j["length_mismatch"] = grabber.length_mismatch();
     j["transient_failures"] = transient_failures;
     j["stop_reason"] = summary.stop_reason;

@@ -93,6 +93,12 @@ int RunPlan(PlanArgs args) {
     j["sigma_gain"] =
         Number(plan.random_sigma_gmean / plan.planned_sigma_gmean);
     j["log_det"] = Number(plan.planned.log_det);
+    j["observability"] = {{"O1", Number(plan.planned.o1)},
+                          {"O3", Number(plan.planned.o3)},
+                          {"O4", Number(plan.planned.o4)}};
+    j["random_observability"] = {{"O1", Number(plan.random.o1)},
+                                 {"O3", Number(plan.random.o3)},
+                                 {"O4", Number(plan.random.o4)}};
     j["random_log_det"] = Number(plan.random.log_det);
     j["joint_travel"] = Number(plan.planned.joint_travel);
     j["random_joint_travel"] = Number(plan.random.joint_travel);

@@ -2,6 +2,7 @@
 //   BM_RecordStereoPair/<png level>/<channels>: SessionRecorder::Write of one
 //     1280x1024 pair (PNG encode + write + rename, both sides), pairs/s;
 //   BM_EncodePng/<png level>: cv::imencode of one 1280x1024 gray image;
+//   BM_EncodePngLibpng/<png level>: the recorder's encoder, same image;
 //   BM_FolderReplay: StereoGrabber over two folders of 1280x1024 PNGs, pairs/s;
 //   BM_Convert*: one 1280x1024 camera buffer to cv::Mat.
 // The images are a smooth scene plus sensor-like noise (sigma 2 grey levels),
@@ -16,6 +17,7 @@
 
 #include "capture/frame_source.h"
 #include "capture/pixel_convert.h"
+#include "capture/png_encode.h"
 #include "capture/recorder.h"
 #include "capture/stereo_grabber.h"
 
@@ -110,6 +112,24 @@ void BM_EncodePng(benchmark::State& state) {
   state.SetItemsProcessed(state.iterations());
 }
 BENCHMARK(BM_EncodePng)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
+
+// The recorder's encoder (capture/png_encode.h: libpng, fixed filter).
+void BM_EncodePngLibpng(benchmark::State& state) {
+  const cv::Mat image = SceneImage(1, 0);
+  std::vector<uint8_t> png;
+  std::string error;
+  for (auto _ : state) {
+    EncodePng(image, static_cast<int>(state.range(0)), &png, &error);
+    benchmark::DoNotOptimize(png.data());
+  }
+  state.counters["bytes"] = static_cast<double>(png.size());
+  state.SetItemsProcessed(state.iterations());
+}
+BENCHMARK(BM_EncodePngLibpng)
+    ->Arg(0)
+    ->Arg(1)
+    ->Arg(3)
+    ->Unit(benchmark::kMillisecond);
 
 void BM_FolderReplay(benchmark::State& state) {
   constexpr int kImages = 16;

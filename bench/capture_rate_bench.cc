@@ -24,6 +24,7 @@ namespace {
 struct Figures {
   int64_t pairs = 0, dropped_pairs = 0, dropped_left = 0, dropped_right = 0;
   int max_queue = 0;
+  int64_t fast = 0;
   double seconds = 0;
   uint64_t bytes = 0;
 };
@@ -69,6 +70,7 @@ Figures Record(const std::string& left_uri, const std::string& right_uri,
   f.dropped_left = grabber.dropped_left();
   f.dropped_right = grabber.dropped_right();
   f.max_queue = writer.max_queue_depth();
+  f.fast = writer.fast_pairs();
   f.bytes = recorder.bytes_written();
   return f;
 }
@@ -76,12 +78,13 @@ Figures Record(const std::string& left_uri, const std::string& right_uri,
 void Print(const char* what, const Figures& f) {
   std::printf(
       "%-34s %6lld pairs %7.2f s %6.2f pairs/s | dropped pairs (queue full) "
-      "%lld | unpaired left/right %lld/%lld | max queue %d | %.1f MB/s\n",
+      "%lld | unpaired left/right %lld/%lld | max queue %d | level-0 pairs "
+      "%lld | %.1f MB/s\n",
       what, static_cast<long long>(f.pairs), f.seconds, f.pairs / f.seconds,
       static_cast<long long>(f.dropped_pairs),
       static_cast<long long>(f.dropped_left),
       static_cast<long long>(f.dropped_right), f.max_queue,
-      f.bytes / 1e6 / f.seconds);
+      static_cast<long long>(f.fast), f.bytes / 1e6 / f.seconds);
 }
 
 }  // namespace

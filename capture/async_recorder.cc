@@ -44,12 +44,16 @@ bool AsyncRecorder::Submit(StereoFrame pair, std::vector<double> joints) {
 void AsyncRecorder::WriterLoop() {
   for (;;) {
     Job job;
+    bool fast = false;
     {
       std::unique_lock<std::mutex> lock(mu_);
       work_.wait(lock, [&] { return stopping_ || !queue_.empty(); });
       if (queue_.empty()) return;  // stopping and drained
       job = std::move(queue_.front());
       queue_.pop_front();
+      fast = options_.adaptive &&
+             4 * static_cast<int>(queue_.size()) >= options_.queue_pairs;
+      if (fast) ++fast_;
       space_.notify_one();
       if (!error_.ok()) continue;  // discard after a failure
     }
@@ -58,7 +62,8 @@ void AsyncRecorder::WriterLoop() {
           std::chrono::duration<double>(options_.writer_delay_s));
     }
     uint64_t bytes = 0;
-    const Status s = recorder_->WritePairImages(job.frame, job.pair, &bytes);
+    const Status s =
+        recorder_->WritePairImages(job.frame, job.pair, &bytes, fast ? 0 : -1);
     std::lock_guard<std::mutex> lock(mu_);
     if (!s.ok()) {
       if (error_.ok()) error_ = s;
@@ -123,6 +128,10 @@ int64_t AsyncRecorder::submitted() const {
 int64_t AsyncRecorder::dropped_pairs() const {
   std::lock_guard<std::mutex> lock(mu_);
   return dropped_;
+}
+int64_t AsyncRecorder::fast_pairs() const {
+  std::lock_guard<std::mutex> lock(mu_);
+  return fast_;
 }
 int AsyncRecorder::max_queue_depth() const {
   std::lock_guard<std::mutex> lock(mu_);

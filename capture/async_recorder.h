@@ -36,6 +36,11 @@ struct AsyncRecorderOptions {
   // Live cameras: a full queue drops the pair. Replay sources (false): Submit
   // waits for room instead, as a recording can wait.
   bool drop_when_full = true;
+  // When the queue is a quarter full or more, write at PNG level 0 (stored:
+  // ~1 ms per frame instead of ~15, still lossless, larger files) until it
+  // drains: the encoder then keeps up whenever the disk does. Counted in
+  // fast_pairs().
+  bool adaptive = true;
   // Test hook: each writer sleeps this long per pair (a slow disk).
   double writer_delay_s = 0.0;
 };
@@ -61,6 +66,7 @@ class AsyncRecorder {
   int64_t submitted() const;
   int64_t dropped_pairs() const;  // queue full
   int max_queue_depth() const;
+  int64_t fast_pairs() const;  // written at level 0 by `adaptive`
 
  private:
   struct Job {
@@ -88,6 +94,7 @@ class AsyncRecorder {
   int64_t submitted_ = 0;
   int64_t dropped_ = 0;
   int max_depth_ = 0;
+  int64_t fast_ = 0;
   bool stopping_ = false;
   bool stopped_ = false;
   Status error_;

@@ -181,6 +181,39 @@ TEST(AsyncRecorderTest, ReplayWaitsInsteadOfDropping) {
   EXPECT_EQ(rec.frames(), 15);
 }
 
+// A backlog switches the writers to PNG level 0 (stored): still lossless.
+TEST(AsyncRecorderTest, BacklogIsWrittenFastAndStillLossless) {
+  const std::string dir = MakeTempDir("arec_adaptive") + "/s";
+  SessionRecorder::Options ro;
+  ro.png_compression = 6;
+  SessionRecorder rec(ro);
+  ASSERT_TRUE(rec.Open(dir, Info()).ok());
+  AsyncRecorderOptions options;
+  options.queue_pairs = 8;
+  options.writer_threads = 1;
+  options.writer_delay_s = 0.01;
+  options.drop_when_full = false;
+  std::vector<StereoFrame> sent;
+  {
+    AsyncRecorder writer(&rec, options);
+    for (int i = 0; i < 16; ++i) {
+      sent.push_back(Pair(i, 320, 240));
+      StereoFrame copy = sent.back();
+      copy.left.image = sent.back().left.image.clone();
+      copy.right.image = sent.back().right.image.clone();
+      ASSERT_TRUE(writer.Submit(std::move(copy)));
+    }
+    ASSERT_TRUE(writer.Stop().ok());
+    EXPECT_GT(writer.fast_pairs(), 0);
+    EXPECT_LT(writer.fast_pairs(), 16);
+  }
+  for (int i = 0; i < 16; ++i) {
+    const std::string name = SessionRecorder::FrameFileName(i);
+    const cv::Mat r = cv::imread(dir + "/right/" + name, cv::IMREAD_UNCHANGED);
+    EXPECT_EQ(cv::norm(r, sent[i].right.image, cv::NORM_INF), 0.0) << i;
+  }
+}
+
 TEST(AsyncRecorderTest, WriteFailureKeepsTheCommittedFramesAndNoHalfPair) {
   const std::string dir = MakeTempDir("arec_fail") + "/s";
   SessionRecorder rec;

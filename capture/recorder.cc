@@ -228,17 +228,19 @@ Status SessionRecorder::CheckWrite(int64_t frame,
 }
 
 Status SessionRecorder::WritePairImages(int64_t frame, const StereoFrame& pair,
-                                        uint64_t* bytes) const {
+                                        uint64_t* bytes,
+                                        int compression) const {
+  const int level = compression >= 0 ? compression : options_.png_compression;
   const std::string name = FrameFileName(frame);
   const std::string left = dir_ + "/left/" + name;
   const std::string right = dir_ + "/right/" + name;
   size_t left_bytes = 0, right_bytes = 0;
-  Status left_status = WritePngAtomic(left, pair.left.image,
-                                      options_.png_compression, &left_bytes);
+  Status left_status =
+      WritePngAtomic(left, pair.left.image, level, &left_bytes);
   Status right_status =
-      left_status.ok() ? WritePngAtomic(right, pair.right.image,
-                                        options_.png_compression, &right_bytes)
-                       : Status::Ok();
+      left_status.ok()
+          ? WritePngAtomic(right, pair.right.image, level, &right_bytes)
+          : Status::Ok();
   if (!left_status.ok() || !right_status.ok()) {
     RemovePairImages(frame);  // never leave half a pair
     return left_status.ok() ? right_status : left_status;

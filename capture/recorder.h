@@ -81,8 +81,9 @@ class SessionRecorder {
   // is left on disk); CommitRow then appends the row of frame frames() to
   // the journal, whose images must be on disk (one thread, frame order).
   Status CheckWrite(int64_t frame, const std::vector<double>& joints) const;
+  // `compression` overrides Options::png_compression when >= 0.
   Status WritePairImages(int64_t frame, const StereoFrame& pair,
-                         uint64_t* bytes) const;
+                         uint64_t* bytes, int compression = -1) const;
   Status CommitRow(const StereoFrame& pair, const std::vector<double>& joints,
                    uint64_t bytes);
   // Joint readings merged after recording (capture --joints): adds the

@@ -2,6 +2,7 @@
 
 #include <Eigen/Cholesky>
 #include <Eigen/Geometry>
+#include <Eigen/SVD>
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -452,6 +453,19 @@ DesignQuality PredictQuality(const Robot& robot, const PlanResult& plan,
   q.log_det =
       ok ? d.array().log().sum() : -std::numeric_limits<double>::infinity();
   q.joint_travel = JointTravel(robot, poses);
+  {
+    Eigen::MatrixXd js = j;
+    for (int k = 0; k < p; ++k) js.col(k) *= scale[k];
+    const Eigen::VectorXd sv =
+        Eigen::JacobiSVD<Eigen::MatrixXd>(js).singularValues();
+    if (sv.size() > 0 && sv[0] > 0) {
+      const double smin = sv[sv.size() - 1];
+      q.o1 = std::exp(sv.array().max(1e-300).log().mean()) /
+             std::sqrt(static_cast<double>(poses.size()));
+      q.o3 = smin / sv[0];
+      q.o4 = smin * smin / sv[0];
+    }
+  }
   const double inf = std::numeric_limits<double>::infinity();
   if (!ok) {
     q.sigma.assign(p, inf);

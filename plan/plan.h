@@ -76,7 +76,12 @@ struct DesignQuality {
   std::vector<double> sigma;  // per PlanResult::params, interface units
   double tip_rms_mm = 0;      // predicted, over the evaluation poses
   double log_det = 0;         // of the Jacobian scaled by the bounds
-  double joint_travel = 0;    // sum over moves of max_j |dq_j| / range_j
+  // Observability indices of the bound-scaled Jacobian (singular values
+  // s_1 >= ... >= s_m, n poses): Borm and Menq's O1 = (s_1...s_m)^(1/m) /
+  // sqrt(n), O3 = s_m / s_1 (inverse condition number), Nahvi and
+  // Hollerbach's O4 = s_m^2 / s_1 (noise amplification index).
+  double o1 = 0, o3 = 0, o4 = 0;
+  double joint_travel = 0;  // sum over moves of max_j |dq_j| / range_j
 };
 
 struct PlanResult {
