@@ -35,6 +35,7 @@ namespace {
 struct BundleArgs {
   std::string robot, rig, target, session, out, out_rig, out_obs;
   std::string extensions;  // comma-separated parameter names
+  int folds = 0;           // k-fold cross-validation (0 = off)
   BundleOptions options;
   // Quality gate of --out-obs tips (as `track`).
   int min_tags = 2;
@@ -124,6 +125,30 @@ int RunBundleCommand(BundleArgs args) {
   const SessionObservations obs = ObserveSession(session, rig, target, oo);
   const BundleResult r =
       RunBundle(robot, rig, target, obs.frames, args.options);
+  // k-fold cross-validation: every used frame held out once.
+  nlohmann::json kfold;
+  if (args.folds >= 2) {
+    std::vector<double> px, mm;
+    for (int k = 0; k < args.folds; ++k) {
+      BundleOptions o = args.options;
+      o.folds = args.folds;
+      o.fold = k;
+      const BundleResult rk = RunBundle(robot, rig, target, obs.frames, o);
+
+      px.insert(px.end(), rk.heldout_corner_px.begin(),
+                rk.heldout_corner_px.end());
+      mm.insert(mm.end(), rk.heldout_tip_mm.begin(), rk.heldout_tip_mm.end());
+    }
+    auto rms = [](const std::vector<double>& v) {
+      double s = 0;
+      for (double x : v) s += x * x;
+      return v.empty() ? 0.0 : std::sqrt(s / v.size());
+    };
+    kfold = {{"folds", args.folds},
+             {"heldout_reproj_rms_px", rms(px)},
+             {"heldout_tip_rms_mm", rms(mm)},
+             {"heldout_tips", mm.size()}};
+  }
 
   // Outputs, all validated and computed before the first write.
   const std::string robot_text = FormatRobotYaml(
@@ -153,7 +178,7 @@ int RunBundleCommand(BundleArgs args) {
         p.tags_used = f.tracked_tags;
       }
       if (p.found && p.tags_used >= args.min_tags &&
-          p.rms_px <= args.max_reproj_px) {
+          p.rms_px <= args.max_reproj_px && SeenByTwoCameras(f)) {
         o.has_point = true;
         o.p_in_meas = p.rig_from_tool * target.tip_in_tool;
         ++obs_points;
@@ -162,8 +187,8 @@ int RunBundleCommand(BundleArgs args) {
     }
     obs_text = FormatObservationsCsv(
         out, {"needle tips seen by the cameras (rig frame, mm) at the "
-              "session's joint readings; empty where the tool pose used "
-              "fewer than " +
+              "session's joint readings; empty where only one camera saw "
+              "the tool, or its pose used fewer than " +
               std::to_string(args.min_tags) + " tags or fit worse than " +
               FormatDouble(args.max_reproj_px) + " px"});
   }
@@ -274,6 +299,7 @@ int RunBundleCommand(BundleArgs args) {
     j["rig_from_base"] = rigid_json(r.rig_from_base);
     j["flange_from_target"] = rigid_json(r.flange_from_tool);
     j["refine_cameras"] = args.options.refine_cameras;
+    if (!kfold.is_null()) j["kfold"] = kfold;
     j["termination"] = r.termination;
     j["iterations"] = r.iterations;
     j["detect_seconds"] = obs.seconds;
@@ -338,6 +364,10 @@ void AddBundleCommand(CLI::App& app, Runner* run) {
       ->check(CLI::Range(0.0, 0.5));
   sub->add_option("--seed", args->options.seed, "seed of the hold-out")
       ->capture_default_str();
+  sub->add_option("--folds", args->folds,
+                  "also k-fold cross-validation: K more fits, each frame "
+                  "held out once; JSON kfold (pooled held-out RMS)")
+      ->check(CLI::Range(2, 20));
   sub->add_option("--huber", args->options.huber_px,
                   "per-corner Huber scale, px")
       ->capture_default_str()

@@ -195,10 +195,17 @@ int RunTrack(const TrackArgs& args) {
     const ToolPoseResult r = EstimateToolPose(rig, target, dets);
     points << f;
     poses << f << "," << (r.found ? 1 : 0);
+    // The quality gate: enough tags, a tight fit, and both cameras (one
+    // camera leaves the depth weak: tens of mm at 2 m).
+    bool cameras[2] = {false, false};
+    for (const TagObservationResult& t : r.tags) {
+      if (t.used && t.camera >= 0 && t.camera < 2) cameras[t.camera] = true;
+    }
+    const bool good = r.found && r.tags_used >= args.min_tags &&
+                      r.rms_px <= args.max_reproj_px && cameras[0] &&
+                      cameras[1];
     if (merged_row[f] >= 0) {
       Observation& row = merged.rows[merged_row[f]];
-      const bool good = r.found && r.tags_used >= args.min_tags &&
-                        r.rms_px <= args.max_reproj_px;
       row.has_point = good;
       if (good) row.p_in_meas = r.tip_in_rig;
       merged_count += good ? 1 : 0;
@@ -208,8 +215,6 @@ int RunTrack(const TrackArgs& args) {
       rms_values.push_back(r.rms_px);
       for (int i = 0; i < 3; ++i)
         points << "," << FormatDouble(r.tip_in_rig(i));
-      const bool good =
-          r.tags_used >= args.min_tags && r.rms_px <= args.max_reproj_px;
       if (!good) failed_gate.push_back(static_cast<int>(f));
       points << "," << FormatDouble(r.rms_px) << "," << r.tags_used << "\n";
       for (int i = 0; i < 9; ++i) {
@@ -224,11 +229,8 @@ int RunTrack(const TrackArgs& args) {
       poses << ",,,,,,,,,,,,,,0";
     }
     poses << "," << CsvQuote(left[f]) << "," << CsvQuote(right[f]) << ","
-          << (r.found && r.tags_used >= args.min_tags &&
-                      r.rms_px <= args.max_reproj_px
-                  ? 1
-                  : 0)
-          << "\n";
+          << (good ? 1 : 0) << "
+";
     progress.Update(static_cast<long>(f + 1), static_cast<long>(n),
                     "frames (" + std::to_string(found) + " with a tip)");
   }
@@ -241,7 +243,8 @@ int RunTrack(const TrackArgs& args) {
                         merged, {"joint readings from " + merged.source +
                                  "; x,y,z = needle tip tracked in the rig "
                                  "frame (empty where the tool was not found, "
-                                 "or seen with fewer than " +
+                                 "seen by one camera only, or with fewer "
+                                 "than " +
                                  std::to_string(args.min_tags) +
                                  " tags or a reprojection RMS over " +
                                  FormatDouble(args.max_reproj_px) + " px)"}));
@@ -282,7 +285,8 @@ int RunTrack(const TrackArgs& args) {
               median_rms, full0, full1);
   if (!failed_gate.empty()) {
     std::printf(
-        "  %zu found tips fail the quality gate (< %d tags or > %.2f px; "
+        "  %zu found tips fail the quality gate (< %d tags, > %.2f px or "
+        "one camera; "
         "good = 0 in %s): frames",
         failed_gate.size(), args.min_tags, args.max_reproj_px,
         poses_path.c_str());

@@ -405,6 +405,13 @@ void SetToolRow(const Eigen::Vector3d& tip, Chain* chain) {
 
 }  // namespace
 
+bool SeenByTwoCameras(const BundleFrame& f) {
+  for (const BundleCorner& c : f.corners) {
+    if (c.camera != f.corners.front().camera) return true;
+  }
+  return false;
+}
+
 bool HandEyeStart(const std::vector<Rigid3>& base_from_flange,
                   const std::vector<Rigid3>& rig_from_tool, Rigid3* x,
                   Rigid3* y) {
@@ -529,9 +536,16 @@ BundleResult RunBundle(const Robot& nominal, const Rig& rig,
   std::vector<int> order = usable;
   std::mt19937_64 rng(opt.seed);
   std::shuffle(order.begin(), order.end(), rng);
-  const int nh = static_cast<int>(
-      std::floor(opt.holdout_fraction * static_cast<double>(order.size())));
-  std::set<int> held(order.begin(), order.begin() + nh);
+  std::set<int> held;
+  if (opt.folds >= 2) {
+    for (size_t k = 0; k < order.size(); ++k) {
+      if (static_cast<int>(k % opt.folds) == opt.fold) held.insert(order[k]);
+    }
+  } else {
+    const int nh = static_cast<int>(
+        std::floor(opt.holdout_fraction * static_cast<double>(order.size())));
+    held.insert(order.begin(), order.begin() + nh);
+  }
   for (int i : usable) (held.count(i) ? res.heldout : res.train).push_back(i);
   res.train_frames = static_cast<int>(res.train.size());
   res.heldout_frames = static_cast<int>(res.heldout.size());
@@ -562,7 +576,7 @@ BundleResult RunBundle(const Robot& nominal, const Rig& rig,
   for (int i : res.train) {
     const BundleFrame& f = frames[i];
     if (!f.tracked || f.tracked_tags < opt.start_min_tags ||
-        f.tracked_rms_px > opt.start_max_rms_px) {
+        f.tracked_rms_px > opt.start_max_rms_px || !SeenByTwoCameras(f)) {
       continue;
     }
     bf.push_back(BaseFromFlange(st.chain, res.inputs[i], false));
@@ -802,8 +816,9 @@ BundleResult RunBundle(const Robot& nominal, const Rig& rig,
   res.corners = 0;
   for (const Obs& o : train) res.corners += static_cast<int>(o.points.size());
   const std::vector<Obs> heldout = make_obs(res.heldout, {});
-  res.heldout_reproj_rms_px =
-      Rms(CornerErrors(&st, heldout, res.inputs, with_errors, rig));
+  res.heldout_corner_px =
+      CornerErrors(&st, heldout, res.inputs, with_errors, rig);
+  res.heldout_reproj_rms_px = Rms(res.heldout_corner_px);
 
   // Results: the tool row from the tip, the refined rig.
   const Rigid3 ft = FromBlock(st.flange_from_tool);
@@ -830,12 +845,18 @@ BundleResult RunBundle(const Robot& nominal, const Rig& rig,
   std::vector<double> tip_err;
   for (int i : res.heldout) {
     const BundleFrame& f = frames[i];
-    if (!f.tracked || f.tracked_tags < opt.start_min_tags) continue;
+    // A tracked tip is a measurement only when both cameras saw the tool
+    // (one camera leaves its depth weak: tens of mm at 2 m).
+    if (!f.tracked || f.tracked_tags < opt.start_min_tags ||
+        f.tracked_rms_px > opt.start_max_rms_px || !SeenByTwoCameras(f)) {
+      continue;
+    }
     const Eigen::Vector3d model = ModelRigFromTool(res, i) * target.tip_in_tool;
     const Eigen::Vector3d seen = f.rig_from_tool * target.tip_in_tool;
     tip_err.push_back((model - seen).norm());
   }
   res.heldout_tips = static_cast<int>(tip_err.size());
+  res.heldout_tip_mm = tip_err;
   res.heldout_tip_rms_mm = Rms(tip_err);
 
   // Names: the two frames and the tool row are determined by construction.

@@ -62,6 +62,10 @@ struct BundleFrame {
 struct BundleOptions {
   double holdout_fraction = 0.2;  // frames held out of the fit
   uint64_t seed = 1;
+  // k-fold: when folds >= 2, the frames held out are fold `fold` (0-based)
+  // of a seeded partition into `folds` parts (holdout_fraction is ignored).
+  int folds = 0;
+  int fold = 0;
   double huber_px = 1.0;  // per-corner Huber scale
   // Tag observations whose RMS after the first fit exceeds
   // max(outlier_px, outlier_ratio * median) are dropped, then the fit redone.
@@ -115,6 +119,9 @@ struct BundleResult {
   double heldout_reproj_rms_px = 0.0;
   double heldout_tip_rms_mm = 0.0;  // model tip vs tracked tip
   int heldout_tips = 0;
+  // Per held-out frame errors (pooling folds): corner residuals, px, and
+  // |model tip - tracked tip|, mm.
+  std::vector<double> heldout_corner_px, heldout_tip_mm;
   double sigma0_px = 0.0;           // noise estimate per pixel coordinate
   std::vector<int> train, heldout;  // indices into the frames given
   std::vector<PoseInput> inputs;    // per frame given (s, tau for errors)
@@ -133,6 +140,10 @@ BundleResult RunBundle(const Robot& nominal, const Rig& rig,
 
 // The model's needle tip / tool pose in the rig frame for one frame.
 Rigid3 ModelRigFromTool(const BundleResult& result, int index);
+
+// Whether the frame's corners come from at least two cameras (a tool pose
+// from one camera is weak in depth: such tips are not used as measurements).
+bool SeenByTwoCameras(const BundleFrame& f);
 
 // Closed-form hand-eye start: X = rig_from_base, Y = flange_from_tool with
 // rig_from_tool_i = X * base_from_flange_i * Y (linear in the rotations,
