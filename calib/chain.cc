@@ -334,6 +334,13 @@ std::vector<PoseInput> MakePoseInputs(const Chain& chain,
       }
     }
     in.thermal_x = use_temp ? obs.rows[out.size()].temp_c - 20.0 : in.t_h;
+    in.trig.resize(2 * kMaxHarmonic * n);
+    for (int j = 0; j < n; ++j) {
+      for (int h = 1; h <= kMaxHarmonic; ++h) {
+        in.trig[2 * kMaxHarmonic * j + 2 * (h - 1)] = std::cos(h * in.q[j]);
+        in.trig[2 * kMaxHarmonic * j + 2 * (h - 1) + 1] = std::sin(h * in.q[j]);
+      }
+    }
     out.push_back(in);
   }
   return out;

@@ -146,6 +146,9 @@ struct PoseInput {
   // Input of the thermal family: temp_c - 20 (K) when every row has a
   // temperature and it varies, else t_h (h).
   double thermal_x = 0.0;
+  // cos(h q), sin(h q) for h = 1..3 per joint (6 per joint), precomputed by
+  // MakePoseInputs; empty = computed on the fly.
+  std::vector<double> trig;
 };
 
 // Builds PoseInputs for the rows of `obs` (in visit order). `s` follows the
@@ -299,6 +302,23 @@ T ModelJointValue(JointType type, double q_read, double s, double tau,
   return q;
 }
 
+// The same with cos(h q_read), sin(h q_read) precomputed (PoseInput::trig),
+// as the fit evaluates it many times per pose.
+template <typename T>
+T ModelJointValueTrig(JointType type, double q_read, double s, double tau,
+                      const T* err, double tau_mass, const double* trig) {
+  if (err == nullptr) return T(q_read);
+  T q = (T(1) + err[kGain]) * q_read - T(0.5 * s) * err[kBacklash] +
+        err[kCompliance] * tau + err[kElastostatic] * tau_mass;
+  if (type == JointType::kRevolute) {
+    for (int h = 1; h <= kMaxHarmonic; ++h) {
+      const int k = CyclicCosIndex(h);
+      q += err[k] * trig[2 * (h - 1)] + err[k + 1] * trig[2 * (h - 1) + 1];
+    }
+  }
+  return q;
+}
+
 // base_from_tip for model joint values q (internal units), rows[i] pointing
 // at row i's geometry block (tool last).
 template <typename T>
@@ -431,10 +451,16 @@ Vec3<T> TipInBase(const Chain& chain, const T* const* rows,
   T q[kMaxJoints];
   const bool masses =
       static_cast<int>(in.tau_mass.size()) == chain.num_joints();
+  const bool trig =
+      static_cast<int>(in.trig.size()) == 2 * kMaxHarmonic * chain.num_joints();
   for (int j = 0; j < chain.num_joints(); ++j) {
-    q[j] = ModelJointValue<T>(chain.rows[j].type, in.q[j], in.s[j], in.tau[j],
-                              joint_errors ? joint_errors[j] : nullptr,
-                              masses ? in.tau_mass[j] : 0.0);
+    const double tm = masses ? in.tau_mass[j] : 0.0;
+    const T* err = joint_errors ? joint_errors[j] : nullptr;
+    q[j] = trig ? ModelJointValueTrig<T>(chain.rows[j].type, in.q[j], in.s[j],
+                                         in.tau[j], err, tm,
+                                         &in.trig[2 * kMaxHarmonic * j])
+                : ModelJointValue<T>(chain.rows[j].type, in.q[j], in.s[j],
+                                     in.tau[j], err, tm);
   }
   Vec3<T> p;
   if (joint_errors != nullptr && in.thermal_x != 0.0) {
