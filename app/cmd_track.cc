@@ -229,8 +229,7 @@ int RunTrack(const TrackArgs& args) {
       poses << ",,,,,,,,,,,,,,0";
     }
     poses << "," << CsvQuote(left[f]) << "," << CsvQuote(right[f]) << ","
-          << (good ? 1 : 0) << "
-";
+          << (good ? 1 : 0) << "\n";
     progress.Update(static_cast<long>(f + 1), static_cast<long>(n),
                     "frames (" + std::to_string(found) + " with a tip)");
   }
