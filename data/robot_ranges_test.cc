@@ -19,8 +19,7 @@ std::string Dh(const std::string& d, const std::string& theta,
   return "kincal_robot: 1\nname: r\nconvention: dh\njoints:\n"
          "  - {name: j1, type: revolute, d: " +
          d + ", a: 100, alpha: 90, theta: " + theta +
-         "}\ntool: {d: 10, a: 0, alpha: 0, theta: 0}\nbounds: " + bounds +
-         "\n";
+         "}\ntool: {d: 10, a: 0, alpha: 0, theta: 0}\nbounds: " + bounds + "\n";
 }
 
 TEST(RobotRanges, AcceptsPhysicalValues) {
