@@ -24,6 +24,7 @@ int main(int argc, char** argv) {
       "kincal: robot accuracy measurement, calibration and diagnosis.\n"
       "Units at every interface: mm, degrees, seconds."};
   app.require_subcommand(1);
+  app.set_version_flag("--version", kincal::ToolVersion());
   kincal::app::Runner run;
   kincal::app::AddSimulateCommand(app, &run);
   kincal::app::AddCalibrateCommand(app, &run);
