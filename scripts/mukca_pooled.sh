@@ -4,8 +4,8 @@
 # recordings pooled (each recording's sockets are their own fixed points,
 # each pair 50 mm apart), then evaluate on the left-out recording beside the
 # authors' calibrated URDF on the same poses.
-# Usage: scripts/mukca_pooled.sh [kincal binary] [mukca dir] > table.tsv
-set -euo pipefail
+# Usage: scripts/mukca_pooled.sh [kincal binary] [mukca dir] [robot glob] > table.tsv
+set -uo pipefail
 K=${1:-build/bin/kincal}
 M=${2:-../shared/data/mukca}
 W=$(mktemp -d)
@@ -19,11 +19,13 @@ authors_of() {
 stats() {
   python3 -c '
 import json,sys
-j=json.load(sys.stdin); f=j["fixed_points"]; d=j["point_distances"][0]["distance_mm"]-50
+try: j=json.load(sys.stdin)
+except Exception: print("NA\tNA\tNA\tNA"); sys.exit()
+f=j["fixed_points"]; d=j["point_distances"][0]["distance_mm"]-50
 print("%.4f\t%.4f\t%.4f\t%+.4f" % (j["rms_mm"], f["hole_0"]["rms_mm"], f["hole_1"]["rms_mm"], d))'
 }
 printf "robot\ttest\tkincal_rms\tkincal_h0\tkincal_h1\tkincal_dist_err\tauthors_rms\tauthors_h0\tauthors_h1\tauthors_dist_err\tkincal_train_rms\tfree\n"
-for robot_dir in "$M"/data/panda_*; do
+for robot_dir in "$M"/data/${3:-panda_*}; do
   robot=$(basename "$robot_dir")
   authors="$M/calibrated_urdf/$(authors_of "$robot")/panda.urdf"
   recs=()
@@ -44,7 +46,10 @@ for robot_dir in "$M"/data/panda_*; do
     done
     cal=$("$K" calibrate --robot "$M/urdf/panda.urdf" --tip ball_link \
       --obs "$pooled" "${dist[@]}" --holdout 0 --out "$W/cal.yaml" --json |
-      python3 -c 'import json,sys; j=json.load(sys.stdin); print("%.4f\t%d" % (j["train_rms_mm"], len(j["identifiable"])))')
+      python3 -c 'import json,sys
+try: j=json.load(sys.stdin)
+except Exception: print("NA\tNA\tNA"); sys.exit()
+print("%.4f\t%d" % (j["train_rms_mm"], len(j["identifiable"])))')
     ours=$("$K" evaluate --robot "$W/cal.yaml" --obs "$W/$test.csv" --json | stats)
     theirs=$("$K" evaluate --robot "$authors" --tip ball_link --obs "$W/$test.csv" --json | stats)
     printf "%s\t%s\t%s\t%s\t%s\n" "$robot" "$test" "$ours" "$theirs" "$cal"
