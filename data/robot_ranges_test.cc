@@ -7,6 +7,7 @@
 #include <string>
 
 #include "data/error.h"
+#include "data/observations.h"
 #include "data/robot.h"
 
 namespace kincal {
@@ -44,6 +45,22 @@ TEST(RobotRanges, RejectsOutOfRangeWithPosition) {
     } catch (const InputError& e) {
       EXPECT_THAT(e.what(), HasSubstr(c.where)) << c.text;
       EXPECT_THAT(e.what(), HasSubstr(c.message)) << c.text;
+    }
+  }
+}
+
+TEST(ObservationRanges, RejectsOutOfRangeWithPosition) {
+  const std::vector<std::string> joints = {"j1"};
+  EXPECT_NO_THROW(
+      ParseObservationsCsv("pose,j1,x,y,z\np1,10,1,2,3\n", "o.csv", joints));
+  for (const std::string text : {"pose,j1,x,y,z\np1,1e300,1,2,3\n",
+                                 "pose,j1,x,y,z\np1,10,1,2e300,3\n"}) {
+    try {
+      ParseObservationsCsv(text, "o.csv", joints);
+      ADD_FAILURE() << "accepted:\n" << text;
+    } catch (const InputError& e) {
+      EXPECT_THAT(e.what(), HasSubstr("o.csv:2:")) << text;
+      EXPECT_THAT(e.what(), HasSubstr("range")) << text;
     }
   }
 }
