@@ -49,6 +49,21 @@ TEST(RobotRanges, RejectsOutOfRangeWithPosition) {
   }
 }
 
+// fuzz/robot_yaml_fuzz.cc finding: a huge integer (format version) was cast
+// to int (undefined behaviour) instead of being rejected.
+TEST(RobotRanges, HugeIntegerIsAnInputError) {
+  std::string text = Dh("300", "0", "{length: 5, angle: 5}");
+  text.replace(text.find("kincal_robot: 1"), 15,
+               "kincal_robot: 555555555555555555555551");
+  try {
+    ParseRobotYaml(text, "r.yaml");
+    ADD_FAILURE() << "accepted";
+  } catch (const InputError& e) {
+    EXPECT_THAT(e.what(), HasSubstr("r.yaml:1:"));
+    EXPECT_THAT(e.what(), HasSubstr("integer out of range"));
+  }
+}
+
 TEST(ObservationRanges, RejectsOutOfRangeWithPosition) {
   const std::vector<std::string> joints = {"j1"};
   EXPECT_NO_THROW(
