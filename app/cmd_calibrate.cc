@@ -209,6 +209,17 @@ void AddCalibrateCommand(CLI::App& app, Runner* run) {
   sub->add_option("--bound-angle", args->bound_angle_deg,
                   "admissible deviation of angles from nominal, deg")
       ->check(CLI::Range(1e-6, 180.0));
+  sub->add_option("--max-sigma-fraction",
+                  args->options.identifiability.max_sigma_fraction,
+                  "at the solution, hold a parameter whose predicted 1-sigma "
+                  "exceeds this fraction of its bound")
+      ->check(CLI::Range(1e-6, 1e6))
+      ->capture_default_str();
+  sub->add_option("--prior", args->options.prior_weight,
+                  "ridge pull of the geometry towards nominal: residual "
+                  "W * deviation / bound, mm-equivalent (0 = none)")
+      ->check(CLI::Range(0.0, 1e6))
+      ->capture_default_str();
   sub->add_option("--id-passes", args->options.max_identifiability_passes,
                   "most passes of fit -> identifiability at the solution -> "
                   "fit (1 = decide once, at the start values)")

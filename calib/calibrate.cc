@@ -180,6 +180,7 @@ CalibrateResult Calibrate(const Robot& nominal, const Observations& obs,
   fit.loss = options.loss;
   fit.loss_scale_mm = options.loss_scale_mm;
   fit.distances = distances;
+  fit.prior_weight = options.prior_weight;
   auto run_fit = [&](const std::vector<ParamInfo>& free) {
     fit.free = free;
     if (options.method == CalibrateOptions::kPaper) {

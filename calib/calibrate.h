@@ -43,6 +43,9 @@ struct CalibrateOptions {
   // Passes of fit -> identifiability at the solution -> fit, until the free
   // set is stable (1 = decide once, at the start values).
   int max_identifiability_passes = 6;
+  // Ridge pull of the geometry towards the nominal model (FitOptions::
+  // prior_weight); 0 = none.
+  double prior_weight = 0.0;
   // The first look (at the start values) also holds parameters whose
   // predicted 1-sigma, for a noise level of this fraction of the misfit
   // after registering the frame, exceeds IdentifiabilityOptions::

@@ -91,6 +91,31 @@ struct DistanceResidual {
   const double weight_;
 };
 
+// A soft pull of one entry of a parameter block towards a centre:
+//   r = weight * (x[index] - center) / scale
+class PriorResidual : public ceres::CostFunction {
+ public:
+  PriorResidual(int block_size, int index, double center, double scale,
+                double weight)
+      : index_(index), center_(center), factor_(weight / scale) {
+    set_num_residuals(1);
+    mutable_parameter_block_sizes()->push_back(block_size);
+  }
+  bool Evaluate(double const* const* params, double* residual,
+                double** jacobians) const override {
+    residual[0] = factor_ * (params[0][index_] - center_);
+    if (jacobians != nullptr && jacobians[0] != nullptr) {
+      for (int k = 0; k < parameter_block_sizes()[0]; ++k)
+        jacobians[0][k] = k == index_ ? factor_ : 0.0;
+    }
+    return true;
+  }
+
+ private:
+  int index_;
+  double center_, factor_;
+};
+
 // The parameter block pointers of one measurement, in TipResidual's order.
 std::vector<double*> BlocksOf(ModelState* s, const Measurement& m) {
   std::vector<double*> blocks;
@@ -222,6 +247,21 @@ FitSummary Fit(const std::vector<Measurement>& measurements,
                                      center + bound);
       // Start inside the box.
       *address = std::min(std::max(*address, center - bound), center + bound);
+    }
+  }
+
+  if (options.bounds_center != nullptr && options.prior_weight > 0) {
+    const Chain& c = *options.bounds_center;
+    for (const ParamInfo& p : summary.params) {
+      if (p.kind != ParamKind::kRow) continue;
+      double* block = ParamAddress(state, p) - p.index;
+      problem.AddResidualBlock(
+          new PriorResidual(
+              problem.ParameterBlockSize(block), p.index,
+              c.rows.at(p.block).p.at(p.index),
+              IsAngle(c, p) ? c.bound_angle_rad : c.bound_length_mm,
+              options.prior_weight),
+          nullptr, block);
     }
   }
 

@@ -55,6 +55,10 @@ struct FitOptions {
   // bound_length_mm / bound_angle_rad) of this chain's values (the seed's
   // |x - t0| <= delta).
   const Chain* bounds_center = nullptr;
+  // With bounds_center: a soft pull of each free geometry parameter towards
+  // it (ridge regularisation), residual prior_weight * (x - center) / bound,
+  // in mm-equivalents beside the tip residuals. 0 = none.
+  double prior_weight = 0.0;
   // Robust loss on the 3D residual: "none", "huber" or "cauchy", scale in mm.
   std::string loss = "none";
   double loss_scale_mm = 1.0;

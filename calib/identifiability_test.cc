@@ -10,8 +10,8 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
-#include "synth/simulate.h"
 #include "data/robot.h"
+#include "synth/simulate.h"
 #include "tests/testing/paths.h"
 
 namespace kincal {

@@ -286,8 +286,8 @@ TEST(RealDataTest, MukcaPandaSinglePointWithKnownDistance) {
 // decided again at the solution (fit -> identifiability -> fit) reaches the
 // authors' level: measured 0.1942 mm training, 31 parameters (2 passes: 32
 // free at the start, one held at the solution), where deciding once at the
-// nominal point with 5 mm / 5 deg bounds stopped at 0.649 mm. Held-out on the other
-// recordings: not above the authors' calibrated model on the same poses
+// nominal point with 5 mm / 5 deg bounds stopped at 0.649 mm. Held-out on the
+// other recordings: not above the authors' calibrated model on the same poses
 // (+0.01 mm tolerance for the seating scatter).
 TEST(RealDataTest, MukcaPandaFromNominalModel) {
   KINCAL_REQUIRE_SHARED_DATA("mukca");

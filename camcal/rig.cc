@@ -118,7 +118,8 @@ Rig ParseRigYaml(const std::string& text, const std::string& file) {
       const YAML::Node n = y.Required(c, key, what);
       const int v = y.Integer(n, what + "." + key);
       if (v <= 0 || v > 100000) {
-        y.Fail(n, what + "." + key + ": expected a size in px, 1 to 100000");
+        y.Fail(n, what + "." + key +
+                      ": expected a positive integer size in px, up to 100000");
       }
       return v;
     };
@@ -128,8 +129,8 @@ Rig ParseRigYaml(const std::string& text, const std::string& file) {
       const YAML::Node n = y.Required(c, key, what);
       const double v = y.Number(n, what + "." + key);
       if (positive && !(v >= 1 && v <= 1e6)) {
-        y.Fail(n,
-               what + "." + key + ": expected a focal length in px, 1 to 1e6");
+        y.Fail(n, what + "." + key +
+                      ": expected a positive focal length in px, 1 to 1e6");
       }
       if (!positive && !(std::abs(v) <= 1e6)) {
         y.Fail(n,

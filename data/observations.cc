@@ -1,5 +1,6 @@
 #include "data/observations.h"
 
+#include <cmath>
 #include <map>
 #include <set>
 #include <sstream>
@@ -165,6 +166,14 @@ Observations ParseObservationsCsv(const std::string& text,
                                  "got '" +
                                  f.text + "'");
           }
+          // Physical range: deg (revolute, a few turns) or mm (prismatic).
+          if (!(std::abs(v) <= 1e5)) {
+            throw InputError(file, line.line, f.column,
+                             "column '" + col.name +
+                                 "': joint reading out of range (|q| <= "
+                                 "1e5 deg or mm), got '" +
+                                 f.text + "'");
+          }
           o.q[col.joint] = v;
           break;
         case kX:
@@ -179,6 +188,13 @@ Observations ParseObservationsCsv(const std::string& text,
                              "column '" + col.name +
                                  "': expected a finite number (mm) or empty, "
                                  "got '" +
+                                 f.text + "'");
+          }
+          if (!(std::abs(v) <= 1e6)) {
+            throw InputError(file, line.line, f.column,
+                             "column '" + col.name +
+                                 "': point out of range (|x| <= 1e6 mm, "
+                                 "1 km), got '" +
                                  f.text + "'");
           }
           o.p_in_meas[col.role - kX] = v;

@@ -119,10 +119,17 @@ Robot ParseUrdfChain(const std::string& xml, const std::string& file,
       if (o->Attribute("rpy"))
         rpy = ParseTriple(file, o->GetLineNum(), o->Attribute("rpy"),
                           "origin rpy");
+      if (!(xyz.cwiseAbs().maxCoeff() <= 100.0)) {
+        throw InputError(file, o->GetLineNum(), 0,
+                         "origin xyz: expected each coordinate within +-100 m");
+      }
       uj.origin.linear() = RpyToMatrix(rpy);
       uj.origin.translation() = xyz;
     }
-    if (const auto* a = j->FirstChildElement("axis")) {
+    // ROS semantics: the axis of a fixed joint is ignored (ROS-Industrial
+    // files carry <axis xyz="0 0 0"/> on flange and tool0 joints).
+    const auto* a = j->FirstChildElement("axis");
+    if (a != nullptr && uj.type != "fixed") {
       uj.axis =
           ParseTriple(file, a->GetLineNum(), a->Attribute("xyz"), "axis xyz");
       if (uj.axis.norm() < 1e-12) {

@@ -3,6 +3,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include "data/atomic_file.h"
 #include "data/error.h"
 #include "tests/testing/paths.h"
 
@@ -51,6 +52,30 @@ TEST(UrdfTest, RejectsBrokenFiles) {
     FAIL();
   } catch (const InputError& e) {
     EXPECT_THAT(e.what(), ::testing::HasSubstr("x.urdf:6:"));
+  }
+}
+
+// Issue 7: a ROS-Industrial style description (fixed flange and tool0
+// joints carrying <axis xyz="0 0 0"/>, which the URDF spec ignores) loads.
+TEST(UrdfTest, LoadsRosIndustrialStyleArmWithZeroAxesOnFixedJoints) {
+  const Robot r =
+      ReadUrdfChain(testing::SourceDir() + "/data/robots/industrial7.urdf");
+  ASSERT_EQ(r.joints.size(), 7u);
+  EXPECT_EQ(r.joints[0].name, "joint_a1");
+  EXPECT_EQ(r.joints[6].name, "joint_a7");
+  EXPECT_NEAR(r.joints[3].axis.y(), -1.0, 1e-12);
+  EXPECT_NEAR(r.tool.xyz_mm.z(), 45.0, 1e-9);  // flange + tool0 folded
+  EXPECT_DOUBLE_EQ(r.bound_length_mm, 20.0);
+  // A zero axis on a movable joint is still an error, with its line.
+  std::string text =
+      ReadFile(testing::SourceDir() + "/data/robots/industrial7.urdf");
+  text.replace(text.find("<axis xyz=\"0 1 0\"/>"), 19, "<axis xyz=\"0 0 0\"/>");
+  try {
+    ParseUrdfChain(text, "i7.urdf");
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_THAT(e.what(), ::testing::HasSubstr("i7.urdf:"));
+    EXPECT_THAT(e.what(), ::testing::HasSubstr("axis"));
   }
 }
 

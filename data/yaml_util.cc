@@ -85,6 +85,10 @@ double YamlReader::NumberOr(const YAML::Node& map, const char* key,
 int YamlReader::Integer(const YAML::Node& node, const std::string& what) const {
   const double v = Number(node, what);
   if (v != std::floor(v)) Fail(node, what + ": expected an integer");
+  // Outside int the cast is undefined (found by fuzz/robot_yaml_fuzz.cc).
+  if (!(std::abs(v) <= 2147483647.0)) {
+    Fail(node, what + ": integer out of range");
+  }
   return static_cast<int>(v);
 }
 

@@ -3,8 +3,8 @@
 # every recording, calibrate from the NOMINAL Panda (urdf/panda.urdf) with
 # the 50 mm socket distance, then evaluate on the robot's other recordings;
 # the authors' calibrated URDF is evaluated on the same poses.
-# Usage: scripts/mukca_compare.sh [kincal binary] [mukca dir] > table.tsv
-set -euo pipefail
+# Usage: scripts/mukca_compare.sh [kincal binary] [mukca dir] [robot glob] > table.tsv
+set -uo pipefail
 K=${1:-build/bin/kincal}
 M=${2:-../shared/data/mukca}
 W=$(mktemp -d)
@@ -18,11 +18,13 @@ authors_of() {  # recording folder -> calibrated_urdf folder
 stats() {  # evaluate JSON -> "rms hole_0 hole_1 distance_error"
   python3 -c '
 import json,sys
-j=json.load(sys.stdin); f=j["fixed_points"]; d=j["point_distances"][0]["distance_mm"]-50
+try: j=json.load(sys.stdin)
+except Exception: print("NA\tNA\tNA\tNA"); sys.exit()
+f=j["fixed_points"]; d=j["point_distances"][0]["distance_mm"]-50
 print("%.4f\t%.4f\t%.4f\t%+.4f" % (j["rms_mm"], f["hole_0"]["rms_mm"], f["hole_1"]["rms_mm"], d))'
 }
 printf "robot\ttrain\ttest\tkincal_rms\tkincal_h0\tkincal_h1\tkincal_dist_err\tauthors_rms\tauthors_h0\tauthors_h1\tauthors_dist_err\tkincal_train_rms\tfree\tpasses\n"
-for robot_dir in "$M"/data/panda_*; do
+for robot_dir in "$M"/data/${3:-panda_*}; do
   robot=$(basename "$robot_dir")
   authors="$M/calibrated_urdf/$(authors_of "$robot")/panda.urdf"
   recs=()
@@ -36,7 +38,10 @@ for robot_dir in "$M"/data/panda_*; do
       "$K" calibrate --robot "$M/urdf/panda.urdf" --tip ball_link \
         --obs "$W/$robot.$train.csv" --fixed-distance hole_0,hole_1,50 \
         --holdout 0 --out "$W/cal.yaml" --json |
-        python3 -c 'import json,sys; j=json.load(sys.stdin); print("%.4f\t%d\t%d" % (j["train_rms_mm"], len(j["identifiable"]), j["identifiability_passes"]))')
+        python3 -c 'import json,sys
+try: j=json.load(sys.stdin)
+except Exception: print("NA\tNA\tNA"); sys.exit()
+print("%.4f\t%d\t%d" % (j["train_rms_mm"], len(j["identifiable"]), j["identifiability_passes"]))')
     for test in "${recs[@]}"; do
       [ "$test" = "$train" ] && continue
       ours=$("$K" evaluate --robot "$W/cal.yaml" --obs "$W/$robot.$test.csv" --json | stats)

@@ -112,9 +112,9 @@ Target ParseTargetYaml(const std::string& text, const std::string& file) {
     const YAML::Node size = r.Required(t, "size", what);
     tag.size_mm = r.Number(size, what + ".size");
     if (!(tag.size_mm >= kMinTagMm && tag.size_mm <= kMaxTagMm)) {
-      r.Fail(size, what + ".size: expected an edge length in mm between " +
-                       FormatDouble(kMinTagMm) + " and " +
-                       FormatDouble(kMaxTagMm));
+      r.Fail(size,
+             what + ".size: expected a positive edge length in mm between " +
+                 FormatDouble(kMinTagMm) + " and " + FormatDouble(kMaxTagMm));
     }
     tag.tool_from_tag = ReadPose(r, r.Required(t, "tool_from_tag", what),
                                  what + ".tool_from_tag");

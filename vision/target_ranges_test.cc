@@ -24,8 +24,8 @@ std::string Target(const std::string& size, const std::string& t,
 }
 
 TEST(TargetRanges, AcceptsPhysicalValues) {
-  EXPECT_NO_THROW(ParseTargetYaml(Target("30", "[0, 0, 0]", "[0, 0, 150]"),
-                                  "t.yaml"));
+  EXPECT_NO_THROW(
+      ParseTargetYaml(Target("30", "[0, 0, 0]", "[0, 0, 150]"), "t.yaml"));
 }
 
 TEST(TargetRanges, RejectsOutOfRangeWithPosition) {

@@ -220,8 +220,10 @@ bool FitPose(const Rig& rig, const std::vector<TagObs>& obs,
                  rig_from_tool->t.z()};
   // Non-finite guard: nothing non-finite may reach Ceres (its manifold
   // CHECKs abort the process instead of failing the solve).
-  for (double v : q) if (!std::isfinite(v)) return false;
-  for (double v : t) if (!std::isfinite(v)) return false;
+  for (double v : q)
+    if (!std::isfinite(v)) return false;
+  for (double v : t)
+    if (!std::isfinite(v)) return false;
   for (size_t i = 0; i < obs.size(); ++i) {
     if (!used[i]) continue;
     for (int k = 0; k < 4; ++k) {
