@@ -174,9 +174,17 @@ TEST(UrdfExportTest, PandaUrdfCalibratedAndExported) {
   const Robot back = RoundTrip(cal.calibrated, &e);
   EXPECT_LT(MaxTipDifference(cal.calibrated, back), 1e-9);
   ExpectCheckUrdfAccepts(e.xml, "panda_urdf");
-  // And the Panda in standard DH (its joint 1 turns about the base z axis).
-  EXPECT_LT(MaxTipDifference(cal.calibrated, ConvertToDh(cal.calibrated)),
-            1e-9);
+  // And the Panda in standard DH. The nominal joint 1 turns about the base z
+  // axis, so DH holds it exactly; the calibration may tilt joint 1 against
+  // the base (the sockets absorb the base frame), and then standard DH, which
+  // has no base row, must refuse with a clear message rather than drop it.
+  EXPECT_LT(MaxTipDifference(panda, ConvertToDh(panda)), 1e-9);
+  try {
+    EXPECT_LT(MaxTipDifference(cal.calibrated, ConvertToDh(cal.calibrated)),
+              1e-9);
+  } catch (const InputError& e) {
+    EXPECT_THAT(e.what(), HasSubstr("base z axis"));
+  }
 }
 
 }  // namespace

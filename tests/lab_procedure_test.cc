@@ -124,8 +124,8 @@ TEST(LabProcedure, SimulateFakeRobotCaptureTrackCalibrate) {
   std::thread controller(
       [&] { FakeController(port, w + "/sim/observations.csv", &done); });
   r = RunKincal("capture --left 'folder:" + w +
-                "/sim/images/left_*.png' --right 'folder:" + w +
-                "/sim/images/right_*.png' --robot " + robot +
+                "/sim/session/left/*.png' --right 'folder:" + w +
+                "/sim/session/right/*.png' --robot " + robot +
                 " --robot-listen 127.0.0.1:" + std::to_string(port) +
                 " --shots 1 --out " + w + "/session --json");
   controller.join();
@@ -133,8 +133,8 @@ TEST(LabProcedure, SimulateFakeRobotCaptureTrackCalibrate) {
   EXPECT_EQ(done, 40);
   EXPECT_EQ(nlohmann::json::parse(r.out)["frames"], 40);
 
-  r = RunKincal("track --rig " + w + "/sim/images/rig.yaml --target " + w +
-                "/sim/images/target.yaml --left '" + w +
+  r = RunKincal("track --rig " + w + "/sim/rig.yaml --target " + w +
+                "/sim/target.yaml --left '" + w +
                 "/session/left/*.png' --right '" + w +
                 "/session/right/*.png' --obs " + w +
                 "/session/observations.csv --robot " + robot + " --out " + w +
