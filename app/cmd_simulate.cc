@@ -30,25 +30,6 @@ struct SimulateArgs {
   RenderOptions render_options;
 };
 
-// The tool frame of vision's example target relative to the needle tip
-// frame: the needle (tip z) runs along tool y from the tags to the tip, tool
-// z (into the tags) along tip x. tip_from_tool maps tool points to tip.
-Rigid3 TipFromTool(const Target& target) {
-  Rigid3 tip_from_tool;
-  tip_from_tool.R << 0, 0, 1,  //
-      1, 0, 0,                 //
-      0, 1, 0;
-  tip_from_tool.t = -(tip_from_tool.R * target.tip_in_tool);
-  return tip_from_tool;
-}
-
-Rigid3 ToRigid(const Eigen::Matrix4d& m) {
-  Rigid3 r;
-  r.R = m.block<3, 3>(0, 0);
-  r.t = m.block<3, 1>(0, 3);
-  return r;
-}
-
 // Places the stereo rig so that it sees every tip and looks along the mean
 // direction the tags face away from (so they face the cameras on average):
 // rig_from_base as [rotation vector rad, t mm]. Returns the distance.
@@ -176,7 +157,7 @@ int RunSimulate(SimulateArgs args) {
   MakeDirs(args.out);
   int rendered = 0;
   if (args.render) {
-    const Rigid3 rig_from_base = ToRigid([&] {
+    const Rigid3 rig_from_base = Rigid3::FromMatrix([&] {
       Eigen::Matrix4d m = Eigen::Matrix4d::Identity();
       const Eigen::Vector3d w(s.meas_from_base[0], s.meas_from_base[1],
                               s.meas_from_base[2]);
@@ -190,7 +171,8 @@ int RunSimulate(SimulateArgs args) {
     }());
     std::vector<Rigid3> rig_from_tool;
     for (const Eigen::Matrix4d& m : s.base_from_tip) {
-      rig_from_tool.push_back(rig_from_base * ToRigid(m) * tip_from_tool);
+      rig_from_tool.push_back(rig_from_base * Rigid3::FromMatrix(m) *
+                              tip_from_tool);
     }
     // A recorded session (spec layout, joint columns) beside the rig and
     // target it was seen with.

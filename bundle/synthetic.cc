@@ -13,22 +13,6 @@
 namespace kincal {
 namespace {
 
-Rigid3 ToRigid(const Eigen::Matrix4d& m) {
-  Rigid3 r;
-  r.R = m.block<3, 3>(0, 0);
-  r.t = m.block<3, 1>(0, 3);
-  return r;
-}
-
-// Tool frame relative to the needle tip frame (as `simulate --render`): the
-// needle (tip z) runs along tool y, tool z (into the tags) along tip x.
-Rigid3 TipFromTool(const Target& target) {
-  Rigid3 r;
-  r.R << 0, 0, 1, 1, 0, 0, 0, 1, 0;
-  r.t = -(r.R * target.tip_in_tool);
-  return r;
-}
-
 // rig_from_base looking at the tips' centroid along the mean tag normal,
 // at a distance where the workspace fills ~80 % of the view.
 Rigid3 PlaceRig(const std::vector<Eigen::Matrix4d>& base_from_tip,
@@ -131,7 +115,7 @@ SyntheticBundle MakeSyntheticBundle(const Robot& nominal,
   const ChainRow& tool = truth.rows[truth.tool_row()];
   const Eigen::Matrix4d flange_from_tip =
       RowTransform<double>(truth.convention, tool, tool.p.data(), 0.0);
-  s.flange_from_tool = ToRigid(flange_from_tip) * tip_from_tool;
+  s.flange_from_tool = Rigid3::FromMatrix(flange_from_tip) * tip_from_tool;
 
   std::mt19937_64 rng(o.seed * 7919 + 17);
   std::normal_distribution<double> noise(0.0, 1.0);
@@ -141,8 +125,9 @@ SyntheticBundle MakeSyntheticBundle(const Robot& nominal,
     bf.frame = f;
     bf.q_reading = row.q;
     bf.t_s = row.HasTime() ? row.t_s : 0.0;
-    const Rigid3 rig_from_tool =
-        s.rig_from_base * ToRigid(sim.base_from_tip[f]) * tip_from_tool;
+    const Rigid3 rig_from_tool = s.rig_from_base *
+                                 Rigid3::FromMatrix(sim.base_from_tip[f]) *
+                                 tip_from_tool;
     std::vector<std::vector<TagDetection>> dets(s.rig.cameras.size());
     for (size_t c = 0; c < s.rig.cameras.size(); ++c) {
       const Camera& cam = s.rig.cameras[c];

@@ -99,6 +99,10 @@ struct Rigid3 {
     iso.translation() = t;
     return iso;
   }
+  // From a 4x4 homogeneous transform (its top 3x4 block).
+  static Rigid3 FromMatrix(const Eigen::Matrix4d& m) {
+    return {m.block<3, 3>(0, 0), m.block<3, 1>(0, 3)};
+  }
 };
 using CameraPose = Rigid3;
 

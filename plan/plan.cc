@@ -30,13 +30,6 @@ Eigen::Matrix4d BaseFromTip(const Chain& chain, const std::vector<double>& q) {
   return BaseFromTipAt(chain, qi);
 }
 
-Rigid3 ToRigid(const Eigen::Matrix4d& m) {
-  Rigid3 r;
-  r.R = m.block<3, 3>(0, 0);
-  r.t = m.block<3, 1>(0, 3);
-  return r;
-}
-
 PoseInput MakeInput(const Chain& chain, const std::vector<double>& q) {
   PoseInput in;
   const size_t n = q.size();
@@ -226,7 +219,7 @@ Rigid3 PlaceRigAuto(const Robot& robot, const Chain& chain, const Rig& rig,
   Eigen::Vector3d mean_z = Eigen::Vector3d::Zero();
   for (int i = 0; i < 1000; ++i) {
     const Rigid3 base_from_tool =
-        ToRigid(BaseFromTip(chain, sampler.Draw())) * tip_from_tool;
+        Rigid3::FromMatrix(BaseFromTip(chain, sampler.Draw())) * tip_from_tool;
     centres.push_back(base_from_tool * tags_in_tool);
     normals.push_back(base_from_tool.R.col(2));
     mean_z += normals.back();
@@ -285,15 +278,6 @@ struct Problem {
 };
 
 }  // namespace
-
-Rigid3 TipFromTool(const Target& target) {
-  Rigid3 tip_from_tool;
-  tip_from_tool.R << 0, 0, 1,  //
-      1, 0, 0,                 //
-      0, 1, 0;
-  tip_from_tool.t = -(tip_from_tool.R * target.tip_in_tool);
-  return tip_from_tool;
-}
 
 int VisibleTags(const Rig& rig, const Target& target,
                 const Rigid3& rig_from_tool, const PlanOptions& options) {
@@ -536,8 +520,9 @@ PlanResult PlanPoses(const Robot& robot, const PlanOptions& options) {
   }
   auto visible = [&](const std::vector<double>& q) {
     if (options.rig == nullptr) return true;
-    const Rigid3 rig_from_tool =
-        plan.rig_from_base * ToRigid(BaseFromTip(chain, q)) * tip_from_tool;
+    const Rigid3 rig_from_tool = plan.rig_from_base *
+                                 Rigid3::FromMatrix(BaseFromTip(chain, q)) *
+                                 tip_from_tool;
     return VisibleTags(*options.rig, *options.target, rig_from_tool, options) >=
            options.min_tags;
   };

@@ -106,11 +106,6 @@ struct PlanResult {
 // identifiable parameters, or too few feasible poses are found.
 PlanResult PlanPoses(const Robot& robot, const PlanOptions& options);
 
-// The tool frame of a target.yaml relative to the robot's tip frame, as
-// `kincal simulate --render` mounts it: the needle (tip z) runs along tool y
-// from the tags to the tip, tool z (into the tags) along tip x.
-Rigid3 TipFromTool(const Target& target);
-
 // Number of target tags fully visible in every camera of the rig for a tool
 // at rig_from_tool (the criteria of PlanOptions).
 int VisibleTags(const Rig& rig, const Target& target,

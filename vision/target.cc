@@ -158,4 +158,13 @@ void WriteTargetYaml(const std::string& path, const Target& target) {
   WriteFileAtomic(path, FormatTargetYaml(target));
 }
 
+Rigid3 TipFromTool(const Target& target) {
+  Rigid3 tip_from_tool;
+  tip_from_tool.R << 0, 0, 1,  //
+      1, 0, 0,                 //
+      0, 1, 0;
+  tip_from_tool.t = -(tip_from_tool.R * target.tip_in_tool);
+  return tip_from_tool;
+}
+
 }  // namespace kincal

@@ -44,6 +44,14 @@ struct Target {
 // duplicate id, an id outside the family, a non-positive size or a matrix
 // that is not a rotation raise InputError with file:line:column. R may be
 // rounded (orthonormal within 1e-3); it is replaced by the nearest rotation.
+// How kincal's synthetic sessions and the planner mount a target on the
+// robot: the tool frame relative to the needle-tip frame (the last row of
+// the chain), with the needle (tip z) running along tool y from the tags to
+// the tip and tool z (into the tags) along tip x. tip_from_tool maps tool
+// points to the tip frame. Real tools are mounted as they are: the bundle
+// estimates flange_from_target instead of assuming this.
+Rigid3 TipFromTool(const Target& target);
+
 Target ReadTargetYaml(const std::string& path);
 Target ParseTargetYaml(const std::string& text, const std::string& file_label);
 
