@@ -182,6 +182,20 @@ int RunCamcal(const CamcalArgs& args) {
       nlohmann::json per_view = nlohmann::json::array();
       for (double r : cs.view_rms_px) per_view.push_back(Nullable(r));
       cj["view_rms_px"] = per_view;
+      const ImageResidualGrid& g = cs.image_grid;
+      auto nullable = [](const std::vector<double>& v) {
+        nlohmann::json a = nlohmann::json::array();
+        for (double x : v) a.push_back(Nullable(x));
+        return a;
+      };
+      cj["image_grid"] = {{"cols", g.cols},
+                          {"rows", g.rows},
+                          {"cell_w_px", g.cell_w_px},
+                          {"cell_h_px", g.cell_h_px},
+                          {"count", g.count},
+                          {"rms_px", nullable(g.rms_px)},
+                          {"mean_dx_px", nullable(g.mean_dx_px)},
+                          {"mean_dy_px", nullable(g.mean_dy_px)}};
       cams.push_back(cj);
     }
     j["cameras"] = cams;

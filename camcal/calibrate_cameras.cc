@@ -3,12 +3,14 @@
 #include <ceres/ceres.h>
 #include <ceres/rotation.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <memory>
 #include <opencv2/calib3d.hpp>
 #include <opencv2/core/eigen.hpp>
 #include <sstream>
+#include <utility>
 
 #include "data/error.h"
 
@@ -420,6 +422,9 @@ ceres::Solver::Options SolverOptions(const CalibrationOptions& options) {
 // Point residuals (pixel error norms) per camera and view.
 struct Residuals {
   std::vector<std::vector<std::vector<double>>> norms;  // [c][v][point]
+  // Detected pixel and residual vector (projected - detected) of every
+  // point with a finite residual: [c] -> (pixel, residual).
+  std::vector<std::vector<std::pair<Eigen::Vector2d, Eigen::Vector2d>>> vectors;
 };
 
 Residuals ComputeResiduals(const std::vector<CalibrationView>& views,
@@ -427,6 +432,7 @@ Residuals ComputeResiduals(const std::vector<CalibrationView>& views,
   const size_t nc = s.intrinsics.size();
   Residuals r;
   r.norms.assign(nc, std::vector<std::vector<double>>(views.size()));
+  r.vectors.resize(nc);
   for (size_t v = 0; v < views.size(); ++v) {
     if (!s.view_used[v]) continue;
     const Rigid3 rig_from_target = s.rig_from_target[v].ToRigid3();
@@ -441,12 +447,44 @@ Residuals ComputeResiduals(const std::vector<CalibrationView>& views,
         double err = kNaN;
         if (ProjectPoint(s.intrinsics[c].data(), p_in_cam.data(), px.data())) {
           err = (px - obs.pixels[i]).norm();
+          r.vectors[c].emplace_back(obs.pixels[i], px - obs.pixels[i]);
         }
         r.norms[c][v].push_back(err);
       }
     }
   }
   return r;
+}
+
+ImageResidualGrid GridOverImage(
+    const std::vector<std::pair<Eigen::Vector2d, Eigen::Vector2d>>& vectors,
+    int width, int height, int cols, int rows) {
+  ImageResidualGrid g;
+  g.cols = cols;
+  g.rows = rows;
+  g.cell_w_px = static_cast<double>(width) / cols;
+  g.cell_h_px = static_cast<double>(height) / rows;
+  const size_t n = static_cast<size_t>(cols) * rows;
+  g.count.assign(n, 0);
+  std::vector<double> ss(n, 0.0), sx(n, 0.0), sy(n, 0.0);
+  for (const auto& [pixel, e] : vectors) {
+    const int i =
+        std::clamp(static_cast<int>(pixel.x() / g.cell_w_px), 0, cols - 1);
+    const int j =
+        std::clamp(static_cast<int>(pixel.y() / g.cell_h_px), 0, rows - 1);
+    const size_t k = static_cast<size_t>(j) * cols + i;
+    ++g.count[k];
+    ss[k] += e.squaredNorm();
+    sx[k] += e.x();
+    sy[k] += e.y();
+  }
+  for (size_t k = 0; k < n; ++k) {
+    const double m = g.count[k];
+    g.rms_px.push_back(m > 0 ? std::sqrt(ss[k] / m) : kNaN);
+    g.mean_dx_px.push_back(m > 0 ? sx[k] / m : kNaN);
+    g.mean_dy_px.push_back(m > 0 ? sy[k] / m : kNaN);
+  }
+  return g;
 }
 
 double Rms(const std::vector<double>& values) {
@@ -632,6 +670,8 @@ CalibrationSummary CalibrateCameras(const CalibrationProblem& input,
     }
     cs.num_points = static_cast<int>(all.size());
     cs.rms_px = Rms(all);
+    cs.image_grid = GridOverImage(res.vectors[c], input.cameras[c].width,
+                                  input.cameras[c].height, 8, 6);
     for (double e : all) {
       cs.max_px = std::max(cs.max_px, e);
       ss_all += e * e;

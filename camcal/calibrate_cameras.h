@@ -82,6 +82,19 @@ struct CalibrationOptions {
   void Check() const;
 };
 
+// Reprojection residuals over the imager: a cols x rows grid of equal cells
+// (row-major, row 0 at the top); per cell the number of corners, their RMS
+// residual and mean residual vector (projected - detected, px; NaN when the
+// cell holds no corner). Shows where in the image the camera model is wrong
+// (a distortion model too weak at the edges shows as outward/inward vectors
+// in the corners) and where the target never was (coverage).
+struct ImageResidualGrid {
+  int cols = 0, rows = 0;
+  double cell_w_px = 0, cell_h_px = 0;
+  std::vector<int> count;
+  std::vector<double> rms_px, mean_dx_px, mean_dy_px;
+};
+
 struct CameraCalibrationSummary {
   CameraIntrinsics intrinsics;
   int num_views = 0;         // views in which the target was used
@@ -92,6 +105,8 @@ struct CameraCalibrationSummary {
   int outliers = 0;          // residuals > outlier_factor * rms_px
   // Per view (same order as the problem's views); NaN when not seen.
   std::vector<double> view_rms_px;
+  // Residuals over the image (8 x 6 cells).
+  ImageResidualGrid image_grid;
   // sigma of fx, fy, cx, cy, k1..k6 (kNumIntrinsics, 0 for fixed ones), scaled
   // by the residual variance; empty when the covariance is not available.
   std::vector<double> sigma;

@@ -101,6 +101,9 @@ void Draw(const Plot& plot, int y0, const std::string& id,
   if (ymin != 0.0) ymin -= pad;
   if (std::isfinite(plot.y_min)) ymin = plot.y_min;
   if (std::isfinite(plot.y_max)) ymax = plot.y_max;
+  if (std::isfinite(plot.x_min)) xmin = plot.x_min;
+  if (std::isfinite(plot.x_max)) xmax = plot.x_max;
+  if (!(xmax > xmin)) xmax = xmin + 1.0;
   if (!(ymax > ymin)) ymax = ymin + 1.0;
   if (!(cmax >= cmin)) cmin = 0, cmax = 1;
   if (cmax - cmin < 1e-12) cmax = cmin + 1e-12;
@@ -113,7 +116,9 @@ void Draw(const Plot& plot, int y0, const std::string& id,
     }
   }
   auto X = [&](double x) { return left + (x - xmin) / (xmax - xmin) * w; };
-  auto Y = [&](double y) { return y0 + top + (ymax - y) / (ymax - ymin) * h; };
+  auto Y = [&](double y) {
+    return y0 + top + (plot.y_down ? y - ymin : ymax - y) / (ymax - ymin) * h;
+  };
   const std::string clip = id + "clip" + std::to_string(y0);
 
   os << "<defs><clipPath id='" << clip << "'><rect x='" << Px(left) << "' y='"
@@ -179,9 +184,9 @@ void Draw(const Plot& plot, int y0, const std::string& id,
                        x1 = X(s.x[i] + s.cell_w / 2);
           const double y1 = Y(s.y[i] - s.cell_h / 2),
                        y0c = Y(s.y[i] + s.cell_h / 2);
-          os << "<rect x='" << Px(x0) << "' y='" << Px(y0c) << "' width='"
-             << Px(x1 - x0) << "' height='" << Px(y1 - y0c) << "' fill='" << c
-             << "'/>\n";
+          os << "<rect x='" << Px(x0) << "' y='" << Px(std::min(y0c, y1))
+             << "' width='" << Px(x1 - x0) << "' height='"
+             << Px(std::abs(y1 - y0c)) << "' fill='" << c << "'/>\n";
           continue;
         }
         if (arrows && i < s.dx.size() && i < s.dy.size()) {

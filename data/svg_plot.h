@@ -50,8 +50,13 @@ struct Plot {
   // frame, e.g. to show a minimum near zero beside curves that reach far up.
   double y_min = std::numeric_limits<double>::quiet_NaN();
   double y_max = std::numeric_limits<double>::quiet_NaN();
+  // Fixed x range (NaN = from the data).
+  double x_min = std::numeric_limits<double>::quiet_NaN();
+  double x_max = std::numeric_limits<double>::quiet_NaN();
   // Same x and y scale (workspace views).
   bool equal_axes = false;
+  // y grows downwards (image rows): the smallest y at the top.
+  bool y_down = false;
 };
 
 // A standalone SVG file of the plot: XML declaration, then the command line

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <fstream>
+#include <limits>
 #include <map>
 #include <nlohmann/json.hpp>
 #include <sstream>
@@ -43,27 +44,6 @@ std::string ThinNote(size_t n, int max) {
              ? " Markers: every " + Fmt(double(n) / max, 2) + "-th of " +
                    std::to_string(n) + " rows (statistics use all)."
              : "";
-}
-
-// temp_c per observations line number (read here: the column is optional
-// in the spec and not every reader keeps it).
-std::map<int, double> ReadTemperatures(const std::string& path) {
-  std::map<int, double> out;
-  const std::vector<CsvLine> lines = TokenizeCsv(ReadFile(path), path);
-  if (lines.empty()) return out;
-  int col = -1;
-  for (size_t c = 0; c < lines[0].fields.size(); ++c) {
-    if (lines[0].fields[c].text == "temp_c") col = static_cast<int>(c);
-  }
-  if (col < 0) return out;
-  for (size_t i = 1; i < lines.size(); ++i) {
-    double v;
-    if (col < static_cast<int>(lines[i].fields.size()) &&
-        ParseFiniteDouble(lines[i].fields[col].text, &v)) {
-      out[lines[i].line] = v;
-    }
-  }
-  return out;
 }
 
 // "# ..." provenance lines of a text file (first 6 comment lines) or the
@@ -119,6 +99,99 @@ struct Inputs {
 
 // Parameter unit shown in tables.
 std::string Unit(const ParamInfo& p) { return p.angle ? "deg" : "mm"; }
+
+// Per camera of camcal's JSON with an image_grid: RMS per cell as coloured
+// cells and the mean residual vector as an arrow from the cell centre,
+// enlarged by *arrow_gain (one gain for all cameras: the 90th-percentile
+// arrow spans half a cell, so one outlier cell does not shrink the rest); image
+// rows grow downwards as in the image. Empty when no camera has a grid.
+std::vector<Plot> ImageGridPlots(const nlohmann::json& cameras,
+                                 double* arrow_gain) {
+  std::vector<Plot> plots;
+  double hi = 0.0, cell = INFINITY;
+  std::vector<double> lengths;
+  for (const auto& c : cameras) {
+    if (!c.contains("image_grid") || !c["image_grid"].is_object()) continue;
+    const nlohmann::json& g = c["image_grid"];
+    const int cols = g.value("cols", 0), rows = g.value("rows", 0);
+    const double cw = g.value("cell_w_px", 0.0), ch = g.value("cell_h_px", 0.0);
+    auto at = [&](const char* key, size_t k) {
+      return g.contains(key) && g[key].is_array() && k < g[key].size() &&
+                     g[key][k].is_number()
+                 ? g[key][k].get<double>()
+                 : std::numeric_limits<double>::quiet_NaN();
+    };
+    if (cols <= 0 || rows <= 0 || !(cw > 0) || !(ch > 0)) continue;
+    Plot p;
+    p.title = c.value("name", "?") + ": residual over the image";
+    p.x_label = "image column (px)";
+    p.y_label = "image row (px, downwards)";
+    p.width = 520;
+    p.height = 420;
+    p.y_down = true;
+    p.equal_axes = true;
+    PlotSeries cells;
+    cells.points = true;
+    cells.color_label = "RMS (px)";
+    cells.cell_w = cw;
+    cells.cell_h = ch;
+    PlotSeries arrows;
+    arrows.points = true;
+    arrows.color_index = 7;
+    for (int j = 0; j < rows; ++j) {
+      for (int i = 0; i < cols; ++i) {
+        const size_t k = static_cast<size_t>(j) * cols + i;
+        const double rms = at("rms_px", k);
+        if (!std::isfinite(rms)) continue;
+        const double x = (i + 0.5) * cw, y = (j + 0.5) * ch;
+        cells.x.push_back(x);
+        cells.y.push_back(y);
+        cells.color.push_back(rms);
+        hi = std::max(hi, rms);
+        const double dx = at("mean_dx_px", k), dy = at("mean_dy_px", k);
+        if (std::isfinite(dx) && std::isfinite(dy)) {
+          arrows.x.push_back(x);
+          arrows.y.push_back(y);
+          arrows.dx.push_back(dx);
+          arrows.dy.push_back(dy);
+          lengths.push_back(std::hypot(dx, dy));
+        }
+      }
+    }
+    if (cells.x.empty()) continue;
+    cell = std::min(cell, std::min(cw, ch));
+    // The frame shows the whole imager, also cells no corner reached.
+    p.x_min = 0.0;
+    p.x_max = cols * cw;
+    p.y_min = 0.0;
+    p.y_max = rows * ch;
+    p.series = {cells, arrows};
+    plots.push_back(p);
+  }
+  // A round gain (1, 2, 5 x 10^k) so the caption can name it.
+  double gain = 1.0;
+  double p90 = 0.0;
+  if (!lengths.empty()) {
+    const size_t k = lengths.size() * 9 / 10;
+    std::nth_element(lengths.begin(), lengths.begin() + k, lengths.end());
+    p90 = lengths[k];
+  }
+  if (p90 > 0 && std::isfinite(cell)) {
+    const double want = 0.5 * cell / p90;
+    const double decade = std::pow(10.0, std::floor(std::log10(want)));
+    gain = want >= 5 * decade   ? 5 * decade
+           : want >= 2 * decade ? 2 * decade
+                                : decade;
+  }
+  for (Plot& p : plots) {
+    p.series[0].color_lo = 0.0;
+    p.series[0].color_hi = hi > 0 ? hi : 1.0;
+    for (double& d : p.series[1].dx) d *= gain;
+    for (double& d : p.series[1].dy) d *= gain;
+  }
+  *arrow_gain = gain;
+  return plots;
+}
 
 }  // namespace
 
@@ -483,12 +556,12 @@ ReportResult BuildReport(
         return in.obs.rows[row].HasTime() ? in.obs.rows[row].t_s : NAN;
       }));
     }
-    const std::map<int, double> temps = ReadTemperatures(opt.obs);
-    if (!temps.empty()) {
+    bool has_temp = false;
+    for (const Observation& r : in.obs.rows) has_temp |= r.HasTemp();
+    if (has_temp) {
       tplots.push_back(
           scatter("against temperature", "temp_c (deg C)", [&](int row) {
-            auto it = temps.find(in.obs.rows[row].line);
-            return it == temps.end() ? NAN : it->second;
+            return in.obs.rows[row].HasTemp() ? in.obs.rows[row].temp_c : NAN;
           }));
     }
     if (!tplots.empty()) {
@@ -554,7 +627,9 @@ ReportResult BuildReport(
                          "poses in each cell of a " +
                          std::to_string(grid_bins) + " x " +
                          std::to_string(grid_bins) +
-                         " grid (cells with 3 or more poses; blue small, red "
+                         " grid (finer than the 5 x 5 grid of the shares "
+                         "above, which keeps their chance level low; cells "
+                         "with 3 or more poses; blue small, red "
                          "large; one scale from 0 for both maps): the "
                          "systematic part the model misses. Grey dots: the "
                          "poses." +
@@ -874,6 +949,22 @@ ReportResult BuildReport(
         page.Figure(views, "From " + camcal_path +
                                " (kincal camcal --json): RMS reprojection "
                                "error of every view, per camera.");
+      }
+      double arrow_gain = 1.0;
+      std::vector<Plot> over_image =
+          ImageGridPlots(camcal["cameras"], &arrow_gain);
+      if (!over_image.empty()) {
+        page.FigureRow(
+            over_image,
+            "Reprojection error over the image: each cell of the imager "
+            "coloured by the RMS residual of the corners detected in it (one "
+            "scale from 0 for all cameras; white: no corner ever there, so "
+            "the model is extrapolated), the arrow is the mean residual "
+            "vector (projected - detected), drawn " +
+                Fmt(arrow_gain, 3) +
+                " x enlarged. Arrows that turn with the position (outwards or "
+                "inwards at the edges) mean the distortion model is too weak; "
+                "random arrows mean noise.");
       }
     } else {
       page.Paragraph(

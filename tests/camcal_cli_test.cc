@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <array>
+#include <cmath>
 #include <cstdio>
 #include <nlohmann/json.hpp>
 #include <string>
@@ -42,6 +43,31 @@ TEST(CamcalCli, StereoChessboardJsonAndRig) {
     EXPECT_TRUE(c.at("holdout_rms_px").is_number());
     EXPECT_TRUE(c.at("sigma").at("fx").is_number());
     EXPECT_NEAR(c.at("fx").get<double>(), 537, 10);
+    // Residuals over the image: 8 x 6 cells holding every corner once, and
+    // the cells' RMS values combine to the camera's RMS.
+    const auto& g = c.at("image_grid");
+    ASSERT_EQ(g.at("cols"), 8);
+    ASSERT_EQ(g.at("rows"), 6);
+    ASSERT_EQ(g.at("count").size(), 48u);
+    EXPECT_NEAR(g.at("cell_w_px").get<double>() * 8, 640, 1e-9);
+    int corners = 0, cells_seen = 0;
+    double ss = 0;
+    for (size_t k = 0; k < 48; ++k) {
+      const int n = g["count"][k].get<int>();
+      corners += n;
+      if (n == 0) {
+        EXPECT_TRUE(g["rms_px"][k].is_null());
+        continue;
+      }
+      ++cells_seen;
+      ss += n * std::pow(g["rms_px"][k].get<double>(), 2);
+      EXPECT_LE(std::hypot(g["mean_dx_px"][k].get<double>(),
+                           g["mean_dy_px"][k].get<double>()),
+                g["rms_px"][k].get<double>() + 1e-12);
+    }
+    EXPECT_EQ(corners, 13 * 54);
+    EXPECT_GT(cells_seen, 20);
+    EXPECT_NEAR(std::sqrt(ss / corners), c.at("rms_px").get<double>(), 1e-9);
   }
   EXPECT_NE(j.at("command").get<std::string>().find("camcal"),
             std::string::npos);

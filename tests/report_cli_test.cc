@@ -157,6 +157,33 @@ TEST(ReportCliTest, BadInputExitsTwoAndWritesNothing) {
   EXPECT_FALSE(Exists(dir + "/r.html"));
 }
 
+// The camera section from a real camera calibration (OpenCV's stereo
+// chessboard images): camcal's JSON saved beside the rig is found, and the
+// per-view and over-the-image figures draw (screenshot in the build folder).
+TEST(ReportCliTest, CameraSectionFromRealCamcal) {
+  KINCAL_REQUIRE_SHARED_DATA("opencv-stereo-left-right");
+  const std::string dir = testing::MakeTempDir("report_camcal");
+  const std::string stereo =
+      testing::SharedDataDir() + "/opencv-stereo-left-right";
+  const auto c =
+      RunKincal("camcal --left '" + stereo + "/left*.jpg' --right '" + stereo +
+                "/right*.jpg' --target chessboard:9x6:1 " + "--out " + dir +
+                "/rig.yaml --json > " + dir + "/rig.json");
+  ASSERT_EQ(c.exit_code, 0) << c.err;
+  const std::string html = dir + "/report.html";
+  const auto r =
+      RunKincal("report --rig " + dir + "/rig.yaml --out " + html + " --json");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_THAT(Sections(j), Contains("camera"));
+  EXPECT_EQ(j["figures"], 3);  // per view + one image map per camera
+  const std::string page = ReadFile(html);
+  EXPECT_THAT(page, HasSubstr("left: residual over the image"));
+  EXPECT_THAT(page, HasSubstr("right: residual over the image"));
+  EXPECT_THAT(page, HasSubstr("sigma fx"));
+  CheckInBrowser(html, 3, std::string(KINCAL_BUILD_DIR) + "/report_camera.png");
+}
+
 // The UR10 series C report (real laser-tracker data) shows the residual
 // structure over shoulder_pan x shoulder_lift that the diagnosis left
 // unexplained.
@@ -177,6 +204,10 @@ TEST(ReportCliTest, Ur10SeriesCShowsPanLiftStructure) {
   EXPECT_THAT(ReadFile(dir + "/ur10.html"),
               HasSubstr("Residual structure over shoulder_pan_joint x "
                         "shoulder_lift_joint"));
+  // The import keeps the tracker's temperature and time: both plots drawn.
+  EXPECT_THAT(ReadFile(dir + "/obs.csv"), HasSubstr("temp_c"));
+  EXPECT_THAT(ReadFile(dir + "/ur10.html"), HasSubstr("against temperature"));
+  EXPECT_THAT(ReadFile(dir + "/ur10.html"), HasSubstr("against time"));
 }
 
 }  // namespace
