@@ -21,6 +21,7 @@
 #include "data/atomic_file.h"
 #include "data/error.h"
 #include "data/observations.h"
+#include "data/progress.h"
 #include "data/provenance.h"
 #include "data/robot.h"
 #include "data/session.h"
@@ -75,6 +76,8 @@ ToolPoseResult RefitPose(const Rig& rig, const Target& target,
 
 int RunBundleCommand(BundleArgs args) {
   const auto start = std::chrono::steady_clock::now();
+  Progress progress("kincal bundle", args.json || args.quiet);
+  progress.Stage("reading the session");
   const Robot robot = ReadRobot(args.robot);
   const Rig rig = ReadRigYaml(args.rig);
   const Target target = ReadTargetYaml(args.target);
@@ -113,16 +116,12 @@ int RunBundleCommand(BundleArgs args) {
   }
 
   ObserveOptions oo;
-  if (!args.quiet) {
-    oo.progress = [](int done, int total) {
-      if (total >= 20 && (done % 10 == 0 || done == total)) {
-        std::fprintf(stderr, "\rkincal bundle: detecting tags %d/%d", done,
-                     total);
-        if (done == total) std::fprintf(stderr, "\n");
-      }
-    };
-  }
+  oo.progress = [&progress](int done, int total) {
+    progress.Update(done, total, "frames (detecting tags)");
+  };
   const SessionObservations obs = ObserveSession(session, rig, target, oo);
+  progress.Stage("solving the bundle (" + std::to_string(obs.frames.size()) +
+                 " frames)");
   const BundleResult r =
       RunBundle(robot, rig, target, obs.frames, args.options);
   // k-fold cross-validation: every used frame held out once.
@@ -130,6 +129,7 @@ int RunBundleCommand(BundleArgs args) {
   if (args.folds >= 2) {
     std::vector<double> px, mm;
     for (int k = 0; k < args.folds; ++k) {
+      progress.Update(k, args.folds, "cross-validation folds");
       BundleOptions o = args.options;
       o.folds = args.folds;
       o.fold = k;
@@ -192,6 +192,7 @@ int RunBundleCommand(BundleArgs args) {
               std::to_string(args.min_tags) + " tags or fit worse than " +
               FormatDouble(args.max_reproj_px) + " px"});
   }
+  progress.Done();
   WriteFileAtomic(args.out, robot_text);
   if (!args.out_rig.empty()) WriteRigYaml(args.out_rig, r.rig);
   if (!args.out_obs.empty()) WriteFileAtomic(args.out_obs, obs_text);
@@ -408,6 +409,14 @@ void AddBundleCommand(CLI::App& app, Runner* run) {
       ->capture_default_str();
   sub->add_flag("--quiet", args->quiet, "no progress on stderr");
   sub->add_flag("--json", args->json, "print one JSON object");
+  sub->footer(
+      "Example (a rendered session with a hidden backlash, then the "
+      "bundle):\n  kincal simulate --robot data/robots/bh7.yaml --out sim "
+      "--poses 160 --noise 0 --render --effect backlash:j3:0.05\n  kincal "
+      "bundle --robot sim/robot.yaml --rig sim/rig.yaml --target "
+      "sim/target.yaml --session sim/session --out cal.yaml --out-obs "
+      "tips.csv --extensions backlash --json\nUnits: lengths mm, angles "
+      "deg, time s (pixels px). Defaults are shown beside each option.");
   sub->callback(
       [run, args] { *run = [args] { return RunBundleCommand(*args); }; });
 }

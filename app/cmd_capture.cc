@@ -29,6 +29,7 @@
 #include "capture/stereo_grabber.h"
 #include "data/atomic_file.h"
 #include "data/error.h"
+#include "data/progress.h"
 #include "data/provenance.h"
 #include "data/robot.h"
 
@@ -364,7 +365,19 @@ int RunCapture(const CaptureArgs& args) {
   int consecutive_failures = 0;
   int64_t transient_failures = 0;
   capture::StereoFrame pair;
+  // Progress on a terminal: pairs recorded (of --frames when given), drops.
+  Progress progress("kincal capture", args.json);
+  double last_progress_s = -1;
   for (;;) {
+    if (progress.enabled() && elapsed() - last_progress_s >= 0.5) {
+      last_progress_s = elapsed();
+      progress.Stage(
+          std::to_string(accepted) +
+          (args.frames > 0 ? "/" + std::to_string(args.frames) : "") +
+          " pairs recorded, " + std::to_string(writer.dropped_pairs()) +
+          " dropped, " + std::to_string(static_cast<int>(last_progress_s)) +
+          " s");
+    }
     if (args.frames > 0 && accepted >= args.frames) {
       stop_reason = "frames";
       break;
@@ -427,6 +440,7 @@ int RunCapture(const CaptureArgs& args) {
     pair = capture::StereoFrame();
   }
   const double seconds = elapsed();
+  progress.Done();
   grabber.Close();
   s = writer.Stop();  // drains the queue
   if (!s.ok() && failure.empty()) failure = "write: " + s.ToString();

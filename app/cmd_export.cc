@@ -95,7 +95,9 @@ void AddExportCommand(CLI::App& app, Runner* run) {
       "  kincal calibrate --robot data/robots/ur10.yaml --obs obs.csv "
       "--out cal.yaml\n"
       "  kincal export urdf --robot cal.yaml --out ur10_calibrated.urdf\n"
-      "  check_urdf ur10_calibrated.urdf");
+      "  check_urdf ur10_calibrated.urdf\n"
+      "Units: robot.yaml in mm and deg; the URDF in metres and radians (its "
+      "own convention).");
   urdf->callback([run, urdf_args] {
     *run = [urdf_args] { return RunExportUrdf(*urdf_args); };
   });
@@ -110,7 +112,8 @@ void AddExportCommand(CLI::App& app, Runner* run) {
   dh->footer(
       "Example:\n"
       "  kincal export dh --robot panda.urdf --tip ball_link --out "
-      "panda_dh.yaml");
+      "panda_dh.yaml\n"
+      "Units: the URDF in metres and radians; robot.yaml in mm and deg.");
   dh->callback(
       [run, dh_args] { *run = [dh_args] { return RunExportDh(*dh_args); }; });
 }

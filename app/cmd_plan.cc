@@ -11,6 +11,7 @@
 #include "camcal/rig.h"
 #include "data/atomic_file.h"
 #include "data/error.h"
+#include "data/progress.h"
 #include "data/urdf.h"
 #include "plan/confirm.h"
 #include "plan/plan.h"
@@ -66,7 +67,12 @@ int RunPlan(PlanArgs args) {
     throw InputError("--criterion: expected 'd' or 'sigma', got '" +
                      args.criterion + "'");
   }
+  Progress progress("kincal plan", args.json);
+  args.options.progress = [&progress](const std::string& what) {
+    progress.Stage(what);
+  };
   const PlanResult plan = PlanPoses(robot, args.options);
+  progress.Done();
   WriteFileAtomic(args.out, FormatPosesCsv(robot, plan.poses));
   if (!args.random_out.empty()) {
     WriteFileAtomic(args.random_out, FormatPosesCsv(robot, plan.random_poses));
@@ -217,6 +223,14 @@ void AddPlanCommand(CLI::App& app, Runner* run) {
                   "random poses, calibrate them and report the actual errors")
       ->check(CLI::Range(0, 1000));
   sub->add_flag("--json", args->json, "print one JSON object");
+  sub->footer(
+      "Example (60 poses for a UR10 seen by a stereo rig, and the gain over "
+      "60 random poses confirmed on simulated sessions):\n  kincal plan "
+      "--robot data/robots/ur10.yaml --n 60 --rig rig.yaml --target "
+      "target.yaml --out poses.csv --random-out random.csv --confirm 5 "
+      "--json\nUnits: lengths mm, angles deg, time s (pixels px); poses.csv "
+      "in the robot's joint units (deg | mm). Defaults are shown beside each "
+      "option.");
   sub->callback([run, args] { *run = [args] { return RunPlan(*args); }; });
 }
 

@@ -101,7 +101,9 @@ void AddReportCommand(CLI::App& app, Runner* run) {
       "  kincal diagnose model --robot R.yaml --obs O.csv --out ext.yaml "
       "--json > diag.json\n"
       "  kincal report --robot R.yaml --obs O.csv --calibrated ext.yaml "
-      "--diagnosis diag.json --out report.html");
+      "--diagnosis diag.json --out report.html\n"
+      "Units: lengths mm, angles deg, time s (pixels px). Defaults are shown "
+      "beside each option.");
   sub->callback([run, args] { *run = [args] { return RunReport(*args); }; });
 }
 

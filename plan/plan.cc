@@ -590,6 +590,10 @@ PlanResult PlanPoses(const Robot& robot, const PlanOptions& options) {
     return out;
   };
   // Uniform feasible poses: the evaluation set and the random design.
+  auto stage = [&](const std::string& what) {
+    if (options.progress) options.progress(what);
+  };
+  stage("drawing feasible random poses");
   Poses uniform = collect(&sampler, options.evaluation_poses + options.n);
   plan.evaluation_poses.assign(uniform.begin(),
                                uniform.begin() + options.evaluation_poses);
@@ -597,6 +601,8 @@ PlanResult PlanPoses(const Robot& robot, const PlanOptions& options) {
                            uniform.end());
   Sampler extreme(robot, options.seed + 1,
                   options.fixed_point ? 0.0 : options.extreme_fraction);
+  stage("drawing " + std::to_string(options.candidates) +
+        " feasible candidates");
   Poses candidates = collect(&extreme, options.candidates);
   plan.feasible_candidates = static_cast<int>(candidates.size());
 
@@ -606,6 +612,7 @@ PlanResult PlanPoses(const Robot& robot, const PlanOptions& options) {
   std::vector<ParamInfo> cand_params =
       pr.fixed_point ? PointParams(pr.state) : FrameParams();
   for (const ParamInfo& p : GeometryParams(pr.chain)) cand_params.push_back(p);
+  stage("identifiability over the candidates");
   const Identifiability ident =
       AnalyzeIdentifiability(ms, pr.state, cand_params);
   plan.params = ident.identifiable;
@@ -630,12 +637,16 @@ PlanResult PlanPoses(const Robot& robot, const PlanOptions& options) {
       if (IsRobotParam(plan.params[k])) marginal.push_back(k);
     }
   }
+  stage("choosing " + std::to_string(options.n) +
+        " poses (greedy, then Fedorov exchange)");
   const std::vector<int> chosen = ExchangeDesign(
       jac, options.n, marginal, options.max_swap_passes, &plan.swaps);
   Poses design;
   for (int i : chosen) design.push_back(candidates[i]);
+  stage("ordering the poses for short joint motions");
   plan.poses = OrderPoses(robot, design);
   plan.random_poses = OrderPoses(robot, plan.random_poses);
+  stage("predicting sigma (planned and random poses)");
 
   plan.planned = PredictQuality(robot, plan, plan.poses, options);
   plan.random = PredictQuality(robot, plan, plan.random_poses, options);

@@ -30,6 +30,7 @@
 
 #include <Eigen/Core>
 #include <cstdint>
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
@@ -49,6 +50,8 @@ struct PlanOptions {
   double noise_mm = 0.05;      // per coordinate of a measured tip
   bool fixed_point = false;    // the seed's single-point experiment
   int max_swap_passes = 20;    // Fedorov exchange passes
+  // Told the stage being computed (may be empty).
+  std::function<void(const std::string&)> progress;
   // kDOptimal: maximise log det(J^T J). kSigma: minimise the product of the
   // predicted sigmas of the robot's parameters (frame / point excluded).
   enum Criterion { kDOptimal, kSigma };

@@ -128,6 +128,24 @@ TEST(BundleCli, NamesAHiddenBacklashFromImages) {
   EXPECT_GT(ci[1].get<double>(), 0.05);
 }
 
+// Progress on a terminal (forced with KINCAL_PROGRESS=1, stderr is a file
+// here): tag detection per frame and the solve; --json keeps stderr clean.
+TEST(BundleCli, ProgressOnStderrNotWithJson) {
+  const std::string dir = MakeTempDir("bundle_progress");
+  const std::string s = Simulate(dir + "/s", 24, 5);
+  const std::string cmd =
+      "KINCAL_PROGRESS=1 " + testing::KincalBinary() + " bundle --robot " + s +
+      "/robot.yaml --rig " + s + "/rig.yaml --target " + s +
+      "/target.yaml --session " + s + "/session --out " + dir + "/cal.yaml";
+  RunResult r = RunShell(cmd);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_THAT(r.err, HasSubstr("kincal bundle: frames (detecting tags) 24/24"));
+  EXPECT_THAT(r.err, HasSubstr("kincal bundle: solving the bundle"));
+  r = RunShell(cmd + " --json");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_THAT(r.err, ::testing::Not(HasSubstr("kincal bundle:")));
+}
+
 TEST(BundleCli, BadInputExitsTwoAndWritesNothing) {
   const std::string dir = MakeTempDir("bundle_bad");
   const std::string s = Simulate(dir + "/s", 12, 3);

@@ -7,6 +7,8 @@
 
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <sstream>
+#include <vector>
 
 #include "data/atomic_file.h"
 #include "data/robot.h"
@@ -84,6 +86,43 @@ TEST_F(CliTest, CalibrateJsonContract) {
       RunKincal("evaluate --robot " + Robot() + " --obs " + Obs() + " --json");
   EXPECT_GT(nlohmann::json::parse(nominal.out)["rms_mm"].get<double>(),
             5 * e["rms_mm"].get<double>());
+}
+
+// Subcommand names listed under "Subcommands:" in a --help text.
+std::vector<std::string> SubcommandsOf(const std::string& help) {
+  std::vector<std::string> names;
+  const size_t at = help.find("Subcommands:");
+  if (at == std::string::npos) return names;
+  std::istringstream in(help.substr(at));
+  std::string line;
+  std::getline(in, line);
+  while (std::getline(in, line)) {
+    if (line.size() < 3 || line[0] != ' ' || line[2] == ' ') continue;
+    std::istringstream words(line);
+    std::string name;
+    words >> name;
+    names.push_back(name);
+  }
+  return names;
+}
+
+// Every command a user runs (the leaves of the command tree) teaches in its
+// --help: a worked example and the units.
+TEST(CliHelp, EveryCommandHasAnExampleAndUnits) {
+  std::vector<std::string> todo = {""}, leaves;
+  while (!todo.empty()) {
+    const std::string cmd = todo.back();
+    todo.pop_back();
+    const RunResult r = RunKincal(cmd + " --help");
+    ASSERT_EQ(r.exit_code, 0) << cmd << ": " << r.err;
+    const std::vector<std::string> subs = SubcommandsOf(r.out);
+    for (const std::string& s : subs) todo.push_back(cmd + " " + s);
+    if (!subs.empty()) continue;
+    leaves.push_back(cmd);
+    EXPECT_THAT(r.out, HasSubstr("Example")) << "kincal" << cmd << " --help";
+    EXPECT_THAT(r.out, HasSubstr("Units:")) << "kincal" << cmd << " --help";
+  }
+  EXPECT_GE(leaves.size(), 15u);  // the tree was walked
 }
 
 TEST_F(CliTest, HumanReadableOutputWithoutJson) {

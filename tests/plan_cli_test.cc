@@ -20,6 +20,25 @@ namespace {
 using testing::RunKincal;
 using testing::RunResult;
 
+// Progress on a terminal (forced here with KINCAL_PROGRESS=1, as stderr is
+// a file): the stages on stderr; --json keeps stderr clean.
+TEST(PlanCli, ProgressStagesOnStderrNotWithJson) {
+  const std::string dir = testing::MakeTempDir("plan_progress");
+  const std::string cmd = "KINCAL_PROGRESS=1 " + testing::KincalBinary() +
+                          " plan --robot " + testing::SourceDir() +
+                          "/data/robots/bh7.yaml --n 20 --candidates 300 "
+                          "--out " +
+                          dir + "/poses.csv";
+  RunResult r = testing::RunShell(cmd);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.err.find("kincal plan: choosing 20 poses"), std::string::npos)
+      << r.err;
+  EXPECT_NE(r.err.find("kincal plan: predicting sigma"), std::string::npos);
+  r = testing::RunShell(cmd + " --json");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(r.err.find("kincal plan:"), std::string::npos) << r.err;
+}
+
 TEST(PlanCli, WritesPosesAndTheSpecFields) {
   const std::string dir = testing::MakeTempDir("plan_cli");
   const std::string robot = testing::SourceDir() + "/data/robots/bh7.yaml";
