@@ -24,6 +24,7 @@ const char* kTwoLink = R"(<?xml version="1.0"?>
   <joint name="b" type="prismatic">
     <parent link="l2"/><child link="flange"/><axis xyz="1 0 0"/>
     <origin xyz="0 0 0.2" rpy="0 0 0"/>
+    <limit lower="-0.1" upper="0.1" effort="10" velocity="1"/>
   </joint>
 </robot>)";
 
