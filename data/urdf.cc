@@ -358,6 +358,22 @@ std::string JoinLeaves(const urdf::ModelInterface& model,
   return out;
 }
 
+// True when the link's subtree (the link's own parent joint excluded) holds a
+// joint that is not fixed.
+bool HasMovableJoint(const urdf::ModelInterface& model,
+                     const std::string& from) {
+  std::vector<std::string> stack = {from};
+  while (!stack.empty()) {
+    const auto link = model.getLink(stack.back());
+    stack.pop_back();
+    for (const auto& j : link->child_joints) {
+      if (j->type != urdf::Joint::FIXED) return true;
+    }
+    for (const auto& c : link->child_links) stack.push_back(c->name);
+  }
+  return false;
+}
+
 const char* TypeName(int type) {
   switch (type) {
     case urdf::Joint::FLOATING:
@@ -394,17 +410,27 @@ Robot ParseUrdfChain(const std::string& xml, const std::string& file,
   }
   std::string tip = tip_link;
   if (tip.empty()) {
+    // Down from the root; at a branch, follow the one child whose subtree
+    // holds a movable joint (a ROS-Industrial `base` frame beside link_1
+    // does not count).
     tip = root;
     for (auto link = model->getLink(tip); !link->child_links.empty();
          link = model->getLink(tip)) {
-      if (link->child_links.size() != 1) {
+      std::vector<std::string> moving;
+      for (const auto& c : link->child_links) {
+        if (HasMovableJoint(*model, c->name)) moving.push_back(c->name);
+      }
+      if (link->child_links.size() == 1) {
+        tip = link->child_links[0]->name;
+      } else if (moving.size() == 1) {
+        tip = moving[0];
+      } else {
         throw InputError(file, 0, 0,
                          "link '" + tip +
                              "' branches: name the tip link with --tip (leaf "
                              "links: " +
                              JoinLeaves(*model, tip) + ")");
       }
-      tip = link->child_links[0]->name;
     }
   }
   if (!model->getLink(tip)) {
