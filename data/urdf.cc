@@ -9,7 +9,6 @@
 #include <map>
 #include <mutex>
 #include <regex>
-#include <set>
 #include <sstream>
 #include <vector>
 
@@ -177,7 +176,8 @@ void PrePass(const Locator& loc, const tinyxml2::XMLDocument& doc,
       }
     }
   }
-  std::set<std::string> children;
+  std::map<std::string, std::string> parent_of;  // child link -> parent link
+  std::vector<const tinyxml2::XMLElement*> joint_els;
   for (auto* j = robot_el->FirstChildElement("joint"); j;
        j = j->NextSiblingElement("joint")) {
     const char* name = j->Attribute("name");
@@ -199,18 +199,20 @@ void PrePass(const Locator& loc, const tinyxml2::XMLDocument& doc,
         !child->Attribute("link")) {
       loc.Fail(j, "<joint", what + ": needs <parent link> and <child link>");
     }
-    if (!children.insert(child->Attribute("link")).second) {
+    if (!parent_of.emplace(child->Attribute("link"), parent->Attribute("link"))
+             .second) {
       loc.Fail(j, "<joint",
                std::string("link '") + child->Attribute("link") +
                    "' has two parent joints");
     }
+    joint_els.push_back(j);
     CheckOrigin(loc, j, what);
     // ROS semantics: the axis of a fixed (and floating) joint is ignored;
     // ROS-Industrial files carry <axis xyz="0 0 0"/> on flange and tool0.
     const auto* a = j->FirstChildElement("axis");
     if (a && type != "fixed" && type != "floating") {
       const Eigen::Vector3d axis = Triple(loc, a, "xyz", what + " axis xyz");
-      if (axis.norm() < 1e-12) {
+      if (!(axis.norm() >= 1e-12 && std::isfinite(axis.norm()))) {
         loc.Fail(a, "xyz=", what + ": axis must not be zero");
       }
     }
@@ -225,6 +227,24 @@ void PrePass(const Locator& loc, const tinyxml2::XMLDocument& doc,
       }
       CheckNumberAttr(loc, mim, "multiplier", what + " mimic");
       CheckNumberAttr(loc, mim, "offset", what + " mimic");
+    }
+  }
+  // A URDF is a tree. urdfdom 3.0.1 accepts a joint whose child is its own
+  // ancestor (a loop cut off from the root), which would leave links with
+  // no way down from the root.
+  for (const auto* j : joint_els) {
+    const std::string child = j->FirstChildElement("child")->Attribute("link");
+    std::string up = j->FirstChildElement("parent")->Attribute("link");
+    for (size_t steps = 0; steps <= parent_of.size(); ++steps) {
+      if (up == child) {
+        loc.Fail(j, "<joint",
+                 std::string("joint '") + j->Attribute("name") +
+                     "' closes a loop (link '" + child +
+                     "' is its own ancestor): a URDF describes a tree");
+      }
+      const auto it = parent_of.find(up);
+      if (it == parent_of.end()) break;
+      up = it->second;
     }
   }
 }
@@ -492,8 +512,12 @@ Robot ParseUrdfChain(const std::string& xml, const std::string& file,
         j->limits->lower < j->limits->upper) {
       const double scale =
           row.type == JointType::kPrismatic ? 1000.0 : kRadToDeg;
-      row.lower = j->limits->lower * scale;
-      row.upper = j->limits->upper * scale;
+      // Beyond +-1e5 (deg or mm; robot.yaml's range) a limit means "none".
+      if (std::abs(j->limits->lower * scale) <= 1e5 &&
+          std::abs(j->limits->upper * scale) <= 1e5) {
+        row.lower = j->limits->lower * scale;
+        row.upper = j->limits->upper * scale;
+      }
     }
     row_of_joint[j->name] = static_cast<int>(robot.joints.size());
     robot.joints.push_back(row);

@@ -305,6 +305,15 @@ TEST(UrdfTest, ErrorsCarryFileLineColumn) {
       "1:1", "xacro file");
   ExpectError(head + "  <xacro:include filename=\"x.xacro\"/>\n</robot>", "4:3",
               "unexpanded xacro");
+  // Loops (urdfdom accepts a link that is its own ancestor; found by the
+  // fuzzer as a hang).
+  ExpectError(head +
+                  "<joint name=\"j\" type=\"fixed\"><parent link=\"a\"/>"
+                  "<child link=\"b\"/></joint>\n"
+                  "<link name=\"c\"/><joint name=\"k\" type=\"fixed\">"
+                  "<parent link=\"c\"/><child link=\"c\"/></joint>\n"
+                  "</robot>",
+              "5:17", "joint 'k' closes a loop");
   // urdfdom's verdicts, located at the element they name.
   ExpectError(head +
                   "<joint name=\"j\" type=\"fixed\">\n"
