@@ -212,7 +212,10 @@ void PrePass(const Locator& loc, const tinyxml2::XMLDocument& doc,
     const auto* a = j->FirstChildElement("axis");
     if (a && type != "fixed" && type != "floating") {
       const Eigen::Vector3d axis = Triple(loc, a, "xyz", what + " axis xyz");
-      if (!(axis.norm() >= 1e-12 && std::isfinite(axis.norm()))) {
+      if (!std::isfinite(axis.norm())) {
+        loc.Fail(a, "xyz=", what + ": axis length overflows");
+      }
+      if (!(axis.norm() >= 1e-12)) {
         loc.Fail(a, "xyz=", what + ": axis must not be zero");
       }
     }

@@ -286,6 +286,15 @@ TEST(UrdfTest, ErrorsCarryFileLineColumn) {
               "axis must not be zero");
   ExpectError(joint("continuous", "<origin xyz=\"0 0 1e3\"/>"), "6:9",
               "within +-100 m");
+  ExpectError(joint("continuous", "<axis xyz=\"1e300 1e300 0\"/>"), "6:7",
+              "axis length overflows");
+  // A limit beyond +-1e5 (deg or mm) means none, as in robot.yaml.
+  EXPECT_FALSE(ParseUrdfChain(joint("revolute",
+                                    "<limit lower=\"-1e300\" upper=\"1e300\" "
+                                    "effort=\"1\" velocity=\"1\"/>"),
+                              "e.urdf")
+                   .joints[0]
+                   .HasLimits());
   ExpectError(joint("spherical", ""), "4:17", "not a URDF joint type");
   ExpectError(joint("floating", ""), "4:17", "joint 'j' is floating");
   ExpectError(joint("planar", "<axis xyz=\"0 0 1\"/>"), "4:17",
