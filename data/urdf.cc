@@ -397,6 +397,20 @@ bool HasMovableJoint(const urdf::ModelInterface& model,
   return false;
 }
 
+// Number of leaf links named `name` below `from`.
+int LeafCount(const urdf::ModelInterface& model, const std::string& from,
+              const std::string& name) {
+  int count = 0;
+  std::vector<std::string> stack = {from};
+  while (!stack.empty()) {
+    const auto link = model.getLink(stack.back());
+    stack.pop_back();
+    if (link->child_links.empty() && link->name == name) ++count;
+    for (const auto& c : link->child_links) stack.push_back(c->name);
+  }
+  return count;
+}
+
 const char* TypeName(int type) {
   switch (type) {
     case urdf::Joint::FLOATING:
@@ -441,12 +455,20 @@ Robot ParseUrdfChain(const std::string& xml, const std::string& file,
          link = model->getLink(tip)) {
       std::vector<std::string> moving;
       for (const auto& c : link->child_links) {
-        if (HasMovableJoint(*model, c->name)) moving.push_back(c->name);
+        if (c->parent_joint->type != urdf::Joint::FIXED ||
+            HasMovableJoint(*model, c->name)) {
+          moving.push_back(c->name);
+        }
       }
       if (link->child_links.size() == 1) {
         tip = link->child_links[0]->name;
       } else if (moving.size() == 1) {
         tip = moving[0];
+      } else if (moving.empty() && LeafCount(*model, tip, "tool0") == 1) {
+        // Only fixed frames left (ROS-I: flange, tool0, ee_link): tool0 is
+        // REP 199's attachment frame.
+        tip = "tool0";
+        break;
       } else {
         throw InputError(file, 0, 0,
                          "link '" + tip +

@@ -223,6 +223,37 @@ TEST(UrdfTest, ContinuousJointsDefaultAxisAndRpy) {
   }
 }
 
+// Default tip: at a branch, the one child with a movable joint below or
+// into it; among fixed frames only (ROS-I ee_link and tool0 side by side),
+// tool0.
+TEST(UrdfTest, DefaultTipRules) {
+  const std::string head = R"(<robot name="t">
+  <link name="base"/><link name="a"/><link name="b"/><link name="cam"/>
+  <link name="ee_link"/><link name="tool0"/>
+  <joint name="j1" type="continuous"><parent link="base"/><child link="a"/></joint>
+  <joint name="cam_mount" type="fixed"><parent link="a"/><child link="cam"/></joint>
+  <joint name="j2" type="continuous"><parent link="a"/><child link="b"/>
+    <origin xyz="0.2 0 0"/></joint>
+  <joint name="ee" type="fixed"><parent link="b"/><child link="ee_link"/></joint>
+  <joint name="t0" type="fixed"><parent link="b"/><child link="tool0"/>
+    <origin xyz="0 0 0.1"/></joint>
+</robot>)";
+  const Robot r = ParseUrdfChain(head, "t.urdf");
+  ASSERT_EQ(r.joints.size(), 2u);  // past the camera, j2 ends in a leaf
+  EXPECT_NEAR(r.tool.xyz_mm.z(), 100.0, 1e-9);  // tool0, not ee_link
+  std::string no_tool0 = head;
+  no_tool0.replace(no_tool0.find("child link=\"tool0\""), 18,
+                   "child link=\"tcp\"  ");
+  no_tool0.replace(no_tool0.find("<link name=\"tool0\"/>"), 20,
+                   "<link name=\"tcp\"/>  ");
+  try {
+    ParseUrdfChain(no_tool0, "t.urdf");
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_THAT(e.what(), ::testing::HasSubstr("link 'b' branches"));
+  }
+}
+
 // Links hanging on fixed joints (and a side branch) are lumped into the row
 // of the movable joint they ride on: mass sum, mass-weighted centre of mass
 // in the frame after that row. Links before the first movable joint (the
