@@ -283,8 +283,27 @@ Robot ConvertToDh(const Robot& robot) {
   dh.tool.xyz_mm.setZero();
   dh.tool.rpy_deg.setZero();
 
-  // Self-check over seeded random poses (an internal error, not bad input).
+  // Centres of mass are given in the frame after their row; that frame
+  // changes with the convention, the link it is fixed to does not, so
+  // com_dh = (base_from_dh_k)^-1 base_from_src_k com at any one q (0 here).
   const Chain out = Chain::FromRobot(dh);
+  {
+    Eigen::Matrix4d src = Eigen::Matrix4d::Identity(),
+                    dst = Eigen::Matrix4d::Identity();
+    for (int k = 0; k < n; ++k) {
+      src = src * RowTransform<double>(chain.convention, chain.rows[k],
+                                       chain.rows[k].p.data(), 0.0);
+      dst = dst * RowTransform<double>(out.convention, out.rows[k],
+                                       out.rows[k].p.data(), 0.0);
+      RobotRow& row = dh.joints[k];
+      if (!row.HasMass()) continue;
+      const Eigen::Vector4d com_in_base =
+          src * robot.joints[k].com_mm.homogeneous();
+      row.com_mm = (dst.inverse() * com_in_base).head<3>();
+    }
+  }
+
+  // Self-check over seeded random poses (an internal error, not bad input).
   std::mt19937_64 rng(1);
   std::uniform_real_distribution<double> u(-M_PI, M_PI);
   for (int trial = 0; trial < 20; ++trial) {

@@ -156,6 +156,49 @@ TEST(UrdfExportTest, DhConversionBothWays) {
   }
 }
 
+// Centres of mass in the base frame at random poses (mm), one per row with
+// a mass.
+std::vector<Eigen::Vector3d> MassCentresInBase(const Robot& robot,
+                                               const std::vector<double>& q) {
+  const Chain chain = Chain::FromRobot(robot);
+  std::vector<Eigen::Vector3d> out;
+  Eigen::Matrix4d m = Eigen::Matrix4d::Identity();
+  for (int k = 0; k < chain.num_joints(); ++k) {
+    m = m * RowTransform<double>(chain.convention, chain.rows[k],
+                                 chain.rows[k].p.data(), q[k]);
+    if (robot.joints[k].HasMass()) {
+      out.push_back((m * robot.joints[k].com_mm.homogeneous()).head<3>());
+    }
+  }
+  return out;
+}
+
+// URDF -> DH keeps the links' masses where they are: the centre of mass of
+// every link, in the base frame, is the same point for both models.
+TEST(UrdfExportTest, DhConversionMovesCentresOfMassIntoTheDhFrames) {
+  const Robot urdf =
+      ReadUrdfChain(testing::SourceDir() + "/data/robots/industrial7.urdf");
+  const Robot dh = ConvertToDh(urdf);
+  ASSERT_EQ(MassCentresInBase(urdf, std::vector<double>(7, 0.0)).size(), 7u);
+  std::mt19937_64 rng(3);
+  std::uniform_real_distribution<double> u(-M_PI, M_PI);
+  double worst = 0.0, moved = 0.0;
+  for (int trial = 0; trial < 50; ++trial) {
+    std::vector<double> q(7);
+    for (double& v : q) v = u(rng);
+    const auto a = MassCentresInBase(urdf, q), b = MassCentresInBase(dh, q);
+    ASSERT_EQ(a.size(), b.size());
+    for (size_t k = 0; k < a.size(); ++k) {
+      worst = std::max(worst, (a[k] - b[k]).norm());
+      moved =
+          std::max(moved, (urdf.joints[k].com_mm - dh.joints[k].com_mm).norm());
+      EXPECT_DOUBLE_EQ(urdf.joints[k].mass_kg, dh.joints[k].mass_kg);
+    }
+  }
+  EXPECT_LT(worst, 1e-9);
+  EXPECT_GT(moved, 1.0);  // the frames differ: copying com would be wrong
+}
+
 // URDF in -> calibrate (real MUKCa socket data, known 50 mm distance) ->
 // URDF out: the exported file's FK equals the calibrated model's.
 TEST(UrdfExportTest, PandaUrdfCalibratedAndExported) {
