@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <fstream>
+#include <ostream>
 
 #include "data/atomic_file.h"
 #include "data/error.h"
@@ -107,6 +108,10 @@ struct BadCase {
   int line;
   const char* message;
 };
+
+// Names the case in test output and in ctest's test names (which otherwise
+// show the struct's bytes, different in every build).
+void PrintTo(const BadCase& c, std::ostream* os) { *os << c.what; }
 
 class RigYamlRejects : public ::testing::TestWithParam<BadCase> {};
 
