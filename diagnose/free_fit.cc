@@ -2,8 +2,13 @@
 
 #include <ceres/ceres.h>
 
+#include <Eigen/Cholesky>
 #include <algorithm>
 #include <array>
+#include <cmath>
+#include <limits>
+
+#include "diagnose/exact_jacobian.h"
 
 namespace kincal {
 namespace {
@@ -79,10 +84,125 @@ class FreeResidual {
   const Measurement& m_;
 };
 
+// Bounds of the free parameters: +-delta about the nominal geometry for row
+// entries (as calib/fit.h), none otherwise.
+void Bounds(const FreeFitOptions& options, std::vector<double>* lower,
+            std::vector<double>* upper) {
+  const int k = static_cast<int>(options.free.size());
+  lower->assign(k, -std::numeric_limits<double>::infinity());
+  upper->assign(k, std::numeric_limits<double>::infinity());
+  if (options.bounds_center == nullptr) return;
+  const Chain& c = *options.bounds_center;
+  for (int i = 0; i < k; ++i) {
+    const ParamInfo& p = options.free[i];
+    if (p.kind != ParamKind::kRow) continue;
+    const bool angle = c.convention == Convention::kUrdf
+                           ? p.index >= 3
+                           : (p.index == 0 || p.index >= 3);
+    const double center = c.rows.at(p.block).p.at(p.index);
+    const double bound = angle ? c.bound_angle_rad : c.bound_length_mm;
+    (*lower)[i] = center - bound;
+    (*upper)[i] = center + bound;
+  }
+}
+
+// Levenberg-Marquardt on the exact Jacobian (diagnose/exact_jacobian.h),
+// steps projected onto the bounds; stops as Ceres does: relative cost change
+// <= function_tolerance or step <= parameter_tolerance (|x| +
+// parameter_tolerance). Starts with a Gauss-Newton step (lambda 0); the
+// candidate refits start at the linearised optimum, so one Jacobian and two
+// residual passes usually suffice.
+double ExactFreeFit(const std::vector<Measurement>& measurements,
+                    const FreeFitOptions& options, ModelState* state) {
+  const int k = static_cast<int>(options.free.size());
+  std::vector<Measurement> ms;
+  ms.reserve(measurements.size());
+  for (const Measurement& m : measurements)
+    if (m.kind == Measurement::kMeasured) ms.push_back(m);
+  std::vector<double> lower, upper;
+  Bounds(options, &lower, &upper);
+  Eigen::VectorXd x(k);
+  for (int i = 0; i < k; ++i) {
+    x[i] = std::min(std::max(ParamValue(*state, options.free[i]), lower[i]),
+                    upper[i]);
+  }
+  auto set = [&](const Eigen::VectorXd& v) {
+    for (int i = 0; i < k; ++i) *ParamAddress(state, options.free[i]) = v[i];
+  };
+  set(x);
+  Eigen::VectorXd r;
+  Eigen::MatrixXd J;
+  if (k == 0 || ms.empty()) {
+    ResidualsAndJacobian(ms, *state, options.free, &r, nullptr);
+    return r.squaredNorm();
+  }
+  ResidualsAndJacobian(ms, *state, options.free, &r, &J);
+  double cost = r.squaredNorm();
+  double lambda = 0.0;
+  bool need_jacobian = false;
+  for (int it = 0; it < options.max_iterations; ++it) {
+    if (need_jacobian) ResidualsAndJacobian(ms, *state, options.free, &r, &J);
+    need_jacobian = false;
+    const Eigen::MatrixXd A = J.transpose() * J;
+    const Eigen::VectorXd g = J.transpose() * r;
+    // Jacobi scaling, as Ceres.
+    Eigen::VectorXd s(k);
+    for (int i = 0; i < k; ++i)
+      s[i] = A(i, i) > 0 ? 1.0 / std::sqrt(A(i, i)) : 1.0;
+    const Eigen::MatrixXd As = s.asDiagonal() * A * s.asDiagonal();
+    bool accepted = false, converged = false;
+    while (!accepted) {
+      Eigen::MatrixXd M = As;
+      M.diagonal().array() += lambda;
+      const Eigen::VectorXd step =
+          s.asDiagonal() * M.ldlt().solve(-(s.asDiagonal() * g));
+      Eigen::VectorXd x_new = x + step;
+      for (int i = 0; i < k; ++i)
+        x_new[i] = std::min(std::max(x_new[i], lower[i]), upper[i]);
+      const double step_norm = (x_new - x).norm();
+      if (step.allFinite() &&
+          step_norm <= options.parameter_tolerance *
+                           (x.norm() + options.parameter_tolerance)) {
+        converged = true;
+        break;
+      }
+      Eigen::VectorXd r_new;
+      if (step.allFinite()) {
+        set(x_new);
+        ResidualsAndJacobian(ms, *state, options.free, &r_new, nullptr);
+      }
+      const double cost_new = step.allFinite()
+                                  ? r_new.squaredNorm()
+                                  : std::numeric_limits<double>::infinity();
+      if (std::isfinite(cost_new) && cost_new <= cost) {
+        accepted = true;
+        const double change = (cost - cost_new) / cost;
+        x = x_new;
+        r = r_new;
+        cost = cost_new;
+        lambda = lambda < 1e-9 ? 0.0 : lambda / 10.0;
+        need_jacobian = true;
+        if (change <= options.function_tolerance) converged = true;
+      } else {
+        set(x);
+        lambda = lambda == 0.0 ? 1e-6 : 10.0 * lambda;
+        if (lambda > 1e12) {
+          converged = true;
+          break;
+        }
+      }
+    }
+    if (converged) break;
+  }
+  set(x);
+  return cost;
+}
+
 }  // namespace
 
 double FreeFit(const std::vector<Measurement>& measurements,
                const FreeFitOptions& options, ModelState* state) {
+  if (options.exact_jacobian) return ExactFreeFit(measurements, options, state);
   const int k = static_cast<int>(options.free.size());
   std::vector<Slot> slots;
   std::vector<double> x(k);

@@ -22,6 +22,10 @@ struct FreeFitOptions {
   int max_iterations = 100;
   double function_tolerance = 1e-10;
   double parameter_tolerance = 1e-10;
+  // true: Levenberg-Marquardt on the exact Jacobian of
+  // diagnose/exact_jacobian.h (one pass per pose for all columns); false:
+  // Ceres with autodiff in the free parameters (the speed reference).
+  bool exact_jacobian = true;
 };
 
 // Fits the free parameters of `state` to the measured rows (kMeasured

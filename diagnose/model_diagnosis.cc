@@ -356,6 +356,7 @@ DiagnosisResult DiagnoseModel(const Robot& nominal, const Observations& obs,
       ffo.max_iterations = fo.max_iterations;
       ffo.function_tolerance = fo.function_tolerance;
       ffo.parameter_tolerance = fo.parameter_tolerance;
+      ffo.exact_jacobian = options.exact_jacobian;
       if (options.free_parameter_fit) {
         FreeFit(pb.train, ffo, &states[c]);
       } else {
