@@ -83,16 +83,42 @@ void ResidualsAndJacobian(const std::vector<Measurement>& measurements,
   const int m = static_cast<int>(measurements.size());
   const int k = static_cast<int>(params.size());
   r->setZero(3 * m);
+  const bool jacobian = J != nullptr && k > 0;
   if (J != nullptr) J->setZero(3 * m, k);
-  const double* rows[kMaxJoints + 1];
-  const double* errs[kMaxJoints];
-  for (int i = 0; i <= n; ++i) rows[i] = chain.rows[i].p.data();
-  for (int j = 0; j < n; ++j) errs[j] = chain.joint_errors[j].data();
-  // Operations of every row (structure only).
+  // Operations of every row, and the rotations that do not depend on the
+  // pose (every rotation but the joint's own).
   std::array<std::array<Op, 7>, kMaxJoints + 1> ops;
+  std::array<std::array<Eigen::Matrix3d, 7>, kMaxJoints + 1> fixed_rot;
   std::array<int, kMaxJoints + 1> num_ops;
-  for (int i = 0; i <= n; ++i)
+  for (int i = 0; i <= n; ++i) {
     num_ops[i] = RowOps(chain.convention, chain.rows[i], ops[i].data());
+    for (int o = 0; o < num_ops[i]; ++o) {
+      const Op& op = ops[i][o];
+      if (op.rotation && !op.joint)
+        fixed_rot[i][o] = AxisRotation(op.axis, chain.rows[i].p[op.param]);
+    }
+  }
+  // The measuring frame is linear in the point, ApplyFrame(f, p) = R p + t:
+  // R and dR / d(rotation vector) from the shared ApplyFrame (autodiff).
+  using Jet3 = ceres::Jet<double, 3>;
+  Eigen::Matrix3d frame_r, frame_dr[3];
+  {
+    Jet3 f[kFrameBlockSize];
+    for (int e = 0; e < kFrameBlockSize; ++e)
+      f[e] = e < 3 ? Jet3(state.meas_from_base[e], e) : Jet3(0.0);
+    for (int c = 0; c < 3; ++c) {
+      Vec3<Jet3> unit(Jet3(0.0), Jet3(0.0), Jet3(0.0));
+      unit[c] = Jet3(1.0);
+      const Vec3<Jet3> col = ApplyFrame(f, unit);
+      for (int a = 0; a < 3; ++a) {
+        frame_r(a, c) = col[a].a;
+        for (int d = 0; d < 3; ++d) frame_dr[d](a, c) = col[a].v[d];
+      }
+    }
+  }
+  const Eigen::Vector3d frame_t(state.meas_from_base[3],
+                                state.meas_from_base[4],
+                                state.meas_from_base[5]);
 
   using JetE = ceres::Jet<double, kJointErrorBlockSize>;
   using Jet9 = ceres::Jet<double, 9>;
@@ -100,65 +126,80 @@ void ResidualsAndJacobian(const std::vector<Measurement>& measurements,
     const Measurement& meas = measurements[pose];
     if (meas.kind != Measurement::kMeasured) continue;
     const PoseInput& in = meas.input;
-    // Residual from the shared chain.
-    const Vec3<double> tip_value =
-        TipInBase<double>(chain, rows, errs, chain.drift.data(), in);
-    const Vec3<double> res =
-        ApplyFrame(state.meas_from_base.data(), tip_value) - meas.p_in_meas;
-    r->segment<3>(3 * pose) = res;
-    if (J == nullptr || k == 0) continue;
-
-    // Joint values and their derivatives by the joint error entries.
+    // Joint values (calib/chain.h TipInBase) and, for the Jacobian, their
+    // derivatives by the joint error entries.
     const bool masses = static_cast<int>(in.tau_mass.size()) == n;
     const bool trig = static_cast<int>(in.trig.size()) == 2 * kMaxHarmonic * n;
     double q[kMaxJoints];
     Eigen::Matrix<double, kJointErrorBlockSize, 1> dq[kMaxJoints];
     for (int j = 0; j < n; ++j) {
+      const double tm = masses ? in.tau_mass[j] : 0.0;
+      const double* tr = trig ? &in.trig[2 * kMaxHarmonic * j] : nullptr;
+      const JointType type = chain.rows[j].type;
+      if (!jacobian) {
+        const double* e = chain.joint_errors[j].data();
+        q[j] = trig ? ModelJointValueTrig<double>(type, in.q[j], in.s[j],
+                                                  in.tau[j], e, tm, tr)
+                    : ModelJointValue<double>(type, in.q[j], in.s[j], in.tau[j],
+                                              e, tm);
+        continue;
+      }
       JetE e[kJointErrorBlockSize];
       for (int t = 0; t < kJointErrorBlockSize; ++t)
         e[t] = JetE(chain.joint_errors[j][t], t);
-      const double tm = masses ? in.tau_mass[j] : 0.0;
-      const JetE qj =
-          trig ? ModelJointValueTrig<JetE>(chain.rows[j].type, in.q[j], in.s[j],
-                                           in.tau[j], e, tm,
-                                           &in.trig[2 * kMaxHarmonic * j])
-               : ModelJointValue<JetE>(chain.rows[j].type, in.q[j], in.s[j],
-                                       in.tau[j], e, tm);
+      const JetE qj = trig ? ModelJointValueTrig<JetE>(type, in.q[j], in.s[j],
+                                                       in.tau[j], e, tm, tr)
+                           : ModelJointValue<JetE>(type, in.q[j], in.s[j],
+                                                   in.tau[j], e, tm);
       q[j] = qj.a;
       dq[j] = qj.v;
     }
     // Thermal scaling of the rows' lengths (calib/chain.h TipInBase).
     const bool thermal = in.thermal_x != 0.0;
-    double scaled[kMaxJoints + 1][kRowBlockSize];
     double factor[kMaxJoints + 1];
     for (int i = 0; i <= n; ++i) {
-      for (int t = 0; t < kRowBlockSize; ++t) scaled[i][t] = rows[i][t];
-      factor[i] = 1.0;
-      if (thermal && i < n) {
-        factor[i] = 1.0 + chain.joint_errors[i][kThermal] * in.thermal_x;
-        ScaleRowLengths(chain.convention, factor[i], scaled[i]);
-      }
+      factor[i] = thermal && i < n
+                      ? 1.0 + chain.joint_errors[i][kThermal] * in.thermal_x
+                      : 1.0;
     }
     // Forward pass: axis and origin of every operation in the base frame.
     Eigen::Vector3d axis_w[kMaxJoints + 1][7], origin_w[kMaxJoints + 1][7];
     Eigen::Matrix3d R = Eigen::Matrix3d::Identity();
     Eigen::Vector3d t = Eigen::Vector3d::Zero();
     for (int i = 0; i <= n; ++i) {
-      const double qi = i < n ? q[i] : 0.0;
+      const RowBlock& p = chain.rows[i].p;
       for (int o = 0; o < num_ops[i]; ++o) {
         const Op& op = ops[i][o];
-        double amount = op.param >= 0 ? scaled[i][op.param] : 0.0;
-        if (op.joint) amount += qi;
-        axis_w[i][o] = R * op.axis;
-        origin_w[i][o] = t;
+        if (jacobian) {
+          axis_w[i][o] = R * op.axis;
+          origin_w[i][o] = t;
+        }
         if (op.rotation) {
-          if (amount != 0.0) R = R * AxisRotation(op.axis, amount);
+          if (!op.joint) {
+            R = R * fixed_rot[i][o];
+          } else {
+            const double angle = (op.param >= 0 ? p[op.param] : 0.0) + q[i];
+            R = R * AxisRotation(op.axis, angle);
+          }
         } else {
-          t += axis_w[i][o] * amount;
+          double amount = op.param >= 0 ? p[op.param] : 0.0;
+          if (op.param >= 0 && IsLength(chain.convention, op.param))
+            amount *= factor[i];
+          if (op.joint) amount += q[i];
+          t += (R * op.axis) * amount;
         }
       }
     }
     const Eigen::Vector3d tip = t;  // before drift and mount tilt
+    // Drift and mount tilt (calib/chain.h TipInBase), then the frame.
+    const Eigen::Vector3d drifted =
+        tip + Eigen::Vector3d(chain.drift[0], chain.drift[1], chain.drift[2]) *
+                  in.t_h;
+    const Vec3<double> tilted =
+        MountTilt<double>(chain.drift.data(), in.moment, drifted);
+    r->segment<3>(3 * pose) = frame_r * tilted + frame_t - meas.p_in_meas;
+    if (!jacobian) continue;
+
     auto d_op = [&](int i, int o) -> Eigen::Vector3d {
       return ops[i][o].rotation
                  ? Eigen::Vector3d(axis_w[i][o].cross(tip - origin_w[i][o]))
@@ -176,32 +217,20 @@ void ResidualsAndJacobian(const std::vector<Measurement>& measurements,
         if (ops[i][o].joint && i < n) d_q[i] += d;
       }
     }
-    // Drift, mount tilt and frame (the shared hooks, autodiff): inputs
-    // global[0..5] | p[0..2], then frame[0..5] | p[0..2].
-    const Eigen::Vector3d drifted =
-        tip + Eigen::Vector3d(chain.drift[0], chain.drift[1], chain.drift[2]) *
-                  in.t_h;
+    // Mount tilt (the shared hook, autodiff): inputs global[0..5] | p.
     Jet9 g[kDriftBlockSize];
     for (int e = 0; e < kDriftBlockSize; ++e) g[e] = Jet9(chain.drift[e], e);
     const Vec3<Jet9> pm(Jet9(drifted[0], 6), Jet9(drifted[1], 7),
                         Jet9(drifted[2], 8));
-    const Vec3<Jet9> tilted = MountTilt(g, in.moment, pm);
-    Jet9 f[kFrameBlockSize];
-    for (int e = 0; e < kFrameBlockSize; ++e)
-      f[e] = Jet9(state.meas_from_base[e], e);
-    const Vec3<Jet9> pf(Jet9(tilted[0].a, 6), Jet9(tilted[1].a, 7),
-                        Jet9(tilted[2].a, 8));
-    const Vec3<Jet9> out = ApplyFrame(f, pf);
-    Eigen::Matrix3d d_frame_p, d_mount_p;
-    Eigen::Matrix<double, 3, 6> d_frame, d_global;
+    const Vec3<Jet9> tilt = MountTilt(g, in.moment, pm);
+    Eigen::Matrix3d d_mount_p;
+    Eigen::Matrix<double, 3, 6> d_global;
     for (int a = 0; a < 3; ++a) {
-      d_frame.row(a) = out[a].v.head<6>().transpose();
-      d_frame_p.row(a) = out[a].v.tail<3>().transpose();
-      d_global.row(a) = tilted[a].v.head<6>().transpose();
-      d_mount_p.row(a) = tilted[a].v.tail<3>().transpose();
+      d_global.row(a) = tilt[a].v.head<6>().transpose();
+      d_mount_p.row(a) = tilt[a].v.tail<3>().transpose();
     }
-    const Eigen::Matrix3d d_tip = d_frame_p * d_mount_p;  // dr / d tip
-    d_global = d_frame_p * d_global;
+    const Eigen::Matrix3d d_tip = frame_r * d_mount_p;  // dr / d tip
+    d_global = frame_r * d_global;
     for (int c = 0; c < k; ++c) {
       const ParamInfo& p = params[c];
       Eigen::Vector3d col = Eigen::Vector3d::Zero();
@@ -219,7 +248,7 @@ void ResidualsAndJacobian(const std::vector<Measurement>& measurements,
             if (thermal) {
               for (int e = 0; e < kRowBlockSize; ++e) {
                 if (IsLength(chain.convention, e))
-                  d += d_row[j][e] * (rows[j][e] * in.thermal_x);
+                  d += d_row[j][e] * (chain.rows[j].p[e] * in.thermal_x);
               }
             }
             col = d_tip * d;
@@ -233,7 +262,8 @@ void ResidualsAndJacobian(const std::vector<Measurement>& measurements,
           if (p.index < 3) col += d_tip.col(p.index) * in.t_h;
           break;
         case ParamKind::kFrame:
-          col = d_frame.col(p.index);
+          col = p.index < 3 ? Eigen::Vector3d(frame_dr[p.index] * tilted)
+                            : Eigen::Vector3d::Unit(p.index - 3);
           break;
         case ParamKind::kPoint:
           break;  // measured rows do not depend on fixed points

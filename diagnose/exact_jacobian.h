@@ -4,9 +4,7 @@
 // Residuals of measured rows and their exact Jacobian with respect to a
 // chosen list of parameters, for the candidate refits of `diagnose model`.
 //
-// The residual values come from the shared templated chain
-// (calib/chain.h TipInBase + ApplyFrame, as calib/fit.h's Residual). The
-// derivatives use the chain's structure instead of differentiating it
+// The derivatives use the chain's structure instead of differentiating it
 // entry by entry: every row is a product of elementary rotations and
 // translations (dh: Rz(theta + q) Tz(d) Tx(a) Rx(alpha) Ry(beta); mdh and
 // urdf likewise), so d tip / d(rotation angle) = w x (tip - o) and
@@ -15,10 +13,13 @@
 // joint-value hooks (gain, backlash, compliance, cyclic, elastostatic), the
 // thermal row scaling, the mount tilt and the measuring frame enter by the
 // chain rule, their own derivatives taken by forward-mode autodiff of the
-// shared hooks (ModelJointValue*, MountTilt, ApplyFrame). One pass per pose
-// gives every column, against one autodiff pass per 8 parameters through
-// the whole chain. `ExactJacobianTest` checks it against calib/fit.h's
-// ResidualJacobian for dh, mdh and urdf chains with every family set.
+// shared hooks (ModelJointValue*, MountTilt, ApplyFrame). The same forward
+// pass gives the residual (rotations that do not depend on the pose and the
+// measuring frame computed once per call). One pass per pose gives every
+// column, against one autodiff pass per 8 parameters through the whole
+// chain. `ExactJacobianTest` checks residuals and Jacobian against
+// calib/fit.h's Residual and ResidualJacobian for dh, mdh and urdf chains
+// with every family set.
 
 #include <Eigen/Core>
 #include <vector>

@@ -110,15 +110,16 @@ void Bounds(const FreeFitOptions& options, std::vector<double>* lower,
 // steps projected onto the bounds; stops as Ceres does: relative cost change
 // <= function_tolerance or step <= parameter_tolerance (|x| +
 // parameter_tolerance). Starts with a Gauss-Newton step (lambda 0); the
-// candidate refits start at the linearised optimum, so one Jacobian and two
-// residual passes usually suffice.
-double ExactFreeFit(const std::vector<Measurement>& measurements,
+// candidate refits start at the linearised optimum, so one Jacobian and a
+// few residual passes usually suffice. After a step that changed the cost by
+// less than kChordChange (relative), the next step reuses the factorised
+// Jacobian (a chord step: the Jacobian moved by O(step), far below what the
+// tolerances see); a chord step that does not lower the cost is retried
+// with a fresh Jacobian.
+double ExactFreeFit(const std::vector<Measurement>& ms,
                     const FreeFitOptions& options, ModelState* state) {
+  constexpr double kChordChange = 1e-6;
   const int k = static_cast<int>(options.free.size());
-  std::vector<Measurement> ms;
-  ms.reserve(measurements.size());
-  for (const Measurement& m : measurements)
-    if (m.kind == Measurement::kMeasured) ms.push_back(m);
   std::vector<double> lower, upper;
   Bounds(options, &lower, &upper);
   Eigen::VectorXd x(k);
@@ -136,26 +137,31 @@ double ExactFreeFit(const std::vector<Measurement>& measurements,
     ResidualsAndJacobian(ms, *state, options.free, &r, nullptr);
     return r.squaredNorm();
   }
-  ResidualsAndJacobian(ms, *state, options.free, &r, &J);
-  double cost = r.squaredNorm();
+  double cost = 0.0;
   double lambda = 0.0;
-  bool need_jacobian = false;
+  bool fresh = false;  // J belongs to x
+  bool need_jacobian = true;
+  Eigen::MatrixXd As;  // Jacobi-scaled J^T J of the last Jacobian
+  Eigen::VectorXd s(k);
   for (int it = 0; it < options.max_iterations; ++it) {
-    if (need_jacobian) ResidualsAndJacobian(ms, *state, options.free, &r, &J);
-    need_jacobian = false;
-    const Eigen::MatrixXd A = J.transpose() * J;
-    const Eigen::VectorXd g = J.transpose() * r;
-    // Jacobi scaling, as Ceres.
-    Eigen::VectorXd s(k);
-    for (int i = 0; i < k; ++i)
-      s[i] = A(i, i) > 0 ? 1.0 / std::sqrt(A(i, i)) : 1.0;
-    const Eigen::MatrixXd As = s.asDiagonal() * A * s.asDiagonal();
+    if (need_jacobian) {
+      ResidualsAndJacobian(ms, *state, options.free, &r, &J);
+      cost = r.squaredNorm();
+      Eigen::MatrixXd A = Eigen::MatrixXd::Zero(k, k);
+      A.selfadjointView<Eigen::Lower>().rankUpdate(J.transpose());
+      A = A.selfadjointView<Eigen::Lower>();
+      for (int i = 0; i < k; ++i)  // Jacobi scaling, as Ceres
+        s[i] = A(i, i) > 0 ? 1.0 / std::sqrt(A(i, i)) : 1.0;
+      As = s.asDiagonal() * A * s.asDiagonal();
+      fresh = true;
+      need_jacobian = false;
+    }
+    const Eigen::VectorXd gs = s.asDiagonal() * (J.transpose() * r);
     bool accepted = false, converged = false;
     while (!accepted) {
       Eigen::MatrixXd M = As;
       M.diagonal().array() += lambda;
-      const Eigen::VectorXd step =
-          s.asDiagonal() * M.ldlt().solve(-(s.asDiagonal() * g));
+      const Eigen::VectorXd step = s.asDiagonal() * M.ldlt().solve(-gs);
       Eigen::VectorXd x_new = x + step;
       for (int i = 0; i < k; ++i)
         x_new[i] = std::min(std::max(x_new[i], lower[i]), upper[i]);
@@ -167,13 +173,12 @@ double ExactFreeFit(const std::vector<Measurement>& measurements,
         break;
       }
       Eigen::VectorXd r_new;
+      double cost_new = std::numeric_limits<double>::infinity();
       if (step.allFinite()) {
         set(x_new);
         ResidualsAndJacobian(ms, *state, options.free, &r_new, nullptr);
+        cost_new = r_new.squaredNorm();
       }
-      const double cost_new = step.allFinite()
-                                  ? r_new.squaredNorm()
-                                  : std::numeric_limits<double>::infinity();
       if (std::isfinite(cost_new) && cost_new <= cost) {
         accepted = true;
         const double change = (cost - cost_new) / cost;
@@ -181,10 +186,15 @@ double ExactFreeFit(const std::vector<Measurement>& measurements,
         r = r_new;
         cost = cost_new;
         lambda = lambda < 1e-9 ? 0.0 : lambda / 10.0;
-        need_jacobian = true;
         if (change <= options.function_tolerance) converged = true;
+        need_jacobian = !(change < kChordChange && lambda == 0.0);
+        fresh = false;
       } else {
         set(x);
+        if (!fresh) {  // a chord step failed: take a fresh Jacobian
+          need_jacobian = true;
+          break;
+        }
         lambda = lambda == 0.0 ? 1e-6 : 10.0 * lambda;
         if (lambda > 1e12) {
           converged = true;

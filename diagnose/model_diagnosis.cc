@@ -17,6 +17,7 @@
 #include "data/error.h"
 #include "data/provenance.h"
 #include "data/yaml_util.h"
+#include "diagnose/exact_jacobian.h"
 #include "diagnose/free_fit.h"
 #include "diagnose/nonparametric.h"
 
@@ -274,14 +275,20 @@ DiagnosisResult DiagnoseModel(const Robot& nominal, const Observations& obs,
   for (int step = 0; step < options.max_findings && !pool.empty() &&
                      current_rss > kExactMm * kExactMm * n_res;
        ++step) {
-    // Identifiability of each candidate against the current model.
-    const Eigen::MatrixXd base_raw =
-        ResidualJacobian(pb.train, current, current_free);
-    const Eigen::MatrixXd basis = Basis(Normalized(base_raw));
-    Eigen::VectorXd r0(3 * pb.train.size());
-    for (size_t i = 0; i < pb.train.size(); ++i) {
-      r0.segment<3>(3 * i) = Residual(current, pb.train[i]);
+    // Identifiability of each candidate against the current model
+    // (residuals and Jacobians: diagnose/exact_jacobian.h).
+    // exact_jacobian = false: calib/fit.h's autodiff, as before.
+    Eigen::VectorXd r0;
+    Eigen::MatrixXd base_raw;
+    if (options.exact_jacobian) {
+      ResidualsAndJacobian(pb.train, current, current_free, &r0, &base_raw);
+    } else {
+      base_raw = ResidualJacobian(pb.train, current, current_free);
+      r0.resize(3 * pb.train.size());
+      for (size_t i = 0; i < pb.train.size(); ++i)
+        r0.segment<3>(3 * i) = Residual(current, pb.train[i]);
     }
+    const Eigen::MatrixXd basis = Basis(Normalized(base_raw));
     // One Jacobian for all candidates' parameters, sliced per candidate.
     std::vector<ParamInfo> all_params;
     std::vector<int> first(pool.size());
@@ -290,8 +297,17 @@ DiagnosisResult DiagnoseModel(const Robot& nominal, const Observations& obs,
       first[c] = static_cast<int>(all_params.size());
       for (const ParamInfo& q : pool[c].params) all_params.push_back(q);
     }
-    const Eigen::MatrixXd cand_jac =
-        ResidualJacobian(pb.train, current, all_params);
+    Eigen::MatrixXd cand_jac;
+    if (options.exact_jacobian) {
+      Eigen::VectorXd unused;
+      ResidualsAndJacobian(pb.train, current, all_params, &unused, &cand_jac);
+    } else {
+      cand_jac = ResidualJacobian(pb.train, current, all_params);
+    }
+    // Normal equations of the base model, shared by every candidate's
+    // Gauss-Newton start.
+    const Eigen::MatrixXd base_ntn = base_raw.transpose() * base_raw;
+    const Eigen::VectorXd base_ntr = base_raw.transpose() * r0;
     std::vector<bool> usable(pool.size());
     for (size_t c = 0; c < pool.size(); ++c) {
       const int k = static_cast<int>(pool[c].params.size());
@@ -325,21 +341,40 @@ DiagnosisResult DiagnoseModel(const Robot& nominal, const Observations& obs,
       fo.free = current_free;
       for (const ParamInfo& q : cand.params) fo.free.push_back(q);
       // Start from the Gauss-Newton step of the linearised joint model, so
-      // that Ceres needs few iterations.
-      Eigen::MatrixXd a(base_raw.rows(), base_raw.cols() + s.k);
+      // that the refit needs few iterations: normal equations of [base,
+      // candidate columns], Jacobi-scaled.
+      const int pb_cols = static_cast<int>(base_raw.cols());
+      Eigen::MatrixXd cc(base_raw.rows(), s.k);
       for (int q = 0; q < s.k; ++q) {
         int col = first[c];
         while (all_params[col].name != cand.params[q].name) ++col;
-        a.col(base_raw.cols() + q) = cand_jac.col(col);
+        cc.col(q) = cand_jac.col(col);
       }
-      a.leftCols(base_raw.cols()) = base_raw;
-      Eigen::VectorXd scale(a.cols());
-      for (int q = 0; q < a.cols(); ++q) {
-        scale[q] = a.col(q).norm() > 0 ? 1.0 / a.col(q).norm() : 1.0;
+      Eigen::MatrixXd ntn(pb_cols + s.k, pb_cols + s.k);
+      ntn.topLeftCorner(pb_cols, pb_cols) = base_ntn;
+      ntn.topRightCorner(pb_cols, s.k) = base_raw.transpose() * cc;
+      ntn.bottomLeftCorner(s.k, pb_cols) =
+          ntn.topRightCorner(pb_cols, s.k).transpose();
+      ntn.bottomRightCorner(s.k, s.k) = cc.transpose() * cc;
+      Eigen::VectorXd ntr(pb_cols + s.k);
+      ntr.head(pb_cols) = base_ntr;
+      ntr.tail(s.k) = cc.transpose() * r0;
+      Eigen::VectorXd scale(ntn.cols());
+      for (int q = 0; q < ntn.cols(); ++q) {
+        scale[q] = ntn(q, q) > 0 ? 1.0 / std::sqrt(ntn(q, q)) : 1.0;
       }
-      const Eigen::VectorXd step =
-          scale.asDiagonal() *
-          (a * scale.asDiagonal()).colPivHouseholderQr().solve(-r0);
+      Eigen::VectorXd step;
+      if (options.exact_jacobian) {
+        step =
+            scale.asDiagonal() * (scale.asDiagonal() * ntn * scale.asDiagonal())
+                                     .ldlt()
+                                     .solve(-(scale.asDiagonal() * ntr));
+      } else {  // QR of the scaled Jacobian, as before
+        Eigen::MatrixXd a(base_raw.rows(), pb_cols + s.k);
+        a << base_raw, cc;
+        step = scale.asDiagonal() *
+               (a * scale.asDiagonal()).colPivHouseholderQr().solve(-r0);
+      }
       for (int q = 0; q < static_cast<int>(fo.free.size()); ++q) {
         if (std::isfinite(step[q]))
           *ParamAddress(&states[c], fo.free[q]) += step[q];
@@ -362,9 +397,23 @@ DiagnosisResult DiagnoseModel(const Robot& nominal, const Observations& obs,
       } else {
         fits[c] = Fit(pb.train, fo, &states[c]);
       }
-      s.rss = Rss(states[c], pb.train);
-      s.train_rms_mm = Rms(states[c], pb.train);
-      s.heldout_rms_mm = Rms(states[c], pb.held);
+      if (options.exact_jacobian) {
+        // The same sums from the exact Jacobian's residual pass.
+        Eigen::VectorXd rt, rh;
+        ResidualsAndJacobian(pb.train, states[c], {}, &rt, nullptr);
+        ResidualsAndJacobian(pb.held, states[c], {}, &rh, nullptr);
+        s.rss = rt.squaredNorm();
+        s.train_rms_mm =
+            std::sqrt(s.rss / static_cast<double>(pb.train.size()));
+        s.heldout_rms_mm = pb.held.empty()
+                               ? kNaN
+                               : std::sqrt(rh.squaredNorm() /
+                                           static_cast<double>(pb.held.size()));
+      } else {
+        s.rss = Rss(states[c], pb.train);
+        s.train_rms_mm = Rms(states[c], pb.train);
+        s.heldout_rms_mm = Rms(states[c], pb.held);
+      }
       const double d2 = n_res - p - s.k;
       // RSS changes at the solver's precision are no evidence.
       double drop = current_rss - s.rss;
