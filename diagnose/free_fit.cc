@@ -3,6 +3,7 @@
 #include <ceres/ceres.h>
 
 #include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -265,6 +266,56 @@ double FreeFit(const std::vector<Measurement>& measurements,
   for (const Measurement& m : measurements)
     rss += Residual(*state, m).squaredNorm();
   return rss;
+}
+
+FitSummary FreeFitWithCovariance(const std::vector<Measurement>& measurements,
+                                 const FreeFitOptions& options,
+                                 ModelState* state) {
+  FitSummary summary;
+  FreeFitOptions o = options;
+  o.exact_jacobian = true;
+  int m = 0;
+  for (const Measurement& x : measurements)
+    m += x.kind == Measurement::kMeasured ? 1 : 0;
+  summary.initial_rms_mm = 0.0;
+  FreeFit(measurements, o, state);
+  Eigen::VectorXd r;
+  Eigen::MatrixXd J;
+  ResidualsAndJacobian(measurements, *state, options.free, &r, &J);
+  const int p = static_cast<int>(options.free.size());
+  summary.converged = true;
+  summary.params = options.free;
+  for (int i = 0; i < static_cast<int>(measurements.size()); ++i)
+    summary.residual_mm.push_back(r.segment<3>(3 * i).norm());
+  summary.final_rms_mm = m > 0 ? std::sqrt(r.squaredNorm() / m) : 0.0;
+  const int dof = 3 * static_cast<int>(measurements.size()) - p;
+  summary.sigma0_mm = dof > 0 ? std::sqrt(r.squaredNorm() / dof) : 0.0;
+  summary.values.resize(p);
+  summary.sigmas.assign(p, std::numeric_limits<double>::quiet_NaN());
+  for (int i = 0; i < p; ++i)
+    summary.values[i] =
+        options.free[i].ToInterface(ParamValue(*state, options.free[i]));
+  if (p > 0 && dof > 0) {
+    Eigen::MatrixXd A = Eigen::MatrixXd::Zero(p, p);
+    A.selfadjointView<Eigen::Lower>().rankUpdate(J.transpose());
+    A = A.selfadjointView<Eigen::Lower>();
+    const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(A);
+    const Eigen::VectorXd& l = eig.eigenvalues();
+    const double lmax = l.maxCoeff();
+    Eigen::VectorXd inv = Eigen::VectorXd::Zero(p);
+    for (int i = 0; i < p; ++i)
+      if (lmax > 0 && l[i] > 1e-14 * lmax) inv[i] = 1.0 / l[i];
+    summary.covariance = summary.sigma0_mm * summary.sigma0_mm *
+                         eig.eigenvectors() * inv.asDiagonal() *
+                         eig.eigenvectors().transpose();
+    for (int i = 0; i < p; ++i) {
+      const double var = summary.covariance(i, i);
+      const double sigma = var >= 0 ? std::sqrt(var) : NAN;
+      summary.sigmas[i] =
+          options.free[i].angle ? options.free[i].ToInterface(sigma) : sigma;
+    }
+  }
+  return summary;
 }
 
 }  // namespace kincal

@@ -33,6 +33,14 @@ struct FreeFitOptions {
 double FreeFit(const std::vector<Measurement>& measurements,
                const FreeFitOptions& options, ModelState* state);
 
+// FreeFit (exact Jacobian), then, as calib/fit.h's Fit with
+// compute_covariance: sigma0 = sqrt(RSS / (3 m - p)) and the covariance
+// sigma0^2 (J^T J)^+ of the free parameters (eigenvalues below 1e-14 of the
+// largest dropped, as ceres::Covariance DENSE_SVD with null_space_rank -1).
+FitSummary FreeFitWithCovariance(const std::vector<Measurement>& measurements,
+                                 const FreeFitOptions& options,
+                                 ModelState* state);
+
 }  // namespace kincal
 
 #endif  // KINCAL_DIAGNOSE_FREE_FIT_H_

@@ -32,23 +32,47 @@ TEST(FreeFitTest, SameOptimumAsFit) {
         "elbow_joint.thermal", "mount.iso"}) {
     free.push_back(FindParam(state, name));
   }
-  ModelState a = state, b = state;
+  ModelState a = state;
   FitOptions fo;
   fo.free = free;
   fo.bounds_center = &nominal;
-  fo.compute_covariance = false;
-  Fit(ms, fo, &a);
+  fo.compute_covariance = true;
+  const FitSummary fit = Fit(ms, fo, &a);
+  double rss_a = 0;
+  for (const Measurement& m : ms) rss_a += Residual(a, m).squaredNorm();
+  // Both refit paths: Ceres autodiff in the free parameters, and
+  // Levenberg-Marquardt on the exact Jacobian (with its covariance).
+  for (bool exact : {false, true}) {
+    SCOPED_TRACE(exact ? "exact Jacobian" : "Ceres autodiff");
+    ModelState b = state;
+    FreeFitOptions ffo;
+    ffo.free = free;
+    ffo.bounds_center = &nominal;
+    ffo.exact_jacobian = exact;
+    const double rss = FreeFit(ms, ffo, &b);
+    EXPECT_NEAR(rss, rss_a, 1e-6 * rss_a + 1e-9);
+    for (const ParamInfo& p : free) {
+      EXPECT_NEAR(ParamValue(b, p), ParamValue(a, p),
+                  1e-6 * std::max(1.0, std::abs(ParamValue(a, p))))
+          << p.name;
+    }
+  }
+  ModelState c = state;
   FreeFitOptions ffo;
   ffo.free = free;
   ffo.bounds_center = &nominal;
-  const double rss = FreeFit(ms, ffo, &b);
-  double rss_a = 0;
-  for (const Measurement& m : ms) rss_a += Residual(a, m).squaredNorm();
-  EXPECT_NEAR(rss, rss_a, 1e-6 * rss_a + 1e-9);
-  for (const ParamInfo& p : free) {
-    EXPECT_NEAR(ParamValue(b, p), ParamValue(a, p),
-                1e-6 * std::max(1.0, std::abs(ParamValue(a, p))))
-        << p.name;
+  ffo.function_tolerance = ffo.parameter_tolerance = 1e-12;
+  const FitSummary exact = FreeFitWithCovariance(ms, ffo, &c);
+  EXPECT_NEAR(exact.sigma0_mm, fit.sigma0_mm, 1e-6 * fit.sigma0_mm);
+  ASSERT_EQ(exact.covariance.rows(), fit.covariance.rows());
+  for (int i = 0; i < fit.covariance.rows(); ++i) {
+    EXPECT_NEAR(exact.sigmas[i], fit.sigmas[i], 1e-4 * fit.sigmas[i])
+        << free[i].name;
+    for (int j = 0; j < fit.covariance.cols(); ++j) {
+      const double scale =
+          std::sqrt(fit.covariance(i, i) * fit.covariance(j, j));
+      EXPECT_NEAR(exact.covariance(i, j), fit.covariance(i, j), 1e-4 * scale);
+    }
   }
 }
 

@@ -75,8 +75,23 @@ struct Problem {
 };
 
 // Frame (and points) registration, identifiability, geometric fit.
+// exact: the fits by diagnose/free_fit.h's exact-Jacobian path (same
+// problem, same bounds, calib/fit.h's tolerances).
 void FitBase(const std::vector<Measurement>& fit_on, const std::string& source,
-             Problem* pb) {
+             Problem* pb, bool exact = false) {
+  auto fit = [&](const FitOptions& fo, ModelState* state) {
+    if (!exact) {
+      Fit(fit_on, fo, state);
+      return;
+    }
+    FreeFitOptions ffo;
+    ffo.free = fo.free;
+    ffo.bounds_center = fo.bounds_center;
+    ffo.max_iterations = fo.max_iterations;
+    ffo.function_tolerance = fo.function_tolerance;
+    ffo.parameter_tolerance = fo.parameter_tolerance;
+    FreeFit(fit_on, ffo, state);
+  };
   ModelState& state = pb->base_state;
   InitializeFrameAndPoints(fit_on, &state);
   std::vector<ParamInfo> nuisance;
@@ -89,7 +104,7 @@ void FitBase(const std::vector<Measurement>& fit_on, const std::string& source,
   FitOptions frame_only;
   frame_only.free = nuisance;
   frame_only.compute_covariance = false;
-  Fit(fit_on, frame_only, &state);
+  fit(frame_only, &state);
 
   std::vector<ParamInfo> candidates = nuisance;
   for (const ParamInfo& p : GeometryParams(state.chain))
@@ -122,7 +137,7 @@ void FitBase(const std::vector<Measurement>& fit_on, const std::string& source,
   geo.free = pb->base_free;
   geo.bounds_center = &pb->nominal;
   geo.compute_covariance = false;
-  Fit(fit_on, geo, &state);
+  fit(geo, &state);
 }
 
 // Measurements of `obs` with the validity checks of the spec.
@@ -240,7 +255,7 @@ DiagnosisResult DiagnoseModel(const Robot& nominal, const Observations& obs,
   pb.held = Pick(pb.all, held_idx);
   out.train_poses = static_cast<int>(pb.train.size());
   out.heldout_poses = static_cast<int>(pb.held.size());
-  FitBase(pb.train, obs.source, &pb);
+  FitBase(pb.train, obs.source, &pb, options.exact_jacobian);
 
   ModelState current = pb.base_state;
   std::vector<ParamInfo> current_free = pb.base_free;
@@ -503,7 +518,18 @@ DiagnosisResult DiagnoseModel(const Robot& nominal, const Observations& obs,
   fo.free = current_free;
   fo.bounds_center = &pb.nominal;
   fo.compute_covariance = true;
-  const FitSummary final_fit = Fit(pb.all, fo, &final_state);
+  FitSummary final_fit;
+  if (options.exact_jacobian) {
+    FreeFitOptions ffo;  // calib/fit.h's defaults
+    ffo.free = fo.free;
+    ffo.bounds_center = fo.bounds_center;
+    ffo.max_iterations = fo.max_iterations;
+    ffo.function_tolerance = fo.function_tolerance;
+    ffo.parameter_tolerance = fo.parameter_tolerance;
+    final_fit = FreeFitWithCovariance(pb.all, ffo, &final_state);
+  } else {
+    final_fit = Fit(pb.all, fo, &final_state);
+  }
   for (size_t i = 0; i < accepted.size(); ++i) {
     const Candidate& c = accepted[i];
     const Magnitude m =
