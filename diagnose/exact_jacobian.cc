@@ -4,6 +4,7 @@
 
 #include <Eigen/Geometry>
 #include <array>
+#include <cmath>
 
 #include "data/error.h"
 
@@ -71,6 +72,27 @@ Eigen::Matrix3d AxisRotation(const Eigen::Vector3d& axis, double angle) {
   return Eigen::AngleAxisd(angle, axis).toRotationMatrix();
 }
 
+// 0, 1, 2 when `axis` is the x, y or z unit vector, else -1.
+int CoordinateAxis(const Eigen::Vector3d& axis) {
+  for (int c = 0; c < 3; ++c)
+    if (axis == Eigen::Vector3d::Unit(c)) return c;
+  return -1;
+}
+
+// R <- R * rotation(axis, angle): about a coordinate axis only two columns
+// change; any other axis by the full product.
+void RotateInPlace(int coordinate, const Eigen::Vector3d& axis, double c,
+                   double s, double angle, Eigen::Matrix3d* R) {
+  if (coordinate < 0) {
+    *R = *R * AxisRotation(axis, angle);
+    return;
+  }
+  const int a = (coordinate + 1) % 3, b = (coordinate + 2) % 3;
+  const Eigen::Vector3d ca = R->col(a), cb = R->col(b);
+  R->col(a) = c * ca + s * cb;
+  R->col(b) = c * cb - s * ca;
+}
+
 }  // namespace
 
 void ResidualsAndJacobian(const std::vector<Measurement>& measurements,
@@ -88,14 +110,18 @@ void ResidualsAndJacobian(const std::vector<Measurement>& measurements,
   // Operations of every row, and the rotations that do not depend on the
   // pose (every rotation but the joint's own).
   std::array<std::array<Op, 7>, kMaxJoints + 1> ops;
-  std::array<std::array<Eigen::Matrix3d, 7>, kMaxJoints + 1> fixed_rot;
+  std::array<std::array<double, 7>, kMaxJoints + 1> fixed_c, fixed_s;
+  std::array<std::array<int, 7>, kMaxJoints + 1> coordinate;
   std::array<int, kMaxJoints + 1> num_ops;
   for (int i = 0; i <= n; ++i) {
     num_ops[i] = RowOps(chain.convention, chain.rows[i], ops[i].data());
     for (int o = 0; o < num_ops[i]; ++o) {
       const Op& op = ops[i][o];
-      if (op.rotation && !op.joint)
-        fixed_rot[i][o] = AxisRotation(op.axis, chain.rows[i].p[op.param]);
+      coordinate[i][o] = CoordinateAxis(op.axis);
+      if (op.rotation && !op.joint) {
+        fixed_c[i][o] = std::cos(chain.rows[i].p[op.param]);
+        fixed_s[i][o] = std::sin(chain.rows[i].p[op.param]);
+      }
     }
   }
   // The measuring frame is linear in the point, ApplyFrame(f, p) = R p + t:
@@ -120,6 +146,16 @@ void ResidualsAndJacobian(const std::vector<Measurement>& measurements,
                                 state.meas_from_base[4],
                                 state.meas_from_base[5]);
 
+  // Which hooks need derivatives: joint values of joints with a free joint
+  // error entry (thermal aside), the global block.
+  bool need_dq[kMaxJoints] = {};
+  bool need_global = false;
+  for (const ParamInfo& p : params) {
+    if (!jacobian) break;
+    if (p.kind == ParamKind::kJointError && p.index != kThermal)
+      need_dq[p.block] = true;
+    if (p.kind == ParamKind::kDrift) need_global = true;
+  }
   using JetE = ceres::Jet<double, kJointErrorBlockSize>;
   using Jet9 = ceres::Jet<double, 9>;
   for (int pose = 0; pose < m; ++pose) {
@@ -136,7 +172,7 @@ void ResidualsAndJacobian(const std::vector<Measurement>& measurements,
       const double tm = masses ? in.tau_mass[j] : 0.0;
       const double* tr = trig ? &in.trig[2 * kMaxHarmonic * j] : nullptr;
       const JointType type = chain.rows[j].type;
-      if (!jacobian) {
+      if (!need_dq[j]) {
         const double* e = chain.joint_errors[j].data();
         q[j] = trig ? ModelJointValueTrig<double>(type, in.q[j], in.s[j],
                                                   in.tau[j], e, tm, tr)
@@ -170,23 +206,29 @@ void ResidualsAndJacobian(const std::vector<Measurement>& measurements,
       const RowBlock& p = chain.rows[i].p;
       for (int o = 0; o < num_ops[i]; ++o) {
         const Op& op = ops[i][o];
+        const int axis = coordinate[i][o];
+        const Eigen::Vector3d w = axis >= 0 ? Eigen::Vector3d(R.col(axis))
+                                            : Eigen::Vector3d(R * op.axis);
         if (jacobian) {
-          axis_w[i][o] = R * op.axis;
+          axis_w[i][o] = w;
           origin_w[i][o] = t;
         }
         if (op.rotation) {
           if (!op.joint) {
-            R = R * fixed_rot[i][o];
+            if (fixed_s[i][o] != 0.0 || fixed_c[i][o] != 1.0)
+              RotateInPlace(axis, op.axis, fixed_c[i][o], fixed_s[i][o],
+                            p[op.param], &R);
           } else {
             const double angle = (op.param >= 0 ? p[op.param] : 0.0) + q[i];
-            R = R * AxisRotation(op.axis, angle);
+            RotateInPlace(axis, op.axis, std::cos(angle), std::sin(angle),
+                          angle, &R);
           }
         } else {
           double amount = op.param >= 0 ? p[op.param] : 0.0;
           if (op.param >= 0 && IsLength(chain.convention, op.param))
             amount *= factor[i];
           if (op.joint) amount += q[i];
-          t += (R * op.axis) * amount;
+          t += w * amount;
         }
       }
     }
@@ -217,17 +259,28 @@ void ResidualsAndJacobian(const std::vector<Measurement>& measurements,
         if (ops[i][o].joint && i < n) d_q[i] += d;
       }
     }
-    // Mount tilt (the shared hook, autodiff): inputs global[0..5] | p.
-    Jet9 g[kDriftBlockSize];
-    for (int e = 0; e < kDriftBlockSize; ++e) g[e] = Jet9(chain.drift[e], e);
-    const Vec3<Jet9> pm(Jet9(drifted[0], 6), Jet9(drifted[1], 7),
-                        Jet9(drifted[2], 8));
-    const Vec3<Jet9> tilt = MountTilt(g, in.moment, pm);
+    // Mount tilt (the shared hook, autodiff): inputs global[0..5] | p, or
+    // p only when no global entry is free.
     Eigen::Matrix3d d_mount_p;
-    Eigen::Matrix<double, 3, 6> d_global;
-    for (int a = 0; a < 3; ++a) {
-      d_global.row(a) = tilt[a].v.head<6>().transpose();
-      d_mount_p.row(a) = tilt[a].v.tail<3>().transpose();
+    Eigen::Matrix<double, 3, 6> d_global = Eigen::Matrix<double, 3, 6>::Zero();
+    if (need_global) {
+      Jet9 g[kDriftBlockSize];
+      for (int e = 0; e < kDriftBlockSize; ++e) g[e] = Jet9(chain.drift[e], e);
+      const Vec3<Jet9> pm(Jet9(drifted[0], 6), Jet9(drifted[1], 7),
+                          Jet9(drifted[2], 8));
+      const Vec3<Jet9> tilt = MountTilt(g, in.moment, pm);
+      for (int a = 0; a < 3; ++a) {
+        d_global.row(a) = tilt[a].v.head<6>().transpose();
+        d_mount_p.row(a) = tilt[a].v.tail<3>().transpose();
+      }
+    } else {
+      using Jet3p = ceres::Jet<double, 3>;
+      Jet3p g[kDriftBlockSize];
+      for (int e = 0; e < kDriftBlockSize; ++e) g[e] = Jet3p(chain.drift[e]);
+      const Vec3<Jet3p> pm(Jet3p(drifted[0], 0), Jet3p(drifted[1], 1),
+                           Jet3p(drifted[2], 2));
+      const Vec3<Jet3p> tilt = MountTilt(g, in.moment, pm);
+      for (int a = 0; a < 3; ++a) d_mount_p.row(a) = tilt[a].v.transpose();
     }
     const Eigen::Matrix3d d_tip = frame_r * d_mount_p;  // dr / d tip
     d_global = frame_r * d_global;
