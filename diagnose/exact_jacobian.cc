@@ -118,7 +118,10 @@ void ResidualsAndJacobian(const std::vector<Measurement>& measurements,
     for (int o = 0; o < num_ops[i]; ++o) {
       const Op& op = ops[i][o];
       coordinate[i][o] = CoordinateAxis(op.axis);
-      if (op.rotation && !op.joint) {
+      // The row entry's angle (for a joint's rotation: its offset theta).
+      fixed_c[i][o] = 1.0;
+      fixed_s[i][o] = 0.0;
+      if (op.rotation && op.param >= 0) {
         fixed_c[i][o] = std::cos(chain.rows[i].p[op.param]);
         fixed_s[i][o] = std::sin(chain.rows[i].p[op.param]);
       }
@@ -218,6 +221,15 @@ void ResidualsAndJacobian(const std::vector<Measurement>& measurements,
             if (fixed_s[i][o] != 0.0 || fixed_c[i][o] != 1.0)
               RotateInPlace(axis, op.axis, fixed_c[i][o], fixed_s[i][o],
                             p[op.param], &R);
+          } else if (trig && q[i] == in.q[i]) {
+            // No joint error: cos / sin of theta + q from the read angle's
+            // precomputed ones (PoseInput::trig).
+            const double cq = in.trig[2 * kMaxHarmonic * i];
+            const double sq = in.trig[2 * kMaxHarmonic * i + 1];
+            const double c = fixed_c[i][o] * cq - fixed_s[i][o] * sq;
+            const double s = fixed_s[i][o] * cq + fixed_c[i][o] * sq;
+            const double angle = (op.param >= 0 ? p[op.param] : 0.0) + q[i];
+            RotateInPlace(axis, op.axis, c, s, angle, &R);
           } else {
             const double angle = (op.param >= 0 ? p[op.param] : 0.0) + q[i];
             RotateInPlace(axis, op.axis, std::cos(angle), std::sin(angle),

@@ -60,6 +60,7 @@ void Check(const Robot& robot, uint64_t seed) {
   for (int r = 0; r <= c.num_joints(); ++r) c.rows[r].p[4] += 0.01 * u(rng);
   for (auto& e : c.joint_errors)
     for (double& v : e) v = 1e-3 * u(rng);
+  c.joint_errors[1].fill(0.0);  // a joint without errors (read angle's trig)
   for (double& v : c.drift) v = 1e-3 * u(rng);
   for (int i = 0; i < 3; ++i) {
     state.meas_from_base[i] = 0.3 * u(rng);
