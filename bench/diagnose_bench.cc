@@ -8,6 +8,7 @@
 //   5. (--only ur10) the UR10 series C timing at 240 and 2773 poses, the
 //      path before the exact-Jacobian refits and now, in one run, with the
 //      comparison of their results (--repeat R runs each, median; default 3);
+//      (--only ur10-240: the 240 poses only);
 //   6. (--only compare) the diagnose tests' simulated cases, before and now.
 // Usage: diagnose_bench [--runs N] (N seeds per rate, default 40).
 
@@ -141,7 +142,7 @@ DiagnosisResult Timed(const Robot& robot, const Observations& obs,
 // the path before (DiagnoseOptions::exact_jacobian = false: Ceres autodiff
 // refits, as on main before the speed-up) and now, in one run; medians of
 // `repeat` runs each, and the comparison of the results.
-void Ur10Timing(int repeat) {
+void Ur10Timing(int repeat, bool small_only) {
   const std::string dir =
       std::string(KINCAL_SOURCE_DIR) + "/../shared/data/ipa-robot-accuracy/";
   const std::string file = dir + "Series_C/measurements_random_poses.csv";
@@ -160,6 +161,7 @@ void Ur10Timing(int repeat) {
       "wall / process CPU seconds (2 threads)\n",
       repeat);
   for (const Observations* obs : {&small, &all}) {
+    if (small_only && obs == &all) break;
     DiagnosisResult results[2];
     for (int fast = 0; fast < 2; ++fast) {
       DiagnoseOptions o;
@@ -330,7 +332,8 @@ int main(int argc, char** argv) {
   }
   const kincal::Robot bh7 = kincal::Bh7();
   if (only.empty() || only == "timing") kincal::Timing(bh7);
-  if (only == "ur10") kincal::Ur10Timing(repeat);
+  if (only == "ur10") kincal::Ur10Timing(repeat, false);
+  if (only == "ur10-240") kincal::Ur10Timing(repeat, true);
   if (only == "compare") kincal::CompareTestCases();
   if (only.empty() || only == "backlash") kincal::SmallestBacklash(bh7, runs);
   if (only.empty() || only == "null") kincal::FalseAlarms(bh7, runs);
