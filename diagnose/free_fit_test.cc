@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include "diagnose/model_diagnosis.h"
 #include "synth/simulate.h"
 #include "tests/testing/paths.h"
 
@@ -74,6 +75,46 @@ TEST(FreeFitTest, SameOptimumAsFit) {
       EXPECT_NEAR(exact.covariance(i, j), fit.covariance(i, j), 1e-4 * scale);
     }
   }
+}
+
+// The whole diagnosis on both refit paths (DiagnoseOptions::exact_jacobian)
+// with a validation series: same findings, magnitudes, intervals, held-out
+// and validation figures.
+TEST(FreeFitTest, DiagnosisSameOnBothPaths) {
+  const Robot ur10 =
+      ReadRobotYaml(testing::SourceDir() + "/data/robots/ur10.yaml");
+  auto sim = [&](uint64_t seed) {
+    SimulateOptions so;
+    so.poses = 150;
+    so.seed = seed;
+    so.effects = {ParseEffect("mount_compliance:0.03", ur10),
+                  ParseEffect("cyclic:elbow_joint:0.05", ur10)};
+    return Simulate(ur10, so);
+  };
+  const SimulatedSession train = sim(5), other = sim(6);
+  DiagnosisResult r[2];
+  for (int exact = 0; exact < 2; ++exact) {
+    DiagnoseOptions o;
+    o.exact_jacobian = exact == 1;
+    o.validation = {other.observations};
+    r[exact] = DiagnoseModel(train.nominal, train.observations, o);
+  }
+  ASSERT_EQ(r[0].findings.size(), r[1].findings.size());
+  ASSERT_GE(r[1].findings.size(), 2u);
+  for (size_t i = 0; i < r[0].findings.size(); ++i) {
+    const Finding &a = r[0].findings[i], &b = r[1].findings[i];
+    EXPECT_EQ(a.cause, b.cause);
+    EXPECT_EQ(a.joint, b.joint);
+    const double sigma = (a.ci_high - a.ci_low) / 3.92;
+    EXPECT_NEAR(a.magnitude, b.magnitude, 0.01 * sigma) << a.cause;
+    EXPECT_NEAR(a.ci_high - a.ci_low, b.ci_high - b.ci_low, 0.01 * sigma);
+    EXPECT_NEAR(a.heldout_rms_after_mm, b.heldout_rms_after_mm,
+                1e-4 * a.heldout_rms_after_mm);
+    EXPECT_NEAR(a.validation_rms_after_mm, b.validation_rms_after_mm,
+                1e-4 * a.validation_rms_after_mm);
+  }
+  EXPECT_NEAR(r[0].final_validation_rms_mm, r[1].final_validation_rms_mm,
+              1e-4 * r[0].final_validation_rms_mm);
 }
 
 }  // namespace

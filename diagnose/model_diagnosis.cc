@@ -2,6 +2,7 @@
 
 #include <Eigen/QR>
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <chrono>
 #include <cmath>
@@ -210,6 +211,24 @@ double ValidationRms(const ModelState& state,
   return Rms(s, validation);
 }
 
+// The same with the exact-Jacobian fit (diagnose/free_fit.h) of the frame,
+// started from `frame` (the current model's registered frame on the
+// validation series) instead of Umeyama: same problem, calib/fit.h's
+// tolerances.
+double ValidationRmsFrom(const ModelState& state,
+                         const std::array<double, kFrameBlockSize>& frame,
+                         const std::vector<Measurement>& validation) {
+  if (validation.empty()) return kNaN;
+  ModelState s = state;
+  s.meas_from_base = frame;
+  FreeFitOptions o;
+  o.free = FrameParams();
+  o.max_iterations = 200;
+  o.function_tolerance = o.parameter_tolerance = 1e-12;
+  const double rss = FreeFit(validation, o, &s);
+  return std::sqrt(rss / static_cast<double>(validation.size()));
+}
+
 ModelState StateWithChain(const Chain& chain) {
   ModelState s;
   s.chain = chain;
@@ -290,6 +309,14 @@ DiagnosisResult DiagnoseModel(const Robot& nominal, const Observations& obs,
   for (int step = 0; step < options.max_findings && !pool.empty() &&
                      current_rss > kExactMm * kExactMm * n_res;
        ++step) {
+    // The current model's measuring frame on the validation series: the
+    // start of every candidate's re-registration.
+    std::array<double, kFrameBlockSize> validation_frame{};
+    if (!validation.empty()) {
+      ModelState v = current;
+      InitializeFrameAndPoints(validation, &v);
+      validation_frame = v.meas_from_base;
+    }
     // Identifiability of each candidate against the current model
     // (residuals and Jacobians: diagnose/exact_jacobian.h).
     // exact_jacobian = false: calib/fit.h's autodiff, as before.
@@ -441,7 +468,10 @@ DiagnosisResult DiagnoseModel(const Robot& nominal, const Observations& obs,
           pb.held.empty() || s.heldout_rms_mm < current_held;
       const double explained_mm =
           std::sqrt(drop / static_cast<double>(pb.train.size()));
-      s.validation_rms_mm = ValidationRms(states[c], validation);
+      s.validation_rms_mm =
+          options.exact_jacobian
+              ? ValidationRmsFrom(states[c], validation_frame, validation)
+              : ValidationRms(states[c], validation);
       const bool validation_better =
           validation.empty() || s.validation_rms_mm < current_validation;
       s.significant = std::log(alpha) > log_p[c] && held_better &&
