@@ -22,12 +22,24 @@ struct FreeFitOptions {
   int max_iterations = 100;
   double function_tolerance = 1e-10;
   double parameter_tolerance = 1e-10;
+  // true: Levenberg-Marquardt on the exact Jacobian of
+  // diagnose/exact_jacobian.h (one pass per pose for all columns); false:
+  // Ceres with autodiff in the free parameters (the speed reference).
+  bool exact_jacobian = true;
 };
 
 // Fits the free parameters of `state` to the measured rows (kMeasured
 // only); returns the final sum of squared residuals, mm^2.
 double FreeFit(const std::vector<Measurement>& measurements,
                const FreeFitOptions& options, ModelState* state);
+
+// FreeFit (exact Jacobian), then, as calib/fit.h's Fit with
+// compute_covariance: sigma0 = sqrt(RSS / (3 m - p)) and the covariance
+// sigma0^2 (J^T J)^+ of the free parameters (eigenvalues below 1e-14 of the
+// largest dropped, as ceres::Covariance DENSE_SVD with null_space_rank -1).
+FitSummary FreeFitWithCovariance(const std::vector<Measurement>& measurements,
+                                 const FreeFitOptions& options,
+                                 ModelState* state);
 
 }  // namespace kincal
 

@@ -2,6 +2,7 @@
 
 #include <Eigen/QR>
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <chrono>
 #include <cmath>
@@ -17,6 +18,7 @@
 #include "data/error.h"
 #include "data/provenance.h"
 #include "data/yaml_util.h"
+#include "diagnose/exact_jacobian.h"
 #include "diagnose/free_fit.h"
 #include "diagnose/nonparametric.h"
 
@@ -74,8 +76,23 @@ struct Problem {
 };
 
 // Frame (and points) registration, identifiability, geometric fit.
+// exact: the fits by diagnose/free_fit.h's exact-Jacobian path (same
+// problem, same bounds, calib/fit.h's tolerances).
 void FitBase(const std::vector<Measurement>& fit_on, const std::string& source,
-             Problem* pb) {
+             Problem* pb, bool exact = false) {
+  auto fit = [&](const FitOptions& fo, ModelState* state) {
+    if (!exact) {
+      Fit(fit_on, fo, state);
+      return;
+    }
+    FreeFitOptions ffo;
+    ffo.free = fo.free;
+    ffo.bounds_center = fo.bounds_center;
+    ffo.max_iterations = fo.max_iterations;
+    ffo.function_tolerance = fo.function_tolerance;
+    ffo.parameter_tolerance = fo.parameter_tolerance;
+    FreeFit(fit_on, ffo, state);
+  };
   ModelState& state = pb->base_state;
   InitializeFrameAndPoints(fit_on, &state);
   std::vector<ParamInfo> nuisance;
@@ -88,7 +105,7 @@ void FitBase(const std::vector<Measurement>& fit_on, const std::string& source,
   FitOptions frame_only;
   frame_only.free = nuisance;
   frame_only.compute_covariance = false;
-  Fit(fit_on, frame_only, &state);
+  fit(frame_only, &state);
 
   std::vector<ParamInfo> candidates = nuisance;
   for (const ParamInfo& p : GeometryParams(state.chain))
@@ -121,7 +138,7 @@ void FitBase(const std::vector<Measurement>& fit_on, const std::string& source,
   geo.free = pb->base_free;
   geo.bounds_center = &pb->nominal;
   geo.compute_covariance = false;
-  Fit(fit_on, geo, &state);
+  fit(geo, &state);
 }
 
 // Measurements of `obs` with the validity checks of the spec.
@@ -194,6 +211,24 @@ double ValidationRms(const ModelState& state,
   return Rms(s, validation);
 }
 
+// The same with the exact-Jacobian fit (diagnose/free_fit.h) of the frame,
+// started from `frame` (the current model's registered frame on the
+// validation series) instead of Umeyama: same problem, calib/fit.h's
+// tolerances.
+double ValidationRmsFrom(const ModelState& state,
+                         const std::array<double, kFrameBlockSize>& frame,
+                         const std::vector<Measurement>& validation) {
+  if (validation.empty()) return kNaN;
+  ModelState s = state;
+  s.meas_from_base = frame;
+  FreeFitOptions o;
+  o.free = FrameParams();
+  o.max_iterations = 200;
+  o.function_tolerance = o.parameter_tolerance = 1e-12;
+  const double rss = FreeFit(validation, o, &s);
+  return std::sqrt(rss / static_cast<double>(validation.size()));
+}
+
 ModelState StateWithChain(const Chain& chain) {
   ModelState s;
   s.chain = chain;
@@ -239,7 +274,7 @@ DiagnosisResult DiagnoseModel(const Robot& nominal, const Observations& obs,
   pb.held = Pick(pb.all, held_idx);
   out.train_poses = static_cast<int>(pb.train.size());
   out.heldout_poses = static_cast<int>(pb.held.size());
-  FitBase(pb.train, obs.source, &pb);
+  FitBase(pb.train, obs.source, &pb, options.exact_jacobian);
 
   ModelState current = pb.base_state;
   std::vector<ParamInfo> current_free = pb.base_free;
@@ -274,14 +309,28 @@ DiagnosisResult DiagnoseModel(const Robot& nominal, const Observations& obs,
   for (int step = 0; step < options.max_findings && !pool.empty() &&
                      current_rss > kExactMm * kExactMm * n_res;
        ++step) {
-    // Identifiability of each candidate against the current model.
-    const Eigen::MatrixXd base_raw =
-        ResidualJacobian(pb.train, current, current_free);
-    const Eigen::MatrixXd basis = Basis(Normalized(base_raw));
-    Eigen::VectorXd r0(3 * pb.train.size());
-    for (size_t i = 0; i < pb.train.size(); ++i) {
-      r0.segment<3>(3 * i) = Residual(current, pb.train[i]);
+    // The current model's measuring frame on the validation series: the
+    // start of every candidate's re-registration.
+    std::array<double, kFrameBlockSize> validation_frame{};
+    if (!validation.empty()) {
+      ModelState v = current;
+      InitializeFrameAndPoints(validation, &v);
+      validation_frame = v.meas_from_base;
     }
+    // Identifiability of each candidate against the current model
+    // (residuals and Jacobians: diagnose/exact_jacobian.h).
+    // exact_jacobian = false: calib/fit.h's autodiff, as before.
+    Eigen::VectorXd r0;
+    Eigen::MatrixXd base_raw;
+    if (options.exact_jacobian) {
+      ResidualsAndJacobian(pb.train, current, current_free, &r0, &base_raw);
+    } else {
+      base_raw = ResidualJacobian(pb.train, current, current_free);
+      r0.resize(3 * pb.train.size());
+      for (size_t i = 0; i < pb.train.size(); ++i)
+        r0.segment<3>(3 * i) = Residual(current, pb.train[i]);
+    }
+    const Eigen::MatrixXd basis = Basis(Normalized(base_raw));
     // One Jacobian for all candidates' parameters, sliced per candidate.
     std::vector<ParamInfo> all_params;
     std::vector<int> first(pool.size());
@@ -290,8 +339,17 @@ DiagnosisResult DiagnoseModel(const Robot& nominal, const Observations& obs,
       first[c] = static_cast<int>(all_params.size());
       for (const ParamInfo& q : pool[c].params) all_params.push_back(q);
     }
-    const Eigen::MatrixXd cand_jac =
-        ResidualJacobian(pb.train, current, all_params);
+    Eigen::MatrixXd cand_jac;
+    if (options.exact_jacobian) {
+      Eigen::VectorXd unused;
+      ResidualsAndJacobian(pb.train, current, all_params, &unused, &cand_jac);
+    } else {
+      cand_jac = ResidualJacobian(pb.train, current, all_params);
+    }
+    // Normal equations of the base model, shared by every candidate's
+    // Gauss-Newton start.
+    const Eigen::MatrixXd base_ntn = base_raw.transpose() * base_raw;
+    const Eigen::VectorXd base_ntr = base_raw.transpose() * r0;
     std::vector<bool> usable(pool.size());
     for (size_t c = 0; c < pool.size(); ++c) {
       const int k = static_cast<int>(pool[c].params.size());
@@ -325,21 +383,40 @@ DiagnosisResult DiagnoseModel(const Robot& nominal, const Observations& obs,
       fo.free = current_free;
       for (const ParamInfo& q : cand.params) fo.free.push_back(q);
       // Start from the Gauss-Newton step of the linearised joint model, so
-      // that Ceres needs few iterations.
-      Eigen::MatrixXd a(base_raw.rows(), base_raw.cols() + s.k);
+      // that the refit needs few iterations: normal equations of [base,
+      // candidate columns], Jacobi-scaled.
+      const int pb_cols = static_cast<int>(base_raw.cols());
+      Eigen::MatrixXd cc(base_raw.rows(), s.k);
       for (int q = 0; q < s.k; ++q) {
         int col = first[c];
         while (all_params[col].name != cand.params[q].name) ++col;
-        a.col(base_raw.cols() + q) = cand_jac.col(col);
+        cc.col(q) = cand_jac.col(col);
       }
-      a.leftCols(base_raw.cols()) = base_raw;
-      Eigen::VectorXd scale(a.cols());
-      for (int q = 0; q < a.cols(); ++q) {
-        scale[q] = a.col(q).norm() > 0 ? 1.0 / a.col(q).norm() : 1.0;
+      Eigen::MatrixXd ntn(pb_cols + s.k, pb_cols + s.k);
+      ntn.topLeftCorner(pb_cols, pb_cols) = base_ntn;
+      ntn.topRightCorner(pb_cols, s.k) = base_raw.transpose() * cc;
+      ntn.bottomLeftCorner(s.k, pb_cols) =
+          ntn.topRightCorner(pb_cols, s.k).transpose();
+      ntn.bottomRightCorner(s.k, s.k) = cc.transpose() * cc;
+      Eigen::VectorXd ntr(pb_cols + s.k);
+      ntr.head(pb_cols) = base_ntr;
+      ntr.tail(s.k) = cc.transpose() * r0;
+      Eigen::VectorXd scale(ntn.cols());
+      for (int q = 0; q < ntn.cols(); ++q) {
+        scale[q] = ntn(q, q) > 0 ? 1.0 / std::sqrt(ntn(q, q)) : 1.0;
       }
-      const Eigen::VectorXd step =
-          scale.asDiagonal() *
-          (a * scale.asDiagonal()).colPivHouseholderQr().solve(-r0);
+      Eigen::VectorXd step;
+      if (options.exact_jacobian) {
+        step =
+            scale.asDiagonal() * (scale.asDiagonal() * ntn * scale.asDiagonal())
+                                     .ldlt()
+                                     .solve(-(scale.asDiagonal() * ntr));
+      } else {  // QR of the scaled Jacobian, as before
+        Eigen::MatrixXd a(base_raw.rows(), pb_cols + s.k);
+        a << base_raw, cc;
+        step = scale.asDiagonal() *
+               (a * scale.asDiagonal()).colPivHouseholderQr().solve(-r0);
+      }
       for (int q = 0; q < static_cast<int>(fo.free.size()); ++q) {
         if (std::isfinite(step[q]))
           *ParamAddress(&states[c], fo.free[q]) += step[q];
@@ -356,14 +433,29 @@ DiagnosisResult DiagnoseModel(const Robot& nominal, const Observations& obs,
       ffo.max_iterations = fo.max_iterations;
       ffo.function_tolerance = fo.function_tolerance;
       ffo.parameter_tolerance = fo.parameter_tolerance;
+      ffo.exact_jacobian = options.exact_jacobian;
       if (options.free_parameter_fit) {
         FreeFit(pb.train, ffo, &states[c]);
       } else {
         fits[c] = Fit(pb.train, fo, &states[c]);
       }
-      s.rss = Rss(states[c], pb.train);
-      s.train_rms_mm = Rms(states[c], pb.train);
-      s.heldout_rms_mm = Rms(states[c], pb.held);
+      if (options.exact_jacobian) {
+        // The same sums from the exact Jacobian's residual pass.
+        Eigen::VectorXd rt, rh;
+        ResidualsAndJacobian(pb.train, states[c], {}, &rt, nullptr);
+        ResidualsAndJacobian(pb.held, states[c], {}, &rh, nullptr);
+        s.rss = rt.squaredNorm();
+        s.train_rms_mm =
+            std::sqrt(s.rss / static_cast<double>(pb.train.size()));
+        s.heldout_rms_mm = pb.held.empty()
+                               ? kNaN
+                               : std::sqrt(rh.squaredNorm() /
+                                           static_cast<double>(pb.held.size()));
+      } else {
+        s.rss = Rss(states[c], pb.train);
+        s.train_rms_mm = Rms(states[c], pb.train);
+        s.heldout_rms_mm = Rms(states[c], pb.held);
+      }
       const double d2 = n_res - p - s.k;
       // RSS changes at the solver's precision are no evidence.
       double drop = current_rss - s.rss;
@@ -376,7 +468,10 @@ DiagnosisResult DiagnoseModel(const Robot& nominal, const Observations& obs,
           pb.held.empty() || s.heldout_rms_mm < current_held;
       const double explained_mm =
           std::sqrt(drop / static_cast<double>(pb.train.size()));
-      s.validation_rms_mm = ValidationRms(states[c], validation);
+      s.validation_rms_mm =
+          options.exact_jacobian
+              ? ValidationRmsFrom(states[c], validation_frame, validation)
+              : ValidationRms(states[c], validation);
       const bool validation_better =
           validation.empty() || s.validation_rms_mm < current_validation;
       s.significant = std::log(alpha) > log_p[c] && held_better &&
@@ -453,7 +548,18 @@ DiagnosisResult DiagnoseModel(const Robot& nominal, const Observations& obs,
   fo.free = current_free;
   fo.bounds_center = &pb.nominal;
   fo.compute_covariance = true;
-  const FitSummary final_fit = Fit(pb.all, fo, &final_state);
+  FitSummary final_fit;
+  if (options.exact_jacobian) {
+    FreeFitOptions ffo;  // calib/fit.h's defaults
+    ffo.free = fo.free;
+    ffo.bounds_center = fo.bounds_center;
+    ffo.max_iterations = fo.max_iterations;
+    ffo.function_tolerance = fo.function_tolerance;
+    ffo.parameter_tolerance = fo.parameter_tolerance;
+    final_fit = FreeFitWithCovariance(pb.all, ffo, &final_state);
+  } else {
+    final_fit = Fit(pb.all, fo, &final_state);
+  }
   for (size_t i = 0; i < accepted.size(); ++i) {
     const Candidate& c = accepted[i];
     const Magnitude m =

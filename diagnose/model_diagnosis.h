@@ -62,6 +62,10 @@ struct DiagnoseOptions {
   // (diagnose/free_fit.h); false = calib/fit.h's Fit (the speed reference
   // of bench/diagnose_bench --only ur10).
   bool free_parameter_fit = true;
+  // With free_parameter_fit: Levenberg-Marquardt on the exact Jacobian
+  // (diagnose/exact_jacobian.h); false = Ceres with autodiff in the free
+  // parameters (the path before, bench/diagnose_bench --only ur10).
+  bool exact_jacobian = true;
   // Restrict candidates to these causes (empty = all of the catalogue).
   std::vector<std::string> causes;
   // Cross-series validation: other measured series of the same robot that

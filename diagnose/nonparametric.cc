@@ -6,6 +6,8 @@
 #include <numeric>
 #include <random>
 
+#include "diagnose/statistics.h"
+
 namespace kincal {
 namespace {
 
@@ -47,36 +49,52 @@ Scaled Standardise(const SmoothInputs& in) {
 }
 
 // Squared prediction errors for every k in Ks() of the queries `q` from the
-// references `ref` (kNN mean of their residuals) over the input subset.
+// references `ref` (kNN mean of their residuals) over the input subset. The
+// neighbours are ordered by (distance, index), a strict order, so selecting
+// them with nth_element gives the same neighbours as a full sort; queries
+// run on two threads, their errors summed in query order.
 void KnnErrors(const std::vector<std::vector<double>>& x_ref,
                const std::vector<Eigen::Vector3d>& r_ref,
                const std::vector<std::vector<double>>& x_q,
                const std::vector<Eigen::Vector3d>& r_q,
                const std::vector<int>& subset, std::vector<double>* sse) {
   const int kmax = std::min<int>(Ks().back(), static_cast<int>(x_ref.size()));
-  std::vector<std::pair<double, int>> d(x_ref.size());
-  for (size_t i = 0; i < x_q.size(); ++i) {
-    for (size_t j = 0; j < x_ref.size(); ++j) {
-      double s = 0;
-      for (int c : subset) {
-        const double t = x_q[i][c] - x_ref[j][c];
-        s += t * t;
+  const int nk = static_cast<int>(Ks().size());
+  const int nq = static_cast<int>(x_q.size());
+  std::vector<double> err(static_cast<size_t>(nq) * nk, 0.0);
+  constexpr int kThreads = 2;
+  ParallelFor(kThreads, kThreads, [&](int part) {
+    std::vector<std::pair<double, int>> d(x_ref.size());
+    for (int i = part; i < nq; i += kThreads) {
+      for (size_t j = 0; j < x_ref.size(); ++j) {
+        double s = 0;
+        for (int c : subset) {
+          const double t = x_q[i][c] - x_ref[j][c];
+          s += t * t;
+        }
+        d[j] = {s, static_cast<int>(j)};
       }
-      d[j] = {s, static_cast<int>(j)};
-    }
-    std::partial_sort(d.begin(), d.begin() + kmax, d.end());
-    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-    size_t next_k = 0;
-    for (int a = 0; a < kmax && next_k < Ks().size(); ++a) {
-      sum += r_ref[d[a].second];
-      while (next_k < Ks().size() && Ks()[next_k] == a + 1) {
-        (*sse)[next_k] += (r_q[i] - sum / (a + 1)).squaredNorm();
-        ++next_k;
+      if (kmax > 0) {
+        std::nth_element(d.begin(), d.begin() + (kmax - 1), d.end());
+        std::sort(d.begin(), d.begin() + kmax);
       }
+      double* e = &err[static_cast<size_t>(i) * nk];
+      Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+      int next_k = 0;
+      for (int a = 0; a < kmax && next_k < nk; ++a) {
+        sum += r_ref[d[a].second];
+        while (next_k < nk && Ks()[next_k] == a + 1) {
+          e[next_k] = (r_q[i] - sum / (a + 1)).squaredNorm();
+          ++next_k;
+        }
+      }
+      for (; next_k < nk; ++next_k)  // fewer references than k
+        e[next_k] = (r_q[i] - sum / kmax).squaredNorm();
     }
-    for (; next_k < Ks().size(); ++next_k)  // fewer references than k
-      (*sse)[next_k] += (r_q[i] - sum / kmax).squaredNorm();
-  }
+  });
+  for (int i = 0; i < nq; ++i)
+    for (int k = 0; k < nk; ++k)
+      (*sse)[k] += err[static_cast<size_t>(i) * nk + k];
 }
 
 // Cross-validated share of the residual power explained; best k.

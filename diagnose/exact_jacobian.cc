@@ -1,0 +1,341 @@
+#include "diagnose/exact_jacobian.h"
+
+#include <ceres/jet.h>
+
+#include <Eigen/Geometry>
+#include <array>
+#include <cmath>
+
+#include "data/error.h"
+
+namespace kincal {
+namespace {
+
+constexpr int kMaxJoints = 16;
+
+// One elementary operation of a row: a rotation about or a translation
+// along a unit axis of the frame it acts in. `param` is the row block entry
+// it carries (-1: none), `joint` whether the joint value enters it.
+struct Op {
+  bool rotation = false;
+  Eigen::Vector3d axis = Eigen::Vector3d::UnitZ();
+  int param = -1;
+  bool joint = false;
+};
+
+// The row's operations in order (calib/chain.h RowTransform).
+int RowOps(Convention convention, const ChainRow& row, Op* ops) {
+  const bool revolute = row.type == JointType::kRevolute;
+  const bool prismatic = row.type == JointType::kPrismatic;
+  const Eigen::Vector3d x = Eigen::Vector3d::UnitX(),
+                        y = Eigen::Vector3d::UnitY(),
+                        z = Eigen::Vector3d::UnitZ();
+  switch (convention) {
+    case Convention::kDh:  // Rz(theta + q) Tz(d + q) Tx(a) Rx(alpha) Ry(beta)
+      ops[0] = {true, z, 0, revolute};
+      ops[1] = {false, z, 1, prismatic};
+      ops[2] = {false, x, 2, false};
+      ops[3] = {true, x, 3, false};
+      ops[4] = {true, y, 4, false};
+      return 5;
+    case Convention::kMdh:  // Rx(alpha) Ry(beta) Tx(a) Rz(theta + q) Tz(d + q)
+      ops[0] = {true, x, 3, false};
+      ops[1] = {true, y, 4, false};
+      ops[2] = {false, x, 2, false};
+      ops[3] = {true, z, 0, revolute};
+      ops[4] = {false, z, 1, prismatic};
+      return 5;
+    case Convention::kUrdf: {  // T(xyz) Rz(yaw) Ry(pitch) Rx(roll) joint
+      ops[0] = {false, x, 0, false};
+      ops[1] = {false, y, 1, false};
+      ops[2] = {false, z, 2, false};
+      ops[3] = {true, z, 5, false};
+      ops[4] = {true, y, 4, false};
+      ops[5] = {true, x, 3, false};
+      if (revolute || prismatic) {
+        ops[6] = {revolute, row.axis.normalized(), -1, true};
+        return 7;
+      }
+      return 6;
+    }
+  }
+  return 0;
+}
+
+// Row block entries that are lengths (scaled by the thermal family).
+bool IsLength(Convention convention, int index) {
+  return convention == Convention::kUrdf ? index < 3
+                                         : (index == 1 || index == 2);
+}
+
+Eigen::Matrix3d AxisRotation(const Eigen::Vector3d& axis, double angle) {
+  return Eigen::AngleAxisd(angle, axis).toRotationMatrix();
+}
+
+// 0, 1, 2 when `axis` is the x, y or z unit vector, else -1.
+int CoordinateAxis(const Eigen::Vector3d& axis) {
+  for (int c = 0; c < 3; ++c)
+    if (axis == Eigen::Vector3d::Unit(c)) return c;
+  return -1;
+}
+
+// R <- R * rotation(axis, angle): about a coordinate axis only two columns
+// change; any other axis by the full product.
+void RotateInPlace(int coordinate, const Eigen::Vector3d& axis, double c,
+                   double s, double angle, Eigen::Matrix3d* R) {
+  if (coordinate < 0) {
+    *R = *R * AxisRotation(axis, angle);
+    return;
+  }
+  const int a = (coordinate + 1) % 3, b = (coordinate + 2) % 3;
+  const Eigen::Vector3d ca = R->col(a), cb = R->col(b);
+  R->col(a) = c * ca + s * cb;
+  R->col(b) = c * cb - s * ca;
+}
+
+}  // namespace
+
+void ResidualsAndJacobian(const std::vector<Measurement>& measurements,
+                          const ModelState& state,
+                          const std::vector<ParamInfo>& params,
+                          Eigen::VectorXd* r, Eigen::MatrixXd* J) {
+  const Chain& chain = state.chain;
+  const int n = chain.num_joints();
+  KINCAL_CHECK(n <= kMaxJoints, "too many joints");
+  const int m = static_cast<int>(measurements.size());
+  const int k = static_cast<int>(params.size());
+  r->setZero(3 * m);
+  const bool jacobian = J != nullptr && k > 0;
+  if (J != nullptr) J->setZero(3 * m, k);
+  // Operations of every row, and the rotations that do not depend on the
+  // pose (every rotation but the joint's own).
+  std::array<std::array<Op, 7>, kMaxJoints + 1> ops;
+  std::array<std::array<double, 7>, kMaxJoints + 1> fixed_c, fixed_s;
+  std::array<std::array<int, 7>, kMaxJoints + 1> coordinate;
+  std::array<int, kMaxJoints + 1> num_ops;
+  for (int i = 0; i <= n; ++i) {
+    num_ops[i] = RowOps(chain.convention, chain.rows[i], ops[i].data());
+    for (int o = 0; o < num_ops[i]; ++o) {
+      const Op& op = ops[i][o];
+      coordinate[i][o] = CoordinateAxis(op.axis);
+      // The row entry's angle (for a joint's rotation: its offset theta).
+      fixed_c[i][o] = 1.0;
+      fixed_s[i][o] = 0.0;
+      if (op.rotation && op.param >= 0) {
+        fixed_c[i][o] = std::cos(chain.rows[i].p[op.param]);
+        fixed_s[i][o] = std::sin(chain.rows[i].p[op.param]);
+      }
+    }
+  }
+  // The measuring frame is linear in the point, ApplyFrame(f, p) = R p + t:
+  // R and dR / d(rotation vector) from the shared ApplyFrame (autodiff).
+  using Jet3 = ceres::Jet<double, 3>;
+  Eigen::Matrix3d frame_r, frame_dr[3];
+  {
+    Jet3 f[kFrameBlockSize];
+    for (int e = 0; e < kFrameBlockSize; ++e)
+      f[e] = e < 3 ? Jet3(state.meas_from_base[e], e) : Jet3(0.0);
+    for (int c = 0; c < 3; ++c) {
+      Vec3<Jet3> unit(Jet3(0.0), Jet3(0.0), Jet3(0.0));
+      unit[c] = Jet3(1.0);
+      const Vec3<Jet3> col = ApplyFrame(f, unit);
+      for (int a = 0; a < 3; ++a) {
+        frame_r(a, c) = col[a].a;
+        for (int d = 0; d < 3; ++d) frame_dr[d](a, c) = col[a].v[d];
+      }
+    }
+  }
+  const Eigen::Vector3d frame_t(state.meas_from_base[3],
+                                state.meas_from_base[4],
+                                state.meas_from_base[5]);
+
+  // Which hooks need derivatives: joint values of joints with a free joint
+  // error entry (thermal aside), the global block.
+  bool need_dq[kMaxJoints] = {};
+  bool need_global = false;
+  for (const ParamInfo& p : params) {
+    if (!jacobian) break;
+    if (p.kind == ParamKind::kJointError && p.index != kThermal)
+      need_dq[p.block] = true;
+    if (p.kind == ParamKind::kDrift) need_global = true;
+  }
+  using JetE = ceres::Jet<double, kJointErrorBlockSize>;
+  using Jet9 = ceres::Jet<double, 9>;
+  for (int pose = 0; pose < m; ++pose) {
+    const Measurement& meas = measurements[pose];
+    if (meas.kind != Measurement::kMeasured) continue;
+    const PoseInput& in = meas.input;
+    // Joint values (calib/chain.h TipInBase) and, for the Jacobian, their
+    // derivatives by the joint error entries.
+    const bool masses = static_cast<int>(in.tau_mass.size()) == n;
+    const bool trig = static_cast<int>(in.trig.size()) == 2 * kMaxHarmonic * n;
+    double q[kMaxJoints];
+    Eigen::Matrix<double, kJointErrorBlockSize, 1> dq[kMaxJoints];
+    for (int j = 0; j < n; ++j) {
+      const double tm = masses ? in.tau_mass[j] : 0.0;
+      const double* tr = trig ? &in.trig[2 * kMaxHarmonic * j] : nullptr;
+      const JointType type = chain.rows[j].type;
+      if (!need_dq[j]) {
+        const double* e = chain.joint_errors[j].data();
+        q[j] = trig ? ModelJointValueTrig<double>(type, in.q[j], in.s[j],
+                                                  in.tau[j], e, tm, tr)
+                    : ModelJointValue<double>(type, in.q[j], in.s[j], in.tau[j],
+                                              e, tm);
+        continue;
+      }
+      JetE e[kJointErrorBlockSize];
+      for (int t = 0; t < kJointErrorBlockSize; ++t)
+        e[t] = JetE(chain.joint_errors[j][t], t);
+      const JetE qj = trig ? ModelJointValueTrig<JetE>(type, in.q[j], in.s[j],
+                                                       in.tau[j], e, tm, tr)
+                           : ModelJointValue<JetE>(type, in.q[j], in.s[j],
+                                                   in.tau[j], e, tm);
+      q[j] = qj.a;
+      dq[j] = qj.v;
+    }
+    // Thermal scaling of the rows' lengths (calib/chain.h TipInBase).
+    const bool thermal = in.thermal_x != 0.0;
+    double factor[kMaxJoints + 1];
+    for (int i = 0; i <= n; ++i) {
+      factor[i] = thermal && i < n
+                      ? 1.0 + chain.joint_errors[i][kThermal] * in.thermal_x
+                      : 1.0;
+    }
+    // Forward pass: axis and origin of every operation in the base frame.
+    Eigen::Vector3d axis_w[kMaxJoints + 1][7], origin_w[kMaxJoints + 1][7];
+    Eigen::Matrix3d R = Eigen::Matrix3d::Identity();
+    Eigen::Vector3d t = Eigen::Vector3d::Zero();
+    for (int i = 0; i <= n; ++i) {
+      const RowBlock& p = chain.rows[i].p;
+      for (int o = 0; o < num_ops[i]; ++o) {
+        const Op& op = ops[i][o];
+        const int axis = coordinate[i][o];
+        const Eigen::Vector3d w = axis >= 0 ? Eigen::Vector3d(R.col(axis))
+                                            : Eigen::Vector3d(R * op.axis);
+        if (jacobian) {
+          axis_w[i][o] = w;
+          origin_w[i][o] = t;
+        }
+        if (op.rotation) {
+          if (!op.joint) {
+            if (fixed_s[i][o] != 0.0 || fixed_c[i][o] != 1.0)
+              RotateInPlace(axis, op.axis, fixed_c[i][o], fixed_s[i][o],
+                            p[op.param], &R);
+          } else if (trig && q[i] == in.q[i]) {
+            // No joint error: cos / sin of theta + q from the read angle's
+            // precomputed ones (PoseInput::trig).
+            const double cq = in.trig[2 * kMaxHarmonic * i];
+            const double sq = in.trig[2 * kMaxHarmonic * i + 1];
+            const double c = fixed_c[i][o] * cq - fixed_s[i][o] * sq;
+            const double s = fixed_s[i][o] * cq + fixed_c[i][o] * sq;
+            const double angle = (op.param >= 0 ? p[op.param] : 0.0) + q[i];
+            RotateInPlace(axis, op.axis, c, s, angle, &R);
+          } else {
+            const double angle = (op.param >= 0 ? p[op.param] : 0.0) + q[i];
+            RotateInPlace(axis, op.axis, std::cos(angle), std::sin(angle),
+                          angle, &R);
+          }
+        } else {
+          double amount = op.param >= 0 ? p[op.param] : 0.0;
+          if (op.param >= 0 && IsLength(chain.convention, op.param))
+            amount *= factor[i];
+          if (op.joint) amount += q[i];
+          t += w * amount;
+        }
+      }
+    }
+    const Eigen::Vector3d tip = t;  // before drift and mount tilt
+    // Drift and mount tilt (calib/chain.h TipInBase), then the frame.
+    const Eigen::Vector3d drifted =
+        tip + Eigen::Vector3d(chain.drift[0], chain.drift[1], chain.drift[2]) *
+                  in.t_h;
+    const Vec3<double> tilted =
+        MountTilt<double>(chain.drift.data(), in.moment, drifted);
+    r->segment<3>(3 * pose) = frame_r * tilted + frame_t - meas.p_in_meas;
+    if (!jacobian) continue;
+
+    auto d_op = [&](int i, int o) -> Eigen::Vector3d {
+      return ops[i][o].rotation
+                 ? Eigen::Vector3d(axis_w[i][o].cross(tip - origin_w[i][o]))
+                 : axis_w[i][o];
+    };
+    // d tip / d scaled row entry, d tip / d q.
+    Eigen::Vector3d d_row[kMaxJoints + 1][kRowBlockSize];
+    Eigen::Vector3d d_q[kMaxJoints];
+    for (int i = 0; i <= n; ++i) {
+      for (int e = 0; e < kRowBlockSize; ++e) d_row[i][e].setZero();
+      if (i < n) d_q[i].setZero();
+      for (int o = 0; o < num_ops[i]; ++o) {
+        const Eigen::Vector3d d = d_op(i, o);
+        if (ops[i][o].param >= 0) d_row[i][ops[i][o].param] += d;
+        if (ops[i][o].joint && i < n) d_q[i] += d;
+      }
+    }
+    // Mount tilt (the shared hook, autodiff): inputs global[0..5] | p, or
+    // p only when no global entry is free.
+    Eigen::Matrix3d d_mount_p;
+    Eigen::Matrix<double, 3, 6> d_global = Eigen::Matrix<double, 3, 6>::Zero();
+    if (need_global) {
+      Jet9 g[kDriftBlockSize];
+      for (int e = 0; e < kDriftBlockSize; ++e) g[e] = Jet9(chain.drift[e], e);
+      const Vec3<Jet9> pm(Jet9(drifted[0], 6), Jet9(drifted[1], 7),
+                          Jet9(drifted[2], 8));
+      const Vec3<Jet9> tilt = MountTilt(g, in.moment, pm);
+      for (int a = 0; a < 3; ++a) {
+        d_global.row(a) = tilt[a].v.head<6>().transpose();
+        d_mount_p.row(a) = tilt[a].v.tail<3>().transpose();
+      }
+    } else {
+      using Jet3p = ceres::Jet<double, 3>;
+      Jet3p g[kDriftBlockSize];
+      for (int e = 0; e < kDriftBlockSize; ++e) g[e] = Jet3p(chain.drift[e]);
+      const Vec3<Jet3p> pm(Jet3p(drifted[0], 0), Jet3p(drifted[1], 1),
+                           Jet3p(drifted[2], 2));
+      const Vec3<Jet3p> tilt = MountTilt(g, in.moment, pm);
+      for (int a = 0; a < 3; ++a) d_mount_p.row(a) = tilt[a].v.transpose();
+    }
+    const Eigen::Matrix3d d_tip = frame_r * d_mount_p;  // dr / d tip
+    d_global = frame_r * d_global;
+    for (int c = 0; c < k; ++c) {
+      const ParamInfo& p = params[c];
+      Eigen::Vector3d col = Eigen::Vector3d::Zero();
+      switch (p.kind) {
+        case ParamKind::kRow: {
+          const int i = p.block;
+          col = d_tip * d_row[i][p.index];
+          if (IsLength(chain.convention, p.index)) col *= factor[i];
+          break;
+        }
+        case ParamKind::kJointError: {
+          const int j = p.block;
+          if (p.index == kThermal) {
+            Eigen::Vector3d d = Eigen::Vector3d::Zero();
+            if (thermal) {
+              for (int e = 0; e < kRowBlockSize; ++e) {
+                if (IsLength(chain.convention, e))
+                  d += d_row[j][e] * (chain.rows[j].p[e] * in.thermal_x);
+              }
+            }
+            col = d_tip * d;
+          } else {
+            col = d_tip * d_q[j] * dq[j][p.index];
+          }
+          break;
+        }
+        case ParamKind::kDrift:
+          col = d_global.col(p.index);
+          if (p.index < 3) col += d_tip.col(p.index) * in.t_h;
+          break;
+        case ParamKind::kFrame:
+          col = p.index < 3 ? Eigen::Vector3d(frame_dr[p.index] * tilted)
+                            : Eigen::Vector3d::Unit(p.index - 3);
+          break;
+        case ParamKind::kPoint:
+          break;  // measured rows do not depend on fixed points
+      }
+      J->block<3, 1>(3 * pose, c) = col;
+    }
+  }
+}
+
+}  // namespace kincal
