@@ -65,18 +65,21 @@ void MakeImages(const fs::path& folder, const std::string& names) {
   }
 }
 
+// A private temporary folder, removed at exit (the path is never destroyed,
+// so the exit handler can still read it).
 const fs::path& Root() {
-  static const fs::path root = [] {
+  static const fs::path* root = [] {
     std::string tmpl =
         (fs::temp_directory_path() / "kincal_fuzz_session_XXXXXX").string();
     if (mkdtemp(tmpl.data()) == nullptr) std::abort();
+    auto* path = new fs::path(tmpl);
     std::atexit([] {
       std::error_code ec;
       fs::remove_all(Root(), ec);
     });
-    return fs::path(tmpl);
+    return path;
   }();
-  return root;
+  return *root;
 }
 
 }  // namespace
