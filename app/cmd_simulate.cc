@@ -7,6 +7,7 @@
 
 #include "app/app_util.h"
 #include "app/command.h"
+#include "app/front_end.h"
 #include "calib/model_state.h"
 #include "data/atomic_file.h"
 #include "data/error.h"
@@ -92,12 +93,21 @@ int RunSimulate(SimulateArgs args) {
   }
   if (args.no_time) opt.seconds_per_pose = 0;
   opt.measure_points = !args.no_points;
+#ifdef KINCAL_FRONT_END
+  // bin/kincal links no image code (app/front_end.h): kincal-vision renders.
+  if (args.render) return ExecImageBinary();
+  const Rig rig{};
+  Target target{};
+#else
   const Rig rig = ExampleStereoRig(args.render_width, args.render_height);
   Target target = ExampleTarget();
+#endif
   double rig_distance = 0.0;
   if (args.render) {
     args.render_options.motion_angle_deg = 30.0;
+#ifndef KINCAL_FRONT_END
     args.render_options.Check();
+#endif
     // Same seed, so the same poses and truth; only the frame is placed.
     std::array<double, 6> rig_from_base;
     rig_distance = PlaceRig(Simulate(nominal, opt).base_from_tip, rig,
@@ -184,8 +194,10 @@ int RunSimulate(SimulateArgs args) {
       in.t_s.push_back(row.HasTime() ? row.t_s : 0.0);
     }
     if (!s.observations.AnyTime()) in.t_s.clear();
+#ifndef KINCAL_FRONT_END
     rendered = RenderRecordedSession(rig, target, in, args.render_options,
                                      opt.seed, args.out + "/session");
+#endif
     WriteRigYaml(args.out + "/rig.yaml", rig);
     WriteTargetYaml(args.out + "/target.yaml", target);
   }

@@ -6,25 +6,32 @@
 # build-fuzz/findings/<target>/ and makes the script exit 1: turn it into a
 # regression test.
 # Usage: scripts/fuzz.sh [SECONDS] [target ...]   (targets: robot_yaml urdf
-#        observations_csv rig_yaml target_yaml)
+#        observations_csv rig_yaml target_yaml session_frames_csv
+#        session_folder joint_log; default: all)
+# The figures of the last long runs are in docs/TESTING.md ("Fuzzing").
 set -euo pipefail
 cd "$(dirname "$0")/.."
 SECONDS_PER_TARGET=${1:-60}
 shift || true
 TARGETS=("$@")
-[ ${#TARGETS[@]} -eq 0 ] && TARGETS=(robot_yaml urdf observations_csv rig_yaml target_yaml)
+ALL=(robot_yaml urdf observations_csv rig_yaml target_yaml session_frames_csv
+  session_folder joint_log)
+[ ${#TARGETS[@]} -eq 0 ] && TARGETS=("${ALL[@]}")
 B=build-fuzz
 CC=clang CXX=clang++ cmake -S . -B $B -DCMAKE_BUILD_TYPE=RelWithDebInfo \
   -DKINCAL_FUZZ=ON -DKINCAL_BUILD_TESTS=OFF -DKINCAL_BUILD_BENCH=OFF \
   -DCMAKE_CXX_FLAGS="-fsanitize=fuzzer-no-link,address,undefined -fno-sanitize-recover=undefined" \
   $(command -v ccache >/dev/null && echo -DCMAKE_CXX_COMPILER_LAUNCHER=ccache) >/dev/null
-seeds() {  # target -> seed files
+seeds() {  # target -> seed files (fuzz/seeds/<target>/ plus project files)
+  ls fuzz/seeds/$1/* 2>/dev/null || true
   case $1 in
     robot_yaml) ls data/robots/*.yaml data/sessions/*/robot.yaml ;;
     urdf) ls data/robots/*.urdf ;;
     observations_csv) ls data/sessions/*/observations.csv ;;
     rig_yaml) find . -path ./build\* -prune -o -name 'rig*.yaml' -print ;;
     target_yaml) find . -path ./build\* -prune -o -name 'target*.yaml' -print ;;
+    session_frames_csv) find . -path ./build\* -prune -o -name 'frames.csv' -print ;;
+    joint_log) find . -path ./build\* -prune -o -name 'joints*.csv' -print ;;
   esac
 }
 status=0

@@ -2,10 +2,6 @@
 
 extern "C" {
 #include <apriltag/apriltag.h>
-#include <apriltag/tag16h5.h>
-#include <apriltag/tag25h9.h>
-#include <apriltag/tag36h11.h>
-#include <apriltag/tagStandard41h12.h>
 }
 
 #include <algorithm>
@@ -14,52 +10,11 @@ extern "C" {
 #include <sstream>
 
 #include "data/error.h"
+#include "vision/tag_family.h"
 
 namespace kincal {
 
 namespace {
-
-struct FamilyFunctions {
-  const char* name;
-  apriltag_family_t* (*create)();
-  void (*destroy)(apriltag_family_t*);
-};
-
-const FamilyFunctions* FindFamily(const std::string& name) {
-  static const FamilyFunctions kFamilies[] = {
-      {"tag36h11", tag36h11_create, tag36h11_destroy},
-      {"tag25h9", tag25h9_create, tag25h9_destroy},
-      {"tag16h5", tag16h5_create, tag16h5_destroy},
-      {"tagStandard41h12", tagStandard41h12_create, tagStandard41h12_destroy},
-  };
-  for (const auto& f : kFamilies) {
-    if (name == f.name) return &f;
-  }
-  return nullptr;
-}
-
-std::string KnownFamilies() {
-  return "tag36h11, tag25h9, tag16h5, tagStandard41h12";
-}
-
-// A family instance that destroys itself.
-struct FamilyHandle {
-  explicit FamilyHandle(const std::string& name) {
-    fns = FindFamily(name);
-    if (fns == nullptr) {
-      throw InputError("unknown tag family '" + name +
-                       "' (expected one of: " + KnownFamilies() + ")");
-    }
-    family = fns->create();
-  }
-  ~FamilyHandle() {
-    if (family != nullptr) fns->destroy(family);
-  }
-  FamilyHandle(const FamilyHandle&) = delete;
-  FamilyHandle& operator=(const FamilyHandle&) = delete;
-  const FamilyFunctions* fns = nullptr;
-  apriltag_family_t* family = nullptr;
-};
 
 // Bilinear intensity at (x, y) in OpenCV pixel convention; the caller keeps
 // (x, y) at least one pixel inside the image.
@@ -117,29 +72,8 @@ bool Intersect(const Line2& a, const Line2& b, Eigen::Vector2d* p) {
 
 }  // namespace
 
-Eigen::Vector3d TagCornerInTag(int k, double size_mm) {
-  static const double kSign[4][2] = {{-1, 1}, {1, 1}, {1, -1}, {-1, -1}};
-  const int i = ((k % 4) + 4) % 4;
-  return Eigen::Vector3d(kSign[i][0] * size_mm / 2, kSign[i][1] * size_mm / 2,
-                         0.0);
-}
-
-int TagBlackSquareCells(const std::string& family) {
-  FamilyHandle f(family);
-  return f.family->width_at_border;
-}
-
-bool IsKnownTagFamily(const std::string& family) {
-  return FindFamily(family) != nullptr;
-}
-
-int TagFamilySize(const std::string& family) {
-  FamilyHandle f(family);
-  return static_cast<int>(f.family->ncodes);
-}
-
 cv::Mat TagImage(const std::string& family, int id) {
-  FamilyHandle f(family);
+  TagFamilyHandle f(family);
   if (id < 0 || id >= static_cast<int>(f.family->ncodes)) {
     std::ostringstream os;
     os << "tag id " << id << " is not in family " << family << " (0.."
@@ -178,9 +112,9 @@ void AprilTagOptions::Check() const {
     os << "apriltag detector option " << what << " = " << value;
     throw InputError(os.str());
   };
-  if (FindFamily(family) == nullptr) {
+  if (FindTagFamily(family) == nullptr) {
     throw InputError("unknown tag family '" + family +
-                     "' (expected one of: " + KnownFamilies() + ")");
+                     "' (expected one of: " + KnownTagFamilies() + ")");
   }
   if (!(quad_decimate >= 1.0))
     fail("quad_decimate (expected >= 1)", quad_decimate);
@@ -205,7 +139,7 @@ struct AprilTagDetector::Impl {
     td->decode_sharpening = o.decode_sharpening;
   }
   ~Impl() { apriltag_detector_destroy(td); }
-  FamilyHandle family;
+  TagFamilyHandle family;
   apriltag_detector_t* td = nullptr;
 };
 

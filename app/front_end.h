@@ -1,0 +1,31 @@
+#ifndef KINCAL_APP_FRONT_END_H_
+#define KINCAL_APP_FRONT_END_H_
+
+// kincal is two executables with one command surface (docs/STARTUP.md):
+//
+//   bin/kincal         every command that reads and writes no images
+//                      (calibrate, evaluate, diagnose, ...): links no image
+//                      codecs, video I/O, camera SDKs (~30 shared libraries)
+//   bin/kincal-vision  every command, built from the same sources (OpenCV's
+//                      imgcodecs and videoio alone bring GDAL, HDF5,
+//                      GStreamer...: ~270 shared libraries, 0.2-0.3 s to load)
+//
+// In bin/kincal, the image commands (camcal, track, capture, bundle) are
+// registered by app/front_end.cc with their names and descriptions only (so
+// `kincal --help` lists them) and accept any arguments; once CLI11 selects
+// one, or `simulate` is given --render, kincal replaces itself by
+// kincal-vision with the same argv (exec), so output, exit codes, provenance
+// and every --help are those of one program.
+
+namespace kincal::app {
+
+// Replaces this process by kincal-vision with this process's argv (read
+// from /proc/self/cmdline). kincal-vision is $KINCAL_VISION when set, else
+// the kincal-vision next to this executable, else
+// <dir>/../libexec/kincal/kincal-vision. Returns only on failure (message on
+// stderr; exit code 1: an incomplete installation, not bad input).
+int ExecImageBinary();
+
+}  // namespace kincal::app
+
+#endif  // KINCAL_APP_FRONT_END_H_
