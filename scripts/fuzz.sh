@@ -8,7 +8,7 @@
 # Usage: scripts/fuzz.sh [SECONDS] [target ...]   (targets: robot_yaml urdf
 #        observations_csv rig_yaml target_yaml session_frames_csv
 #        session_folder joint_log; default: all)
-# The figures of the last long runs are in docs/TESTING.md ("Fuzzing").
+# The figures of the last long runs are in docs/FUZZING.md.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 SECONDS_PER_TARGET=${1:-60}
