@@ -13,6 +13,7 @@
 
 #include "app/app_util.h"
 #include "app/command.h"
+#include "app/front_end.h"
 #include "bundle/bundle.h"
 #include "bundle/observe.h"
 #include "calib/chain.h"
@@ -339,12 +340,7 @@ int RunBundleCommand(BundleArgs args) {
 
 void AddBundleCommand(CLI::App& app, Runner* run) {
   auto args = std::make_shared<BundleArgs>();
-  CLI::App* sub = app.add_subcommand(
-      "bundle",
-      "Calibrate the robot from a recorded session's images: one Ceres "
-      "problem over every tag corner in every camera at every frame with "
-      "joint readings (robot parameters, base in the rig, target on the "
-      "flange, optionally the cameras)");
+  CLI::App* sub = app.add_subcommand("bundle", kBundleDescription);
   sub->add_option("--robot", args->robot, "robot.yaml (nominal)")->required();
   sub->add_option("--rig", args->rig, "rig.yaml (2 cameras)")->required();
   sub->add_option("--target", args->target, "target.yaml")->required();

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "app/command.h"
+#include "app/front_end.h"
 #include "camcal/calibrate_cameras.h"
 #include "camcal/rig.h"
 #include "data/error.h"
@@ -267,10 +268,7 @@ int RunCamcal(const CamcalArgs& args) {
 
 void AddCamcalCommand(CLI::App& app, Runner* run) {
   auto args = std::make_shared<CamcalArgs>();
-  CLI::App* sub = app.add_subcommand(
-      "camcal",
-      "Calibrate one camera or a stereo pair from images of a chessboard or "
-      "an AprilGrid; writes rig.yaml");
+  CLI::App* sub = app.add_subcommand("camcal", kCamcalDescription);
   sub->add_option("--left", args->left,
                   "images of the first (reference) camera, a quoted glob")
       ->required();

@@ -19,6 +19,7 @@
 #include <sstream>
 
 #include "app/command.h"
+#include "app/front_end.h"
 #include "capture/async_recorder.h"
 #include "capture/frame_source.h"
 #include "capture/joint_log.h"
@@ -605,13 +606,7 @@ int RunCapture(const CaptureArgs& args) {
 
 void AddCaptureCommand(CLI::App& app, Runner* run) {
   auto args = std::make_shared<CaptureArgs>();
-  CLI::App* sub = app.add_subcommand(
-      "capture",
-      "Record a stereo session (left/*.png, right/*.png, frames.csv, "
-      "session.yaml) from two cameras or two recordings; --list shows "
-      "cameras. Sources: v4l2:/dev/videoN?width=..&height=..&fps=..&format="
-      "GREY|YUYV|MJPG, aravis:<camera id>?exposure_us=..&gain=..&fps=..&"
-      "format=Mono8|..., folder:/path/left*.png?fps=.., video:/path/file.mp4");
+  CLI::App* sub = app.add_subcommand("capture", kCaptureDescription);
   auto* list = sub->add_flag("--list", args->list,
                              "list V4L2 devices and Aravis cameras");
   sub->add_option("--left", args->left, "left source URI")->excludes(list);

@@ -10,6 +10,7 @@
 #include <thread>
 
 #include "app/command.h"
+#include "app/front_end.h"
 #include "camcal/rig.h"
 #include "data/atomic_file.h"
 #include "data/csv.h"
@@ -302,10 +303,7 @@ int RunTrack(const TrackArgs& args) {
 
 void AddTrackCommand(CLI::App& app, Runner* run) {
   auto args = std::make_shared<TrackArgs>();
-  CLI::App* sub = app.add_subcommand(
-      "track",
-      "Needle tip in the rig frame for every stereo frame pair, from the "
-      "tool's AprilTags (writes points.csv and <out>.poses.csv)");
+  CLI::App* sub = app.add_subcommand("track", kTrackDescription);
   sub->add_option("--rig", args->rig, "rig.yaml (2 cameras)")->required();
   sub->add_option("--target", args->target, "target.yaml")->required();
   sub->add_option("--left", args->left, "left images, a glob (quote it)");

@@ -2,8 +2,8 @@
 // the command list, and the exec into kincal-vision. Built into bin/kincal
 // only; bin/kincal-vision has the real commands (cmd_camcal.cc, ...).
 //
-// The descriptions here must equal the ones in cmd_<name>.cc:
-// tests/startup.cmake compares `kincal --help` with `kincal-vision --help`.
+// The descriptions are app/front_end.h's, shared with cmd_<name>.cc
+// (tests/startup_cli_test.cc compares both executables' --help).
 
 #include "app/front_end.h"
 
@@ -76,34 +76,19 @@ int ExecImageBinary() {
 }
 
 void AddCamcalCommand(CLI::App& app, Runner* run) {
-  AddImageCommand(app, run, "camcal",
-                  "Calibrate one camera or a stereo pair from images of a "
-                  "chessboard or an AprilGrid; writes rig.yaml");
+  AddImageCommand(app, run, "camcal", kCamcalDescription);
 }
 
 void AddTrackCommand(CLI::App& app, Runner* run) {
-  AddImageCommand(app, run, "track",
-                  "Needle tip in the rig frame for every stereo frame pair, "
-                  "from the tool's AprilTags (writes points.csv and "
-                  "<out>.poses.csv)");
+  AddImageCommand(app, run, "track", kTrackDescription);
 }
 
 void AddCaptureCommand(CLI::App& app, Runner* run) {
-  AddImageCommand(
-      app, run, "capture",
-      "Record a stereo session (left/*.png, right/*.png, frames.csv, "
-      "session.yaml) from two cameras or two recordings; --list shows "
-      "cameras. Sources: v4l2:/dev/videoN?width=..&height=..&fps=..&format="
-      "GREY|YUYV|MJPG, aravis:<camera id>?exposure_us=..&gain=..&fps=..&"
-      "format=Mono8|..., folder:/path/left*.png?fps=.., video:/path/file.mp4");
+  AddImageCommand(app, run, "capture", kCaptureDescription);
 }
 
 void AddBundleCommand(CLI::App& app, Runner* run) {
-  AddImageCommand(app, run, "bundle",
-                  "Calibrate the robot from a recorded session's images: one "
-                  "Ceres problem over every tag corner in every camera at "
-                  "every frame with joint readings (robot parameters, base in "
-                  "the rig, target on the flange, optionally the cameras)");
+  AddImageCommand(app, run, "bundle", kBundleDescription);
 }
 
 }  // namespace kincal::app

@@ -19,6 +19,26 @@
 
 namespace kincal::app {
 
+// The image commands' descriptions in the command list, one text for both
+// executables (cmd_<name>.cc registers the real command with it).
+inline constexpr char kCamcalDescription[] =
+    "Calibrate one camera or a stereo pair from images of a chessboard or an "
+    "AprilGrid; writes rig.yaml";
+inline constexpr char kTrackDescription[] =
+    "Needle tip in the rig frame for every stereo frame pair, from the tool's "
+    "AprilTags (writes points.csv and <out>.poses.csv)";
+inline constexpr char kCaptureDescription[] =
+    "Record a stereo session (left/*.png, right/*.png, frames.csv, "
+    "session.yaml) from two cameras or two recordings; --list shows cameras. "
+    "Sources: v4l2:/dev/videoN?width=..&height=..&fps=..&format=GREY|YUYV|"
+    "MJPG, aravis:<camera id>?exposure_us=..&gain=..&fps=..&format=Mono8|..., "
+    "folder:/path/left*.png?fps=.., video:/path/file.mp4";
+inline constexpr char kBundleDescription[] =
+    "Calibrate the robot from a recorded session's images: one Ceres problem "
+    "over every tag corner in every camera at every frame with joint readings "
+    "(robot parameters, base in the rig, target on the flange, optionally the "
+    "cameras)";
+
 // Replaces this process by kincal-vision with this process's argv (read
 // from /proc/self/cmdline). kincal-vision is $KINCAL_VISION when set, else
 // the kincal-vision next to this executable, else
