@@ -420,8 +420,10 @@ ReportResult BuildReport(
         << Fmt(res_nominal.stats.rms_mm, 3) << " mm";
     }
     s << ". " << calres.identifiability.RobotParameterCount()
-      << " robot parameters identifiable, "
-      << calres.identifiability.unidentifiable.size() << " held at nominal.";
+      << " robot parameters identifiable; "
+      << calres.identifiability.unidentifiable.size()
+      << " others are redundant with them or the frame and stay at nominal "
+         "(see Identifiability).";
     verdict.push_back(s.str());
   }
   if (has_ext) {
