@@ -178,11 +178,40 @@ TEST(SmoothCorrectionTest, FindsTheInputItDependsOn) {
   };
   make(&in.train, &rt, 500);
   make(&in.held, &rh, 100);
+  // Measured points that the error does not depend on (a robot error).
+  for (size_t i = 0; i < rt.size(); ++i) {
+    in.point_train.emplace_back(300 * n(rng), 300 * n(rng), 300 * n(rng));
+  }
   const SmoothCorrection c = FitSmoothCorrection(in, rt, rh);
   ASSERT_FALSE(c.depends_on.empty());
   EXPECT_EQ(c.depends_on[0], "b");
   EXPECT_GT(c.cv_explained, 0.8);
   EXPECT_LT(c.heldout_rms_after_mm, 0.5 * c.heldout_rms_before_mm);
+  EXPECT_LT(c.point_cv_explained, 0.05);
+}
+
+// An instrument error: a smooth function of where the point is in the
+// measuring frame, whatever joint values put it there. The point explains
+// it, the joints do not.
+TEST(SmoothCorrectionTest, SeparatesAnInstrumentErrorFromTheJoints) {
+  std::mt19937_64 rng(7);
+  std::normal_distribution<double> n(0, 1);
+  SmoothInputs in;
+  in.names = {"j1", "j2", "j3"};
+  std::vector<Eigen::Vector3d> rt, rh;
+  for (int i = 0; i < 600; ++i) {
+    in.train.push_back({n(rng), n(rng), n(rng)});
+    const Eigen::Vector3d p(500 * n(rng), 500 * n(rng), 500 * n(rng));
+    in.point_train.push_back(p);
+    // Zero-mean smooth errors over x and z (a fitted model leaves no
+    // offset), plus noise.
+    rt.emplace_back(0.2 * std::sin(p.x() / 400) + 0.02 * n(rng), 0.02 * n(rng),
+                    0.1 * std::sin(p.z() / 300));
+  }
+  const SmoothCorrection c = FitSmoothCorrection(in, rt, rh);
+  EXPECT_GT(c.point_cv_explained, 0.6);
+  EXPECT_LT(c.cv_explained, 0.05);
+  EXPECT_TRUE(c.depends_on.empty());
 }
 
 }  // namespace

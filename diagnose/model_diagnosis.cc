@@ -190,6 +190,13 @@ SmoothInputs MakeSmoothInputs(const Observations& obs,
   };
   for (const Measurement& m : train) in.train.push_back(row(m));
   for (const Measurement& m : held) in.held.push_back(row(m));
+  bool points = true;
+  for (const Measurement& m : train) points &= obs.rows[m.row].has_point;
+  if (points) {
+    for (const Measurement& m : train) {
+      in.point_train.push_back(obs.rows[m.row].p_in_meas);
+    }
+  }
   return in;
 }
 
@@ -613,6 +620,7 @@ DiagnosisResult DiagnoseModel(const Robot& nominal, const Observations& obs,
       u.cv_explained = sc.cv_explained;
       u.smooth_k = sc.k;
       u.single_inputs = sc.single;
+      u.point_cv_explained = sc.point_cv_explained;
       if (!pb.held.empty()) u.heldout_rms_after_mm = sc.heldout_rms_after_mm;
       out.findings.push_back(u);
     }
@@ -746,7 +754,8 @@ nlohmann::json DiagnosisJson(const DiagnosisResult& r,
            "cross-validation"},
           {"k", f.smooth_k},
           {"cv_explained", Num(f.cv_explained)},
-          {"single_input_cv_explained", single}};
+          {"single_input_cv_explained", single},
+          {"measured_point_cv_explained", Num(f.point_cv_explained)}};
     }
   }
   nlohmann::json steps = nlohmann::json::array();

@@ -28,6 +28,7 @@
 //      nearest-neighbour pose pairs).
 
 #include <cstdint>
+#include <limits>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
@@ -118,6 +119,9 @@ struct Finding {
   double cv_explained = 0.0;
   int smooth_k = 0;
   std::vector<std::pair<std::string, double>> single_inputs;
+  // The same share from the measured point's position alone (robot or
+  // instrument, see SmoothCorrection); NaN without measured points.
+  double point_cv_explained = std::numeric_limits<double>::quiet_NaN();
 };
 
 struct DiagnosisResult {

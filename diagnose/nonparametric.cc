@@ -153,6 +153,26 @@ SmoothCorrection FitSmoothCorrection(
     fold_of.push_back(static_cast<int>(i) % folds);
   }
 
+  // Robot or instrument: the measured point as the only input (one common
+  // scale for x, y, z: they are lengths in one frame).
+  if (inputs.point_train.size() == train_res.size()) {
+    Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+    for (int i : order) mean += inputs.point_train[i] / order.size();
+    double var = 0;
+    for (int i : order) {
+      var += (inputs.point_train[i] - mean).squaredNorm() / order.size();
+    }
+    const double sd = std::sqrt(std::max(var / 3.0, 1e-24));
+    std::vector<std::vector<double>> xp;
+    for (int i : order) {
+      const Eigen::Vector3d z = (inputs.point_train[i] - mean) / sd;
+      xp.push_back({z.x(), z.y(), z.z()});
+    }
+    int k = 0;
+    out.point_cv_explained =
+        CrossValidate(xp, r, fold_of, folds, {0, 1, 2}, &k);
+  }
+
   // Each input alone, ranked.
   const int d = static_cast<int>(inputs.names.size());
   std::vector<std::pair<double, int>> ranked;

@@ -10,6 +10,7 @@
 // them predicts on poses it was not fitted to (held-out RMS before / after).
 
 #include <Eigen/Core>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -18,6 +19,9 @@ namespace kincal {
 struct SmoothInputs {
   std::vector<std::string> names;                // one per input column
   std::vector<std::vector<double>> train, held;  // [pose][input]
+  // The measured point of every training pose (measuring frame, mm); empty
+  // when the data have none (single-point data without metrology).
+  std::vector<Eigen::Vector3d> point_train;
 };
 
 struct SmoothCorrection {
@@ -30,6 +34,13 @@ struct SmoothCorrection {
   double heldout_rms_before_mm = 0.0, heldout_rms_after_mm = 0.0;
   // Per single input: its cross-validated share of the residual power.
   std::vector<std::pair<std::string, double>> single;
+  // Robot or instrument: the share a smooth function of the measured
+  // point's position (x, y, z in the measuring frame, one scale) predicts in
+  // the same cross-validation. An error of the measuring instrument depends
+  // on where the point is in the instrument's frame, not on the joint
+  // configuration that put it there; an error of the robot follows the
+  // joints. NaN when the data have no measured points.
+  double point_cv_explained = std::numeric_limits<double>::quiet_NaN();
 };
 
 // `train_res` / `held_res`: residual vectors (mm) of the final model.
