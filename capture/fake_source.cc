@@ -6,8 +6,6 @@
 // frame number. For tests, benchmarks and the lab procedure without
 // cameras; like any live camera it never ends.
 
-#include <time.h>
-
 #include <cmath>
 #include <opencv2/imgproc.hpp>
 #include <thread>
@@ -16,12 +14,6 @@
 
 namespace kincal::capture {
 namespace {
-
-double Now() {
-  timespec ts{};
-  ::clock_gettime(CLOCK_MONOTONIC, &ts);
-  return ts.tv_sec + 1e-9 * ts.tv_nsec;
-}
 
 class FakeSource : public FrameSource {
  public:
@@ -52,7 +44,7 @@ class FakeSource : public FrameSource {
       scenes_.push_back(gray);
     }
     // The next frame time on the global grid of 1/fps.
-    next_tick_ = static_cast<int64_t>(std::ceil(Now() * fps_));
+    next_tick_ = static_cast<int64_t>(std::ceil(MonotonicSeconds() * fps_));
     sequence_ = 0;
     open_ = true;
     return Status::Ok();
@@ -64,7 +56,7 @@ class FakeSource : public FrameSource {
                            "fake camera '" + name_ + "': not open");
     }
     const double t = next_tick_ / fps_;
-    const double wait = t - Now();
+    const double wait = t - MonotonicSeconds();
     if (wait > 0) {
       std::this_thread::sleep_for(std::chrono::duration<double>(wait));
     }

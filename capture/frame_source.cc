@@ -3,6 +3,7 @@
 #include <cerrno>
 #include <cmath>
 #include <cstdlib>
+#include <ctime>
 #include <set>
 #include <sstream>
 
@@ -53,6 +54,12 @@ bool LooksLikeQuery(const std::string& q) {
 }
 
 }  // namespace
+
+double MonotonicSeconds() {
+  timespec now{};
+  ::clock_gettime(CLOCK_MONOTONIC, &now);
+  return now.tv_sec + 1e-9 * now.tv_nsec;
+}
 
 const char* TimeBaseName(TimeBase base) {
   return base == TimeBase::kHostMonotonic ? "host_monotonic" : "media";

@@ -23,6 +23,9 @@ enum class TimeBase {
   kMedia,
 };
 
+// Now on the host's CLOCK_MONOTONIC (TimeBase::kHostMonotonic), seconds.
+double MonotonicSeconds();
+
 const char* TimeBaseName(TimeBase base);  // "host_monotonic" / "media"
 
 // One image from one camera.

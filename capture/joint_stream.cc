@@ -1,22 +1,12 @@
 #include "capture/joint_stream.h"
 
-#include <time.h>
-
 #include <algorithm>
 #include <limits>
 
+#include "capture/frame_source.h"
 #include "data/error.h"
 
 namespace kincal::capture {
-namespace {
-
-double MonotonicNow() {
-  timespec now{};
-  ::clock_gettime(CLOCK_MONOTONIC, &now);
-  return now.tv_sec + 1e-9 * now.tv_nsec;
-}
-
-}  // namespace
 
 JointStreamReceiver::JointStreamReceiver(RobotLink* link,
                                          std::vector<int> order,
@@ -46,7 +36,7 @@ void JointStreamReceiver::Loop() {
     }
     std::string line;
     const Status s = link_->ReadLine(0.25, &line);
-    const double arrival = MonotonicNow();
+    const double arrival = MonotonicSeconds();
     if (s.kind() == Status::Kind::kTimeout) continue;
     std::lock_guard<std::mutex> lock(mu_);
     if (!s.ok()) {

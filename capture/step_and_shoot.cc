@@ -1,24 +1,17 @@
 #include "capture/step_and_shoot.h"
 
-#include <time.h>
-
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <iostream>
 
+#include "capture/frame_source.h"
 #include "capture/robot_link.h"
 #include "data/atomic_file.h"
 #include "data/provenance.h"
 
 namespace kincal::capture {
 namespace {
-
-double MonotonicNow() {
-  timespec now{};
-  ::clock_gettime(CLOCK_MONOTONIC, &now);
-  return now.tv_sec + 1e-9 * now.tv_nsec;
-}
 
 void AppendValues(const std::vector<double>& q, std::string* row) {
   char buf[64];
@@ -169,7 +162,7 @@ StepAndShootResult RunStepAndShoot(StereoGrabber* grabber, bool live,
       continue;
     }
     // SETTLED: `shots` pairs taken after the message arrived.
-    const double settled_at = MonotonicNow();
+    const double settled_at = MonotonicSeconds();
     std::vector<StereoFrame> shots;
     while (static_cast<int>(shots.size()) < options.shots) {
       StereoFrame pair;

@@ -69,12 +69,6 @@ uint32_t FourCcCode(const std::string& name) {
   return V4L2_PIX_FMT_YUYV;
 }
 
-double MonotonicNow() {
-  timespec ts{};
-  ::clock_gettime(CLOCK_MONOTONIC, &ts);
-  return ts.tv_sec + 1e-9 * ts.tv_nsec;
-}
-
 // Opens a device and checks it speaks V4L2 (VIDIOC_QUERYCAP) before handing
 // it to libv4l2, so a wrong path is reported once, quietly. -1 with errno set
 // (ENOTTY: not a V4L2 device).
@@ -173,9 +167,9 @@ class V4l2Source : public FrameSource {
     if (!streaming_) {
       return Status::Error(Status::Kind::kIoError, device_ + ": not open");
     }
-    const double deadline = MonotonicNow() + 1e-3 * timeout_ms_;
+    const double deadline = MonotonicSeconds() + 1e-3 * timeout_ms_;
     for (;;) {
-      const double left = deadline - MonotonicNow();
+      const double left = deadline - MonotonicSeconds();
       if (left <= 0) break;
       fd_set fds;
       FD_ZERO(&fds);
@@ -381,7 +375,7 @@ class V4l2Source : public FrameSource {
                            V4L2_BUF_FLAG_TIMESTAMP_MONOTONIC;
     frame->timestamp_s =
         monotonic ? buf.timestamp.tv_sec + 1e-6 * buf.timestamp.tv_usec
-                  : MonotonicNow();
+                  : MonotonicSeconds();
     frame->sequence = buf.sequence;
     return Status::Ok();
   }
