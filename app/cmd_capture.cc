@@ -143,6 +143,39 @@ int RunList(const CaptureArgs& args) {
   return 0;
 }
 
+// Opens the pair. A missing replay file is bad input (InputError); a camera
+// that cannot be opened is a failure: message on stderr, false.
+bool OpenGrabber(capture::StereoGrabber* grabber, bool live) {
+  const Status s = grabber->Open();
+  if (s.ok()) return true;
+  if (!live && s.kind() == Status::Kind::kNotFound) {
+    throw InputError("capture: " + s.message());
+  }
+  std::cerr << "kincal: failure: capture: " << s.ToString() << std::endl;
+  return false;
+}
+
+// What session.yaml records about the cameras and their pairing.
+capture::SessionInfo DescribeCameras(const CaptureArgs& args,
+                                     const capture::FrameSource& left,
+                                     const capture::FrameSource& right,
+                                     const capture::StereoGrabber& grabber,
+                                     double tolerance_s, bool live) {
+  capture::SessionInfo info;
+  info.left_uri = args.left;
+  info.right_uri = args.right;
+  info.left_description = left.Describe();
+  info.right_description = right.Describe();
+  info.live = live;
+  info.pairing = capture::PairingName(grabber.pairing());
+  info.tolerance_s =
+      grabber.pairing() == capture::StereoGrabber::Pairing::kLockStep
+          ? 0.0
+          : tolerance_s;
+  info.time_base = capture::TimeBaseName(left.time_base());
+  return info;
+}
+
 // Step and shoot with a live robot link (capture/step_and_shoot.h).
 int RunStepAndShoot(const CaptureArgs& args, capture::FrameSource* left,
                     capture::FrameSource* right, bool live) {
@@ -163,26 +196,10 @@ int RunStepAndShoot(const CaptureArgs& args, capture::FrameSource* left,
   capture::StereoGrabberOptions grab_options;
   grab_options.tolerance_s = args.tolerance_ms * 1e-3;
   capture::StereoGrabber grabber(left, right, grab_options);
-  Status s = grabber.Open();
-  if (!s.ok()) {
-    if (!live && s.kind() == Status::Kind::kNotFound) {
-      throw InputError("capture: " + s.message());
-    }
-    std::cerr << "kincal: failure: capture: " << s.ToString() << std::endl;
-    return 1;
-  }
+  if (!OpenGrabber(&grabber, live)) return 1;
   capture::SessionInfo& info = options.info;
-  info.left_uri = args.left;
-  info.right_uri = args.right;
-  info.left_description = left->Describe();
-  info.right_description = right->Describe();
-  info.live = live;
-  info.pairing = capture::PairingName(grabber.pairing());
-  info.tolerance_s =
-      grabber.pairing() == capture::StereoGrabber::Pairing::kLockStep
-          ? 0.0
-          : grab_options.tolerance_s;
-  info.time_base = capture::TimeBaseName(left->time_base());
+  info = DescribeCameras(args, *left, *right, grabber, grab_options.tolerance_s,
+                         live);
   info.settings["png_compression"] = std::to_string(args.png_compression);
 
   InterruptGuard guard;
@@ -265,15 +282,8 @@ int RunCapture(const CaptureArgs& args) {
   capture::StereoGrabberOptions options;
   options.tolerance_s = args.tolerance_ms * 1e-3;
   capture::StereoGrabber grabber(left.get(), right.get(), options);
-  Status s = grabber.Open();
-  if (!s.ok()) {
-    // A missing replay file is bad input; a missing camera a failure.
-    if (!live && s.kind() == Status::Kind::kNotFound) {
-      throw InputError("capture: " + s.message());
-    }
-    std::cerr << "kincal: failure: capture: " << s.ToString() << std::endl;
-    return 1;
-  }
+  if (!OpenGrabber(&grabber, live)) return 1;
+  Status s;
 
   // Live joint stream: the robot connects and says HELLO before anything
   // is written (an unknown joint is bad input with nothing on disk).
@@ -309,18 +319,8 @@ int RunCapture(const CaptureArgs& args) {
         std::make_unique<capture::JointStreamReceiver>(&link, order, names);
   }
 
-  capture::SessionInfo info;
-  info.left_uri = args.left;
-  info.right_uri = args.right;
-  info.left_description = left->Describe();
-  info.right_description = right->Describe();
-  info.live = live;
-  info.pairing = capture::PairingName(grabber.pairing());
-  info.tolerance_s =
-      grabber.pairing() == capture::StereoGrabber::Pairing::kLockStep
-          ? 0.0
-          : options.tolerance_s;
-  info.time_base = capture::TimeBaseName(left->time_base());
+  capture::SessionInfo info =
+      DescribeCameras(args, *left, *right, grabber, options.tolerance_s, live);
   if (stream) info.settings["mode"] = "joint_stream";
   if (args.frames > 0) info.settings["frames"] = std::to_string(args.frames);
   if (args.seconds > 0) info.settings["seconds"] = std::to_string(args.seconds);
