@@ -9,6 +9,7 @@
 #include "calib/chain.h"
 #include "data/error.h"
 #include "data/provenance.h"
+#include "data/svg_plot.h"
 
 namespace kincal {
 namespace {
@@ -25,23 +26,6 @@ std::string Short(double v) {
   char buf[40];
   std::snprintf(buf, sizeof(buf), "%.6g", v);
   return buf;
-}
-
-std::string Escape(const std::string& s) {
-  std::string out;
-  for (char c : s) {
-    if (c == '<')
-      out += "&lt;";
-    else if (c == '>')
-      out += "&gt;";
-    else if (c == '&')
-      out += "&amp;";
-    else if (c == '"')
-      out += "&quot;";
-    else
-      out += c;
-  }
-  return out;
 }
 
 // XML forbids "--" inside a comment (and a trailing '-'): written "- -".
@@ -122,11 +106,12 @@ UrdfExport ExportUrdf(const Robot& robot) {
     const Eigen::Vector3d axis = chain.convention == Convention::kUrdf
                                      ? chain.rows[k].axis
                                      : Eigen::Vector3d::UnitZ();
-    joints << "  <joint name=\"" << Escape(row.name) << "\" type=\"" << type
-           << "\">\n    <parent link=\"" << Escape(link_name(k - 1))
-           << "\"/>\n    <child link=\"" << Escape(link_name(k)) << "\"/>\n    "
-           << Origin(origin[k]) << "\n    <axis xyz=\"" << Num(axis.x()) << " "
-           << Num(axis.y()) << " " << Num(axis.z()) << "\"/>\n";
+    joints << "  <joint name=\"" << XmlEscape(row.name) << "\" type=\"" << type
+           << "\">\n    <parent link=\"" << XmlEscape(link_name(k - 1))
+           << "\"/>\n    <child link=\"" << XmlEscape(link_name(k))
+           << "\"/>\n    " << Origin(origin[k]) << "\n    <axis xyz=\""
+           << Num(axis.x()) << " " << Num(axis.y()) << " " << Num(axis.z())
+           << "\"/>\n";
     if (type != "continuous") {
       double lo = -1.0, hi = 1.0;  // m: placeholder for a prismatic joint
       if (row.HasLimits()) {
@@ -173,15 +158,15 @@ UrdfExport ExportUrdf(const Robot& robot) {
   for (const std::string& s : out.placeholders) {
     os << "  Placeholder: " << CommentText(s) << "\n";
   }
-  os << "-->\n<robot name=\"" << Escape(robot.name) << "\">\n";
+  os << "-->\n<robot name=\"" << XmlEscape(robot.name) << "\">\n";
   os << "  <link name=\"base_link\"/>\n";
   for (int k = 0; k < n; ++k) {
-    os << "  <link name=\"" << Escape(link_name(k)) << "\"/>\n";
+    os << "  <link name=\"" << XmlEscape(link_name(k)) << "\"/>\n";
   }
   os << "  <link name=\"tip\"/>\n";
   os << joints.str();
   os << "  <joint name=\"tool\" type=\"fixed\">\n    <parent link=\""
-     << Escape(link_name(n - 1)) << "\"/>\n    <child link=\"tip\"/>\n    "
+     << XmlEscape(link_name(n - 1)) << "\"/>\n    <child link=\"tip\"/>\n    "
      << Origin(tool) << "\n  </joint>\n</robot>\n";
   out.xml = os.str();
   return out;
