@@ -250,7 +250,7 @@ std::string ClearanceCsv(const ClearanceResult& r) {
   return os.str();
 }
 
-std::string ClearanceSvg(const ClearanceResult& r) {
+Plot DeviationPlot(const ClearanceResult& r) {
   Plot deviations;
   deviations.title = "Joint motion error test: deviation per pose (Fig. 4)";
   deviations.x_label = "pose (visit order)";
@@ -264,33 +264,39 @@ std::string ClearanceSvg(const ClearanceResult& r) {
   }
   deviations.series.push_back(bars);
   deviations.lines.push_back({r.stats.rms_mm, "RMS"});
+  return deviations;
+}
 
+Plot SweepPlot(const ClearanceResult& r, size_t k) {
   Plot curves;
-  curves.title = r.sweeps.empty() ? "no pose examined"
-                                  : "Sweep of each joint at the worst pose " +
-                                        r.sweeps[0].pose + " (Fig. 5)";
   curves.x_label = "reading offset (deg | mm)";
   curves.y_label = "eps (mm)";
-  if (!r.sweeps.empty()) {
-    // The ends of a +-gamma sweep reach tens of mm and would flatten the
-    // minimum near zero the test is about: show 0 .. 3x the pose's error
-    // (curves leaving the frame are clipped).
-    const double before = r.sweeps[0].error_mm;
-    if (before > 0) {
-      curves.y_min = 0.0;
-      curves.y_max = 3.0 * before;
-      curves.y_label = "eps (mm), clipped at 3x the pose's error";
-      curves.lines.push_back({before, "error before"});
-    }
-    for (const SweepCurve& c : r.sweeps[0].joints) {
-      PlotSeries s;
-      s.label = r.joint_names[c.joint] + " (" + r.joint_units[c.joint] + ")";
-      s.x = c.offset;
-      s.y = c.error_mm;
-      curves.series.push_back(s);
-    }
+  if (k >= r.sweeps.size()) {
+    curves.title = "no pose examined";
+    return curves;
   }
-  return FormatSvgPlots({deviations, curves});
+  const PoseSweep& ps = r.sweeps[k];
+  curves.title = (k == 0 ? "Sweep of each joint at the worst pose "
+                         : "Sweep of each joint at pose ") +
+                 ps.pose + (k == 0 ? " (Fig. 5)" : "");
+  if (ps.error_mm > 0) {
+    curves.y_min = 0.0;
+    curves.y_max = 3.0 * ps.error_mm;
+    curves.y_label = "eps (mm), clipped at 3x the pose's error";
+    curves.lines.push_back({ps.error_mm, "error before"});
+  }
+  for (const SweepCurve& c : ps.joints) {
+    PlotSeries s;
+    s.label = r.joint_names[c.joint] + " (" + r.joint_units[c.joint] + ")";
+    s.x = c.offset;
+    s.y = c.error_mm;
+    curves.series.push_back(s);
+  }
+  return curves;
+}
+
+std::string ClearanceSvg(const ClearanceResult& r) {
+  return FormatSvgPlots({DeviationPlot(r), SweepPlot(r, 0)});
 }
 
 }  // namespace kincal

@@ -29,6 +29,7 @@
 #include "calib/fit.h"
 #include "data/observations.h"
 #include "data/robot.h"
+#include "data/svg_plot.h"
 
 namespace kincal {
 
@@ -98,6 +99,13 @@ nlohmann::json ClearanceJson(const ClearanceResult& result);
 // Long-format CSV: kind,pose,joint,offset,error_mm with kind "deviation"
 // (Fig. 4, one row per pose) or "sweep" (Fig. 5, one row per grid point).
 std::string ClearanceCsv(const ClearanceResult& result);
+// The seed's Fig. 4: the error eps_i of every pose as bars, with the RMS.
+Plot DeviationPlot(const ClearanceResult& result);
+// The seed's Fig. 5 for result.sweeps[k] (k = 0: the worst pose): each
+// joint's sweep. The ends of a +-gamma sweep reach tens of mm and would
+// flatten the minimum near zero the test is about, so y runs from 0 to 3x
+// the pose's error (curves leaving the frame are clipped).
+Plot SweepPlot(const ClearanceResult& result, size_t k);
 // Two stacked plots: per-pose deviations and the worst pose's curves.
 std::string ClearanceSvg(const ClearanceResult& result);
 

@@ -651,19 +651,8 @@ ReportResult BuildReport(
   // --- the seed's Section 4: clearance sweeps -------------------------------
   if (has_clear) {
     page.Section("clearance", "Joint motion error test (seed Section 4)");
-    Plot dev;
+    Plot dev = DeviationPlot(clear);
     dev.title = "Deviation per pose, geometric model (Fig. 4)";
-    dev.x_label = "pose (visit order)";
-    dev.y_label = "eps_i (mm)";
-    PlotSeries bars;
-    bars.label = "eps_i";
-    bars.bars = true;
-    for (size_t i = 0; i < clear.errors_mm.size(); ++i) {
-      bars.x.push_back(static_cast<double>(i + 1));
-      bars.y.push_back(clear.errors_mm[i]);
-    }
-    dev.series.push_back(bars);
-    dev.lines.push_back({clear.stats.rms_mm, "RMS"});
     dev.height = 300;
     std::vector<Plot> devs = {dev};
     if (has_ext) {
@@ -692,21 +681,11 @@ ReportResult BuildReport(
     std::vector<Plot> sweeps;
     for (size_t k = 0; k < clear.sweeps.size(); ++k) {
       const PoseSweep& ps = clear.sweeps[k];
-      Plot p;
+      Plot p = SweepPlot(clear, k);
       p.title = (k == 0 ? "Worst pose " : "Pose ") + ps.pose +
                 (k == 0 ? " (Fig. 5)" : "");
-      p.x_label = "reading offset (deg | mm)";
-      p.y_label = "eps (mm)";
       p.width = k == 0 ? 800 : 420;
       p.height = k == 0 ? 420 : 280;
-      p.y_min = 0;
-      p.y_max = 3.0 * ps.error_mm;
-      p.lines.push_back({ps.error_mm, "before"});
-      for (const SweepCurve& c : ps.joints) {
-        p.series.push_back({clear.joint_names[c.joint] + " (" +
-                                clear.joint_units[c.joint] + ")",
-                            c.offset, c.error_mm});
-      }
       if (k == 0) {
         page.Figure(p, "Each joint's reading swept +-" + Fmt(clear.gamma, 3) +
                            " with the others fixed at the worst pose; y "
