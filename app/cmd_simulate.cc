@@ -15,6 +15,7 @@
 #include "data/urdf.h"
 #include "synth/recorded_session.h"
 #include "synth/render.h"
+#include "synth/rig_placement.h"
 #include "synth/simulate.h"
 
 namespace kincal::app {
@@ -30,52 +31,6 @@ struct SimulateArgs {
   int render_width = 1280, render_height = 1024;
   RenderOptions render_options;
 };
-
-// Places the stereo rig so that it sees every tip and looks along the mean
-// direction the tags face away from (so they face the cameras on average):
-// rig_from_base as [rotation vector rad, t mm]. Returns the distance.
-double PlaceRig(const std::vector<Eigen::Matrix4d>& base_from_tip,
-                const Rig& rig, const Rigid3& tip_from_tool,
-                std::array<double, 6>* rig_from_base) {
-  Eigen::Vector3d centroid = Eigen::Vector3d::Zero(),
-                  mean_z = Eigen::Vector3d::Zero();
-  for (const Eigen::Matrix4d& m : base_from_tip) {
-    centroid += m.block<3, 1>(0, 3);
-    mean_z += m.block<3, 3>(0, 0) * tip_from_tool.R.col(2);
-  }
-  centroid /= static_cast<double>(base_from_tip.size());
-  Eigen::Vector3d z =
-      mean_z.norm() > 1e-6 ? mean_z.normalized() : Eigen::Vector3d(0, 0, -1);
-  const Eigen::Vector3d e = std::abs(z.z()) < 0.9 ? Eigen::Vector3d::UnitZ()
-                                                  : Eigen::Vector3d::UnitX();
-  const Eigen::Vector3d x = z.cross(e).normalized();
-  const Eigen::Vector3d y = z.cross(x);
-  const auto& cam = rig.cameras.at(0).intrinsics;
-  const double tan_half =
-      0.8 * std::min(cam.width / (2.0 * cam.fx), cam.height / (2.0 * cam.fy));
-  // Distance at which 90 % of the tips are in view (the rest leave the
-  // image, as on a real rig), at least the target's working distance.
-  std::vector<double> needed;
-  for (const Eigen::Matrix4d& m : base_from_tip) {
-    const Eigen::Vector3d d = m.block<3, 1>(0, 3) - centroid;
-    const double lateral = std::hypot(d.dot(x), d.dot(y));
-    needed.push_back(lateral / tan_half - d.dot(z));
-  }
-  std::sort(needed.begin(), needed.end());
-  const double distance =
-      std::max(450.0, needed[static_cast<size_t>(0.9 * (needed.size() - 1))]);
-  Eigen::Matrix3d base_from_rig;
-  base_from_rig.col(0) = x;
-  base_from_rig.col(1) = y;
-  base_from_rig.col(2) = z;
-  const Eigen::Matrix3d r = base_from_rig.transpose();
-  const Eigen::Vector3d origin = centroid - distance * z;
-  const Eigen::Vector3d t = -(r * origin);
-  const Eigen::AngleAxisd aa(r);
-  const Eigen::Vector3d w = aa.axis() * aa.angle();
-  *rig_from_base = {w.x(), w.y(), w.z(), t.x(), t.y(), t.z()};
-  return distance;
-}
 
 int RunSimulate(SimulateArgs args) {
   const Robot nominal = ReadRobot(args.robot, args.root, args.tip);
@@ -109,10 +64,18 @@ int RunSimulate(SimulateArgs args) {
     args.render_options.Check();
 #endif
     // Same seed, so the same poses and truth; only the frame is placed.
-    std::array<double, 6> rig_from_base;
-    rig_distance = PlaceRig(Simulate(nominal, opt).base_from_tip, rig,
-                            TipFromTool(target), &rig_from_base);
-    opt.meas_from_base = rig_from_base;
+    // 90 % of the tips in view: the rest leave the image, as on a real rig.
+    const Rigid3 rig_from_base =
+        PlaceRigFacingTips(Simulate(nominal, opt).base_from_tip, rig,
+                           TipFromTool(target), 0.9, &rig_distance);
+    const Eigen::AngleAxisd aa(rig_from_base.R);
+    const Eigen::Vector3d w = aa.axis() * aa.angle();
+    opt.meas_from_base = {w.x(),
+                          w.y(),
+                          w.z(),
+                          rig_from_base.t.x(),
+                          rig_from_base.t.y(),
+                          rig_from_base.t.z()};
     // Tags at least ~40 px wide at that distance: scale the example tool.
     const double tag_mm = 40.0 * rig_distance / rig.cameras.at(0).intrinsics.fx;
     const double scale = std::max(1.0, tag_mm / target.tags.at(0).size_mm);

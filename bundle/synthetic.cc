@@ -7,47 +7,12 @@
 #include "calib/evaluate.h"
 #include "data/error.h"
 #include "synth/render.h"
+#include "synth/rig_placement.h"
 #include "vision/apriltag_detector.h"
 #include "vision/tool_pose.h"
 
 namespace kincal {
-namespace {
-
-// rig_from_base looking at the tips' centroid along the mean tag normal,
-// at a distance where the workspace fills ~80 % of the view.
-Rigid3 PlaceRig(const std::vector<Eigen::Matrix4d>& base_from_tip,
-                const Rig& rig, const Rigid3& tip_from_tool) {
-  Eigen::Vector3d centroid = Eigen::Vector3d::Zero(),
-                  mean_z = Eigen::Vector3d::Zero();
-  for (const Eigen::Matrix4d& m : base_from_tip) {
-    centroid += m.block<3, 1>(0, 3);
-    mean_z += m.block<3, 3>(0, 0) * tip_from_tool.R.col(2);
-  }
-  centroid /= static_cast<double>(base_from_tip.size());
-  const Eigen::Vector3d z =
-      mean_z.norm() > 1e-6 ? mean_z.normalized() : Eigen::Vector3d(0, 0, -1);
-  const Eigen::Vector3d e = std::abs(z.z()) < 0.9 ? Eigen::Vector3d::UnitZ()
-                                                  : Eigen::Vector3d::UnitX();
-  const Eigen::Vector3d x = z.cross(e).normalized();
-  const Eigen::Vector3d y = z.cross(x);
-  const CameraIntrinsics& cam = rig.cameras.at(0).intrinsics;
-  const double tan_half =
-      0.8 * std::min(cam.width / (2.0 * cam.fx), cam.height / (2.0 * cam.fy));
-  double distance = 450;
-  for (const Eigen::Matrix4d& m : base_from_tip) {
-    const Eigen::Vector3d d = m.block<3, 1>(0, 3) - centroid;
-    distance = std::max(distance,
-                        std::hypot(d.dot(x), d.dot(y)) / tan_half - d.dot(z));
-  }
-  Rigid3 base_from_rig;
-  base_from_rig.R.col(0) = x;
-  base_from_rig.R.col(1) = y;
-  base_from_rig.R.col(2) = z;
-  base_from_rig.t = centroid - distance * z;
-  return base_from_rig.Inverse();
-}
-
-}  // namespace
+namespace {}  // namespace
 
 Target ThreeTagHolder(double s, const std::string& family) {
   Target t;
@@ -108,7 +73,8 @@ SyntheticBundle MakeSyntheticBundle(const Robot& nominal,
   const SimulatedSession sim = Simulate(nominal, so);
   s.truth = sim.truth;
   const Rigid3 tip_from_tool = TipFromTool(s.target);
-  s.rig_from_base = PlaceRig(sim.base_from_tip, s.rig, tip_from_tool);
+  s.rig_from_base = PlaceRigFacingTips(sim.base_from_tip, s.rig, tip_from_tool,
+                                       /*in_view=*/1.0);
   // flange_from_tool = flange_from_tip * tip_from_tool, where flange_from_tip
   // is the truth's tool row.
   const Chain truth = Chain::FromRobot(s.truth);
