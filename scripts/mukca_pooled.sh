@@ -10,30 +10,12 @@ K=${1:-build/bin/kincal}
 M=${2:-../shared/data/mukca}
 W=$(mktemp -d)
 trap 'rm -rf "$W"' EXIT
-authors_of() {
-  case $1 in
-    panda_2_clean) echo panda_2 ;; panda_3 | panda_3_bis) echo panda_3 ;;
-    panda_4_clean) echo panda_4 ;; *) echo "$1" ;;
-  esac
-}
-stats() {
-  python3 -c '
-import json,sys
-try: j=json.load(sys.stdin)
-except Exception: print("NA\tNA\tNA\tNA"); sys.exit()
-f=j["fixed_points"]; d=j["point_distances"][0]["distance_mm"]-50
-print("%.4f\t%.4f\t%.4f\t%+.4f" % (j["rms_mm"], f["hole_0"]["rms_mm"], f["hole_1"]["rms_mm"], d))'
-}
+. "$(dirname "$0")/mukca_common.sh"
 printf "robot\ttest\tkincal_rms\tkincal_h0\tkincal_h1\tkincal_dist_err\tauthors_rms\tauthors_h0\tauthors_h1\tauthors_dist_err\tkincal_train_rms\tfree\n"
 for robot_dir in "$M"/data/${3:-panda_*}; do
   robot=$(basename "$robot_dir")
   authors="$M/calibrated_urdf/$(authors_of "$robot")/panda.urdf"
-  recs=()
-  for rec in "$robot_dir"/*/; do
-    r=$(basename "$rec")
-    "$K" import mukca --dir "$rec" --out "$W/$r.csv" >/dev/null
-    recs+=("$r")
-  done
+  import_recordings "$K" "$robot_dir" "$W/"
   for test in "${recs[@]}"; do
     pooled="$W/pooled.csv"
     dist=()
