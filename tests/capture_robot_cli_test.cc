@@ -5,16 +5,12 @@
 // name exits 2 writing nothing; a malformed line exits 2 keeping what was
 // recorded.
 
-#include <arpa/inet.h>
 #include <gtest/gtest.h>
-#include <netinet/in.h>
-#include <sys/socket.h>
 #include <time.h>
 #include <unistd.h>
 #include <yaml-cpp/yaml.h>
 
 #include <chrono>
-#include <cstring>
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <string>
@@ -23,6 +19,7 @@
 
 #include "data/atomic_file.h"
 #include "data/csv.h"
+#include "tests/testing/loopback.h"
 #include "tests/testing/paths.h"
 #include "tests/testing/run.h"
 
@@ -32,46 +29,21 @@ namespace {
 using testing::RunKincal;
 using testing::RunResult;
 
-int FreePort() {
-  const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
-  sockaddr_in a{};
-  a.sin_family = AF_INET;
-  a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-  ::bind(fd, reinterpret_cast<sockaddr*>(&a), sizeof(a));
-  socklen_t len = sizeof(a);
-  ::getsockname(fd, reinterpret_cast<sockaddr*>(&a), &len);
-  ::close(fd);
-  return ntohs(a.sin_port);
-}
-
 // A robot controller's side of the protocol: connects (retrying while
 // kincal starts), sends lines, and reads kincal's answer after each line
 // that expects one. `drop_after` closes the link after that many SETTLED.
 class FakeRobot {
  public:
   void Run(int port, const std::vector<std::string>& lines) {
-    for (int i = 0; i < 200 && fd_ < 0; ++i) {
-      const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
-      sockaddr_in a{};
-      a.sin_family = AF_INET;
-      a.sin_port = htons(port);
-      a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-      if (::connect(fd, reinterpret_cast<sockaddr*>(&a), sizeof(a)) == 0) {
-        fd_ = fd;
-      } else {
-        ::close(fd);
-        std::this_thread::sleep_for(std::chrono::milliseconds(50));
-      }
-    }
+    fd_ = testing::ConnectLoopback(port, 200);
     if (fd_ < 0) return;
     for (const std::string& line : lines) {
       if (line == "<drop>") break;
-      const std::string data = line + "\n";
-      if (::send(fd_, data.data(), data.size(), MSG_NOSIGNAL) < 0) break;
+      if (!testing::SendLine(fd_, line)) break;
       if (line == "BYE") break;
       if (line.rfind("J ", 0) == 0) continue;  // no answer to a reading
       std::string reply;
-      if (!ReadLine(&reply)) break;
+      if (!testing::ReceiveLine(fd_, &reply)) break;
       replies.push_back(reply);
       if (reply.rfind("ERROR", 0) == 0) break;
     }
@@ -80,15 +52,6 @@ class FakeRobot {
   std::vector<std::string> replies;
 
  private:
-  bool ReadLine(std::string* line) {
-    line->clear();
-    char c;
-    while (::recv(fd_, &c, 1, 0) == 1) {
-      if (c == '\n') return true;
-      line->push_back(c);
-    }
-    return false;
-  }
   int fd_ = -1;
 };
 
@@ -109,7 +72,7 @@ Rig Make(const std::string& tag) {
                   "theta: 0, limits: [0, 100]}\n"
                   "tool: {d: 0, alpha: 0, a: 50, theta: 0}\n");
   s.out = s.dir + "/session";
-  s.port = FreePort();
+  s.port = testing::FreeLoopbackPort();
   return s;
 }
 
@@ -209,36 +172,21 @@ double HostNow() {
 // dropped link.
 void StreamingRobot(int port, double seconds, bool bye,
                     std::vector<std::string>* replies) {
-  int fd = -1;
-  for (int i = 0; i < 200 && fd < 0; ++i) {
-    const int f = ::socket(AF_INET, SOCK_STREAM, 0);
-    sockaddr_in a{};
-    a.sin_family = AF_INET;
-    a.sin_port = htons(port);
-    a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-    if (::connect(f, reinterpret_cast<sockaddr*>(&a), sizeof(a)) == 0) {
-      fd = f;
-    } else {
-      ::close(f);
-      std::this_thread::sleep_for(std::chrono::milliseconds(50));
-    }
-  }
+  const int fd = testing::ConnectLoopback(port, 200);
   if (fd < 0) return;
-  const std::string hello = "HELLO streamer j2 j1\n";
-  ::send(fd, hello.data(), hello.size(), MSG_NOSIGNAL);
+  testing::SendLine(fd, "HELLO streamer j2 j1");
   std::string reply;
-  char c;
-  while (::recv(fd, &c, 1, 0) == 1 && c != '\n') reply.push_back(c);
+  testing::ReceiveLine(fd, &reply);
   replies->push_back(reply);
   const double end = HostNow() + seconds;
   while (HostNow() < end) {
     const double t = HostNow();
     char line[128];
-    std::snprintf(line, sizeof(line), "J %.6f 7 %.6f\n", t + 500.0, 2 * t);
-    ::send(fd, line, std::strlen(line), MSG_NOSIGNAL);
+    std::snprintf(line, sizeof(line), "J %.6f 7 %.6f", t + 500.0, 2 * t);
+    testing::SendLine(fd, line);
     std::this_thread::sleep_for(std::chrono::milliseconds(10));
   }
-  if (bye) ::send(fd, "BYE\n", 4, MSG_NOSIGNAL);
+  if (bye) testing::SendLine(fd, "BYE");
   ::close(fd);
 }
 

@@ -5,10 +5,7 @@
 // the simulated ones pose by pose: proof that every recorded frame carries
 // the readings of the pose it shows.
 
-#include <arpa/inet.h>
 #include <gtest/gtest.h>
-#include <netinet/in.h>
-#include <sys/socket.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -20,6 +17,7 @@
 
 #include "data/atomic_file.h"
 #include "data/csv.h"
+#include "tests/testing/loopback.h"
 #include "tests/testing/paths.h"
 #include "tests/testing/run.h"
 
@@ -28,18 +26,6 @@ namespace {
 
 using testing::RunKincal;
 using testing::RunResult;
-
-int FreePort() {
-  const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
-  sockaddr_in a{};
-  a.sin_family = AF_INET;
-  a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-  ::bind(fd, reinterpret_cast<sockaddr*>(&a), sizeof(a));
-  socklen_t len = sizeof(a);
-  ::getsockname(fd, reinterpret_cast<sockaddr*>(&a), &len);
-  ::close(fd);
-  return ntohs(a.sin_port);
-}
 
 struct Row {
   std::vector<std::string> joints;
@@ -72,29 +58,12 @@ std::map<std::string, Row> ReadObs(const std::string& path, int joints) {
 // Visits the rows in file order: HELLO, SETTLED <pose> <q...> / DONE, BYE.
 void FakeController(int port, const std::string& obs, int* done) {
   const auto lines = TokenizeCsv(ReadFile(obs), obs);
-  int fd = -1;
-  for (int i = 0; i < 300 && fd < 0; ++i) {
-    const int f = ::socket(AF_INET, SOCK_STREAM, 0);
-    sockaddr_in a{};
-    a.sin_family = AF_INET;
-    a.sin_port = htons(port);
-    a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-    if (::connect(f, reinterpret_cast<sockaddr*>(&a), sizeof(a)) == 0) {
-      fd = f;
-    } else {
-      ::close(f);
-      std::this_thread::sleep_for(std::chrono::milliseconds(50));
-    }
-  }
+  const int fd = testing::ConnectLoopback(port, 300);
   if (fd < 0) return;
-  auto say = [&](const std::string& s) {
-    const std::string d = s + "\n";
-    ::send(fd, d.data(), d.size(), MSG_NOSIGNAL);
-  };
+  auto say = [&](const std::string& s) { testing::SendLine(fd, s); };
   auto hear = [&] {
     std::string l;
-    char c;
-    while (::recv(fd, &c, 1, 0) == 1 && c != '\n') l.push_back(c);
+    testing::ReceiveLine(fd, &l);
     return l;
   };
   say("HELLO BH-7 j1 j2 j3 j4 j5");
@@ -119,7 +88,7 @@ TEST(LabProcedure, SimulateFakeRobotCaptureTrackCalibrate) {
                           w + "/sim --json");
   ASSERT_EQ(r.exit_code, 0) << r.err;
 
-  const int port = FreePort();
+  const int port = testing::FreeLoopbackPort();
   int done = 0;
   std::thread controller(
       [&] { FakeController(port, w + "/sim/observations.csv", &done); });
