@@ -141,6 +141,10 @@ double Seconds(std::chrono::steady_clock::time_point start) {
 
 }  // namespace
 
+double RowBound(const Chain& center, const ParamInfo& p) {
+  return IsAngle(center, p) ? center.bound_angle_rad : center.bound_length_mm;
+}
+
 std::vector<Measurement> MakeMeasurements(const Chain& nominal,
                                           const Observations& obs,
                                           ModelState* state) {
@@ -239,8 +243,7 @@ FitSummary Fit(const std::vector<Measurement>& measurements,
       if (p.kind != ParamKind::kRow) continue;
       double* address = ParamAddress(state, p);
       const double center = c.rows.at(p.block).p.at(p.index);
-      const double bound =
-          IsAngle(c, p) ? c.bound_angle_rad : c.bound_length_mm;
+      const double bound = RowBound(c, p);
       problem.SetParameterLowerBound(address - p.index, p.index,
                                      center - bound);
       problem.SetParameterUpperBound(address - p.index, p.index,
@@ -256,11 +259,9 @@ FitSummary Fit(const std::vector<Measurement>& measurements,
       if (p.kind != ParamKind::kRow) continue;
       double* block = ParamAddress(state, p) - p.index;
       problem.AddResidualBlock(
-          new PriorResidual(
-              problem.ParameterBlockSize(block), p.index,
-              c.rows.at(p.block).p.at(p.index),
-              IsAngle(c, p) ? c.bound_angle_rad : c.bound_length_mm,
-              options.prior_weight),
+          new PriorResidual(problem.ParameterBlockSize(block), p.index,
+                            c.rows.at(p.block).p.at(p.index), RowBound(c, p),
+                            options.prior_weight),
           nullptr, block);
     }
   }

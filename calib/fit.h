@@ -90,6 +90,11 @@ struct FitSummary {
 FitSummary Fit(const std::vector<Measurement>& measurements,
                const FitOptions& options, ModelState* state);
 
+// Half-width of a geometry parameter's box about FitOptions::bounds_center
+// (internal units): the chain's bound_angle_rad for an angle,
+// bound_length_mm for a length.
+double RowBound(const Chain& center, const ParamInfo& p);
+
 // Jacobian of all stacked residuals (3 per measurement, then one per
 // distance) with respect to `params` (internal units), evaluated at `state`,
 // by the same autodiff functors the fit uses.

@@ -97,13 +97,9 @@ void Bounds(const FreeFitOptions& options, std::vector<double>* lower,
   for (int i = 0; i < k; ++i) {
     const ParamInfo& p = options.free[i];
     if (p.kind != ParamKind::kRow) continue;
-    const bool angle = c.convention == Convention::kUrdf
-                           ? p.index >= 3
-                           : (p.index == 0 || p.index >= 3);
     const double center = c.rows.at(p.block).p.at(p.index);
-    const double bound = angle ? c.bound_angle_rad : c.bound_length_mm;
-    (*lower)[i] = center - bound;
-    (*upper)[i] = center + bound;
+    (*lower)[i] = center - RowBound(c, p);
+    (*upper)[i] = center + RowBound(c, p);
   }
 }
 
@@ -211,6 +207,16 @@ double ExactFreeFit(const std::vector<Measurement>& ms,
 
 }  // namespace
 
+FreeFitOptions FreeFitOptionsFrom(const FitOptions& fit_options) {
+  FreeFitOptions o;
+  o.free = fit_options.free;
+  o.bounds_center = fit_options.bounds_center;
+  o.max_iterations = fit_options.max_iterations;
+  o.function_tolerance = fit_options.function_tolerance;
+  o.parameter_tolerance = fit_options.parameter_tolerance;
+  return o;
+}
+
 double FreeFit(const std::vector<Measurement>& measurements,
                const FreeFitOptions& options, ModelState* state) {
   if (options.exact_jacobian) return ExactFreeFit(measurements, options, state);
@@ -236,20 +242,13 @@ double FreeFit(const std::vector<Measurement>& measurements,
     problem.AddResidualBlock(cost, nullptr, x.data());
   }
   if (k > 0 && problem.NumResidualBlocks() > 0) {
-    if (options.bounds_center != nullptr) {
-      const Chain& c = *options.bounds_center;
-      for (int i = 0; i < k; ++i) {
-        const ParamInfo& p = options.free[i];
-        if (p.kind != ParamKind::kRow) continue;
-        const bool angle = c.convention == Convention::kUrdf
-                               ? p.index >= 3
-                               : (p.index == 0 || p.index >= 3);
-        const double center = c.rows.at(p.block).p.at(p.index);
-        const double bound = angle ? c.bound_angle_rad : c.bound_length_mm;
-        x[i] = std::min(std::max(x[i], center - bound), center + bound);
-        problem.SetParameterLowerBound(x.data(), i, center - bound);
-        problem.SetParameterUpperBound(x.data(), i, center + bound);
-      }
+    std::vector<double> lower, upper;
+    Bounds(options, &lower, &upper);
+    for (int i = 0; i < k; ++i) {
+      if (!std::isfinite(lower[i])) continue;  // no box (not a row entry)
+      x[i] = std::min(std::max(x[i], lower[i]), upper[i]);
+      problem.SetParameterLowerBound(x.data(), i, lower[i]);
+      problem.SetParameterUpperBound(x.data(), i, upper[i]);
     }
     ceres::Solver::Options solver;
     solver.linear_solver_type = ceres::DENSE_QR;

@@ -28,6 +28,10 @@ struct FreeFitOptions {
   bool exact_jacobian = true;
 };
 
+// The same free parameters, box and stopping rules as a calib/fit.h fit
+// (its distances, prior and covariance are not carried over).
+FreeFitOptions FreeFitOptionsFrom(const FitOptions& fit_options);
+
 // Fits the free parameters of `state` to the measured rows (kMeasured
 // only); returns the final sum of squared residuals, mm^2.
 double FreeFit(const std::vector<Measurement>& measurements,

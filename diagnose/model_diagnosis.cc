@@ -85,13 +85,7 @@ void FitBase(const std::vector<Measurement>& fit_on, const std::string& source,
       Fit(fit_on, fo, state);
       return;
     }
-    FreeFitOptions ffo;
-    ffo.free = fo.free;
-    ffo.bounds_center = fo.bounds_center;
-    ffo.max_iterations = fo.max_iterations;
-    ffo.function_tolerance = fo.function_tolerance;
-    ffo.parameter_tolerance = fo.parameter_tolerance;
-    FreeFit(fit_on, ffo, state);
+    FreeFit(fit_on, FreeFitOptionsFrom(fo), state);
   };
   ModelState& state = pb->base_state;
   InitializeFrameAndPoints(fit_on, &state);
@@ -434,12 +428,7 @@ DiagnosisResult DiagnoseModel(const Robot& nominal, const Observations& obs,
       fo.function_tolerance = 1e-10;
       fo.parameter_tolerance = 1e-10;
       // Differentiated in the free parameters only (diagnose/free_fit.h).
-      FreeFitOptions ffo;
-      ffo.free = fo.free;
-      ffo.bounds_center = fo.bounds_center;
-      ffo.max_iterations = fo.max_iterations;
-      ffo.function_tolerance = fo.function_tolerance;
-      ffo.parameter_tolerance = fo.parameter_tolerance;
+      FreeFitOptions ffo = FreeFitOptionsFrom(fo);
       ffo.exact_jacobian = options.exact_jacobian;
       if (options.free_parameter_fit) {
         FreeFit(pb.train, ffo, &states[c]);
@@ -557,13 +546,8 @@ DiagnosisResult DiagnoseModel(const Robot& nominal, const Observations& obs,
   fo.compute_covariance = true;
   FitSummary final_fit;
   if (options.exact_jacobian) {
-    FreeFitOptions ffo;  // calib/fit.h's defaults
-    ffo.free = fo.free;
-    ffo.bounds_center = fo.bounds_center;
-    ffo.max_iterations = fo.max_iterations;
-    ffo.function_tolerance = fo.function_tolerance;
-    ffo.parameter_tolerance = fo.parameter_tolerance;
-    final_fit = FreeFitWithCovariance(pb.all, ffo, &final_state);
+    final_fit =
+        FreeFitWithCovariance(pb.all, FreeFitOptionsFrom(fo), &final_state);
   } else {
     final_fit = Fit(pb.all, fo, &final_state);
   }
