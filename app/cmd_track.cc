@@ -5,9 +5,7 @@
 #include <chrono>
 #include <cstdio>
 #include <memory>
-#include <opencv2/imgcodecs.hpp>
 #include <sstream>
-#include <thread>
 
 #include "app/command.h"
 #include "app/front_end.h"
@@ -22,6 +20,7 @@
 #include "data/session.h"
 #include "data/urdf.h"
 #include "data/yaml_util.h"
+#include "vision/stereo_images.h"
 #include "vision/target.h"
 #include "vision/tool_pose.h"
 #include "vision/tracker.h"
@@ -46,18 +45,6 @@ struct TrackArgs {
   double decimate = 2.0;
   bool quiet = false;
 };
-
-cv::Mat ReadGray(const std::string& path, const CameraIntrinsics& cam) {
-  const cv::Mat im = cv::imread(path, cv::IMREAD_GRAYSCALE);
-  if (im.empty()) throw InputError(path + ": cannot read the image");
-  if (im.cols != cam.width || im.rows != cam.height) {
-    std::ostringstream os;
-    os << path << ": image is " << im.cols << "x" << im.rows << " but camera '"
-       << cam.name << "' in the rig is " << cam.width << "x" << cam.height;
-    throw InputError(os.str());
-  }
-  return im;
-}
 
 std::string PosesPath(const std::string& out) {
   const std::string ext = ".csv";
@@ -177,22 +164,10 @@ int RunTrack(const TrackArgs& args) {
   for (size_t f = 0; f < n; ++f) {
     std::vector<std::vector<TagDetection>> dets(2);
     const std::string* files[2] = {&left[f], &right[f]};
-    // One thread per camera; errors are carried back, not thrown in threads.
-    std::string error[2];
-    auto work = [&](int c) {
-      try {
-        const cv::Mat im = ReadGray(*files[c], rig.cameras[c].intrinsics);
-        dets[c] = trackers[c]->Track(im);
-      } catch (const std::exception& e) {
-        error[c] = e.what();
-      }
-    };
-    std::thread t1(work, 1);
-    work(0);
-    t1.join();
-    for (int c = 0; c < 2; ++c) {
-      if (!error[c].empty()) throw InputError(error[c]);
-    }
+    ForBothCameras([&](int c) {
+      dets[c] = trackers[c]->Track(
+          ReadCameraImage(*files[c], rig.cameras[c].intrinsics));
+    });
     const ToolPoseResult r = EstimateToolPose(rig, target, dets);
     points << f;
     poses << f << "," << (r.found ? 1 : 0);

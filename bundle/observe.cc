@@ -1,32 +1,11 @@
 #include "bundle/observe.h"
 
 #include <chrono>
-#include <opencv2/imgcodecs.hpp>
-#include <sstream>
-#include <thread>
 
 #include "data/error.h"
+#include "vision/stereo_images.h"
 
 namespace kincal {
-namespace {
-
-cv::Mat ReadGray(const std::string& path, const CameraIntrinsics& cam) {
-  const cv::Mat im = cv::imread(path, cv::IMREAD_GRAYSCALE);
-  if (im.empty()) {
-    throw InputError(path +
-                     ": cannot read the image (not an image file, or "
-                     "truncated)");
-  }
-  if (im.cols != cam.width || im.rows != cam.height) {
-    std::ostringstream os;
-    os << path << ": image is " << im.cols << "x" << im.rows << " but camera '"
-       << cam.name << "' in the rig is " << cam.width << "x" << cam.height;
-    throw InputError(os.str());
-  }
-  return im;
-}
-
-}  // namespace
 
 SessionObservations ObserveSession(const Session& session, const Rig& rig,
                                    const Target& target,
@@ -51,22 +30,11 @@ SessionObservations ObserveSession(const Session& session, const Rig& rig,
       continue;
     }
     std::vector<std::vector<TagDetection>> dets(2);
-    std::string error[2];
     const std::string* files[2] = {&sf.left_image, &sf.right_image};
-    auto work = [&](int c) {
-      try {
-        dets[c] =
-            detectors[c].Detect(ReadGray(*files[c], rig.cameras[c].intrinsics));
-      } catch (const std::exception& e) {
-        error[c] = e.what();
-      }
-    };
-    std::thread t1(work, 1);
-    work(0);
-    t1.join();
-    for (int c = 0; c < 2; ++c) {
-      if (!error[c].empty()) throw InputError(error[c]);
-    }
+    ForBothCameras([&](int c) {
+      dets[c] = detectors[c].Detect(
+          ReadCameraImage(*files[c], rig.cameras[c].intrinsics));
+    });
     BundleFrame f;
     f.frame = sf.frame;
     f.q_reading = sf.q;

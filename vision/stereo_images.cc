@@ -1,0 +1,45 @@
+#include "vision/stereo_images.h"
+
+#include <exception>
+#include <opencv2/imgcodecs.hpp>
+#include <sstream>
+#include <thread>
+
+#include "data/error.h"
+
+namespace kincal {
+
+cv::Mat ReadCameraImage(const std::string& path, const CameraIntrinsics& cam) {
+  const cv::Mat im = cv::imread(path, cv::IMREAD_GRAYSCALE);
+  if (im.empty()) {
+    throw InputError(path +
+                     ": cannot read the image (not an image file, or "
+                     "truncated)");
+  }
+  if (im.cols != cam.width || im.rows != cam.height) {
+    std::ostringstream os;
+    os << path << ": image is " << im.cols << "x" << im.rows << " but camera '"
+       << cam.name << "' in the rig is " << cam.width << "x" << cam.height;
+    throw InputError(os.str());
+  }
+  return im;
+}
+
+void ForBothCameras(const std::function<void(int camera)>& work) {
+  std::string error[2];
+  auto guarded = [&](int c) {
+    try {
+      work(c);
+    } catch (const std::exception& e) {
+      error[c] = e.what();
+    }
+  };
+  std::thread second(guarded, 1);
+  guarded(0);
+  second.join();
+  for (const std::string& e : error) {
+    if (!e.empty()) throw InputError(e);
+  }
+}
+
+}  // namespace kincal

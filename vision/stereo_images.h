@@ -1,0 +1,25 @@
+#ifndef KINCAL_VISION_STEREO_IMAGES_H_
+#define KINCAL_VISION_STEREO_IMAGES_H_
+
+// Reading a recorded stereo pair for tag detection: each image checked
+// against its camera in the rig, and both cameras worked on at once.
+
+#include <functional>
+#include <opencv2/core.hpp>
+#include <string>
+
+#include "camcal/camera_model.h"
+
+namespace kincal {
+
+// The image at `path` as 8-bit gray. InputError when it cannot be read or
+// its size is not the camera's in the rig.
+cv::Mat ReadCameraImage(const std::string& path, const CameraIntrinsics& cam);
+
+// Runs work(0) and work(1) on two threads. An exception in either is
+// carried back and thrown here as InputError (the first camera's first).
+void ForBothCameras(const std::function<void(int camera)>& work);
+
+}  // namespace kincal
+
+#endif  // KINCAL_VISION_STEREO_IMAGES_H_
