@@ -198,7 +198,8 @@ void AddDiagnoseCommand(CLI::App& app, Runner* run) {
       "model",
       "Fit geometry, test the catalogue of causes (backlash, compliance, "
       "cyclic, gain, axis_tilt, drift, elastostatic, thermal, "
-      "mount_compliance) against held-out poses, report findings");
+      "mount_compliance, transmission) against held-out poses, report "
+      "findings");
   model->add_option("--robot", margs->robot, "robot.yaml or .urdf")->required();
   model->add_option("--root", margs->root, "URDF root link");
   model->add_option("--tip", margs->tip, "URDF tip link");

@@ -245,7 +245,8 @@ void AddSimulateCommand(CLI::App& app, Runner* run) {
   sub->add_option("--effect", args->effects,
                   "injected effect cause:joint:magnitude (backlash, "
                   "compliance, cyclic, gain, axis_tilt, elastostatic deg, "
-                  "thermal mm_per_h) or drift:mm_per_h or "
+                  "thermal mm_per_h, transmission deg RMS) or drift:mm_per_h "
+                  "or "
                   "mount_compliance:deg; repeatable");
   sub->add_option("--seed", args->options.seed, "random seed")
       ->capture_default_str();

@@ -96,6 +96,15 @@ Chain Chain::FromRobot(const Robot& robot) {
     if (e.cause == "elastostatic")  // deg (mm) per kN m (kN) in the file
       err[kElastostatic] = e.values.at("per_knm") * unit / 1000.0;
     if (e.cause == "thermal") err[kThermal] = e.values.at("rate");
+    if (e.cause == "transmission") {
+      // lo, hi: the travel (deg | mm); s1 .. s24: sine coefficients.
+      c.rows[j].transmission_lo = e.values.at("lo") * unit;
+      c.rows[j].transmission_hi = e.values.at("hi") * unit;
+      for (int k = 0; k < kMaxTransmissionTerms; ++k) {
+        const auto it = e.values.find("s" + std::to_string(k + 1));
+        if (it != e.values.end()) err[kTransmission0 + k] = it->second * unit;
+      }
+    }
     if (e.cause == "cyclic") {
       // Harmonic 1: cos, sin; harmonics 2, 3: cos2, sin2, cos3, sin3.
       for (int h = 1; h <= kMaxHarmonic; ++h) {
@@ -156,6 +165,18 @@ Robot Chain::ToRobot(const Robot& description) const {
            {{"per_knm", err[kElastostatic] / unit * 1000.0}}});
     if (err[kThermal] != 0.0)
       robot.extensions.push_back({"thermal", name, {{"rate", err[kThermal]}}});
+    Extension transmission{"transmission", name, {}};
+    for (int k = 0; k < kMaxTransmissionTerms; ++k) {
+      if (err[kTransmission0 + k] == 0.0) continue;
+      transmission.values["s" + std::to_string(k + 1)] =
+          err[kTransmission0 + k] / unit;
+    }
+    if (!transmission.values.empty() &&
+        rows[j].transmission_hi > rows[j].transmission_lo) {
+      transmission.values["lo"] = rows[j].transmission_lo / unit;
+      transmission.values["hi"] = rows[j].transmission_hi / unit;
+      robot.extensions.push_back(transmission);
+    }
   }
   if (drift[0] != 0.0 || drift[1] != 0.0 || drift[2] != 0.0) {
     robot.extensions.push_back(

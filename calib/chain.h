@@ -15,6 +15,7 @@
 #include <cmath>
 #include <limits>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 #include "data/observations.h"
@@ -37,6 +38,7 @@ constexpr int kRowBlockSize = 6;
 //   cyclic 1..3    joint   kCyclicCos .. kCyclic3Sin    JointValue
 //   elastostatic   joint   kElastostatic (link masses)  JointValue
 //   thermal        joint   kThermal (row length growth) RowLengthScale
+//   transmission   joint   kTransmission0 .. +23        JointValue
 //   drift          global  kDriftX .. kDriftZ           TipOffset
 //   mount          global  kMountIso, kMountCos, ..Sin  TipOffset
 //
@@ -50,8 +52,11 @@ constexpr int kRowBlockSize = 6;
 //    cyclic3_sin (third harmonic), elastostatic (rad|mm per N m of the
 //    gravity torque of the link masses about the joint), thermal (relative
 //    growth of the row's lengths per unit of the thermal input: per K when
-//    the data have temp_c, else per hour)]
-constexpr int kJointErrorBlockSize = 11;
+//    the data have temp_c, else per hour), transmission_1 ..
+//    transmission_24 (rad|mm, sine series of the joint error over the
+//    joint's travel, see TransmissionError)]
+constexpr int kMaxTransmissionTerms = 24;
+constexpr int kJointErrorBlockSize = 11 + kMaxTransmissionTerms;
 enum JointErrorIndex {
   kGain = 0,
   kBacklash,
@@ -63,7 +68,8 @@ enum JointErrorIndex {
   kCyclic3Cos,
   kCyclic3Sin,
   kElastostatic,
-  kThermal
+  kThermal,
+  kTransmission0  // first of kMaxTransmissionTerms sine coefficients
 };
 constexpr int kMaxHarmonic = 3;
 // Index of the cosine term of harmonic h (1..3); the sine term follows it.
@@ -103,6 +109,10 @@ struct ChainRow {
   // row ends in; NaN mass = not given (robot.yaml mass/com).
   double mass_kg = std::numeric_limits<double>::quiet_NaN();
   Eigen::Vector3d com_mm = Eigen::Vector3d::Zero();
+  // Travel [lo, hi] of the joint (internal units) over which the
+  // transmission family's sine series lives; lo == hi = none. Structure,
+  // not a fitted value: set from the data the map is fitted on.
+  double transmission_lo = 0.0, transmission_hi = 0.0;
 };
 
 struct Chain {
@@ -281,18 +291,55 @@ Mat4<T> RowTransform(Convention convention, const ChainRow& row, const T* p,
   return Mat4<T>::Identity();
 }
 
+// Transmission family hook: an angle error that varies along the joint's
+// travel without being a low harmonic of the angle (the kinematic error of a
+// gear train, an encoder's non-linearity), as a sine series over the travel
+// [lo, hi] of the data, without its mean over the travel:
+//   e(q) = sum_k c_k (sin(k pi u) - m_k),  u = (q_read - lo) / (hi - lo),
+//   m_k = (1 - cos(k pi)) / (k pi) (the mean of sin(k pi u) on [0, 1]),
+// for k = 1..24 inside the travel, and 0 outside: the mean error is the
+// geometry's offset, which is also the prediction outside the travel the
+// series was fitted on. RMS over the travel: sqrt(|c|^2 / 2 - (m . c)^2)
+// (TransmissionRms). `c` points at kMaxTransmissionTerms values.
+inline double TransmissionMean(int k) {  // m_k, k = 1..24
+  return (k % 2 == 1) ? 2.0 / (k * M_PI) : 0.0;
+}
+template <typename T>
+T TransmissionError(const T* c, double q_read, double lo, double hi) {
+  if (!(hi > lo) || q_read <= lo || q_read >= hi) return T(0);
+  if constexpr (std::is_same_v<T, double>) {  // most joints have no series
+    bool any = false;
+    for (int k = 0; k < kMaxTransmissionTerms && !any; ++k) any = c[k] != 0.0;
+    if (!any) return 0.0;
+  }
+  const double x = M_PI * (q_read - lo) / (hi - lo);
+  const double two_cos = 2.0 * std::cos(x);
+  double s_prev = 0.0, s = std::sin(x);  // sin(k x) by recurrence
+  T e(0);
+  for (int k = 0; k < kMaxTransmissionTerms; ++k) {
+    e += c[k] * (s - TransmissionMean(k + 1));
+    const double next = two_cos * s - s_prev;
+    s_prev = s;
+    s = next;
+  }
+  return e;
+}
+
 // The joint value FK uses for a reading (docs/CONVENTIONS.md):
 //   q = (1 + gain) q_read - s backlash / 2 + compliance tau
 //       + sum_h cyclic{h}_cos cos(h q_read) + cyclic{h}_sin sin(h q_read)
-//       + elastostatic tau_mass
+//       + elastostatic tau_mass + transmission(q_read)
 // for harmonics h = 1..3. `err` may be null (no error model). Cyclic terms
-// apply to revolute joints.
+// apply to revolute joints; the transmission series to joints with a travel
+// (ChainRow::transmission_lo < transmission_hi).
 template <typename T>
 T ModelJointValue(JointType type, double q_read, double s, double tau,
-                  const T* err, double tau_mass = 0.0) {
+                  const T* err, double tau_mass = 0.0, double travel_lo = 0.0,
+                  double travel_hi = 0.0) {
   if (err == nullptr) return T(q_read);
   T q = (T(1) + err[kGain]) * q_read - T(0.5 * s) * err[kBacklash] +
-        err[kCompliance] * tau + err[kElastostatic] * tau_mass;
+        err[kCompliance] * tau + err[kElastostatic] * tau_mass +
+        TransmissionError(err + kTransmission0, q_read, travel_lo, travel_hi);
   if (type == JointType::kRevolute) {
     for (int h = 1; h <= kMaxHarmonic; ++h) {
       const int k = CyclicCosIndex(h);
@@ -306,10 +353,12 @@ T ModelJointValue(JointType type, double q_read, double s, double tau,
 // as the fit evaluates it many times per pose.
 template <typename T>
 T ModelJointValueTrig(JointType type, double q_read, double s, double tau,
-                      const T* err, double tau_mass, const double* trig) {
+                      const T* err, double tau_mass, const double* trig,
+                      double travel_lo = 0.0, double travel_hi = 0.0) {
   if (err == nullptr) return T(q_read);
   T q = (T(1) + err[kGain]) * q_read - T(0.5 * s) * err[kBacklash] +
-        err[kCompliance] * tau + err[kElastostatic] * tau_mass;
+        err[kCompliance] * tau + err[kElastostatic] * tau_mass +
+        TransmissionError(err + kTransmission0, q_read, travel_lo, travel_hi);
   if (type == JointType::kRevolute) {
     for (int h = 1; h <= kMaxHarmonic; ++h) {
       const int k = CyclicCosIndex(h);
@@ -456,11 +505,13 @@ Vec3<T> TipInBase(const Chain& chain, const T* const* rows,
   for (int j = 0; j < chain.num_joints(); ++j) {
     const double tm = masses ? in.tau_mass[j] : 0.0;
     const T* err = joint_errors ? joint_errors[j] : nullptr;
-    q[j] = trig ? ModelJointValueTrig<T>(chain.rows[j].type, in.q[j], in.s[j],
-                                         in.tau[j], err, tm,
-                                         &in.trig[2 * kMaxHarmonic * j])
-                : ModelJointValue<T>(chain.rows[j].type, in.q[j], in.s[j],
-                                     in.tau[j], err, tm);
+    const ChainRow& row = chain.rows[j];
+    q[j] =
+        trig ? ModelJointValueTrig<T>(row.type, in.q[j], in.s[j], in.tau[j],
+                                      err, tm, &in.trig[2 * kMaxHarmonic * j],
+                                      row.transmission_lo, row.transmission_hi)
+             : ModelJointValue<T>(row.type, in.q[j], in.s[j], in.tau[j], err,
+                                  tm, row.transmission_lo, row.transmission_hi);
   }
   Vec3<T> p;
   if (joint_errors != nullptr && in.thermal_x != 0.0) {

@@ -7,10 +7,15 @@
 namespace kincal {
 namespace {
 constexpr double kRadToDeg = 180.0 / M_PI;
-const char* kJointErrorNames[kJointErrorBlockSize] = {
+const char* kJointErrorNames[kTransmission0] = {
     "gain",        "backlash",     "compliance",  "cyclic_cos",
     "cyclic_sin",  "cyclic2_cos",  "cyclic2_sin", "cyclic3_cos",
     "cyclic3_sin", "elastostatic", "thermal"};
+// Entries past kTransmission0: "transmission1" .. "transmission24".
+std::string JointErrorName(int index) {
+  if (index < kTransmission0) return kJointErrorNames[index];
+  return "transmission" + std::to_string(index - kTransmission0 + 1);
+}
 }  // namespace
 
 int ModelState::PointIndex(const std::string& label) const {
@@ -107,7 +112,7 @@ ParamInfo JointErrorParam(const Chain& chain, int joint, int index) {
   // per mm of torque; all shown in degrees. Gain is dimensionless.
   const bool angle = chain.rows.at(joint).type == JointType::kRevolute &&
                      index != kGain && index != kThermal;
-  return {chain.rows[joint].name + "." + kJointErrorNames[index],
+  return {chain.rows[joint].name + "." + JointErrorName(index),
           ParamKind::kJointError, joint, index, angle};
 }
 

@@ -56,7 +56,8 @@ const std::map<std::string, std::vector<std::string>>& ExtensionFields() {
       {"backlash", {"width"}},       {"compliance", {"per_torque"}},
       {"cyclic", {"cos", "sin"}},    {"gain", {"g"}},
       {"drift", {"vx", "vy", "vz"}}, {"elastostatic", {"per_knm"}},
-      {"thermal", {"rate"}},         {"mount_compliance", {"iso"}}};
+      {"thermal", {"rate"}},         {"mount_compliance", {"iso"}},
+      {"transmission", {"lo", "hi"}}};
   return fields;
 }
 
@@ -66,7 +67,13 @@ const std::vector<std::string>& OptionalFields(const std::string& cause) {
                                                   "sin3"};
   static const std::vector<std::string> mount = {"aniso_cos", "aniso_sin"};
   static const std::vector<std::string> none;
+  static const std::vector<std::string> transmission = [] {
+    std::vector<std::string> v;  // s1 .. s24: sine series coefficients
+    for (int k = 1; k <= 24; ++k) v.push_back("s" + std::to_string(k));
+    return v;
+  }();
   if (cause == "mount_compliance") return mount;
+  if (cause == "transmission") return transmission;
   return cause == "cyclic" ? cyclic : none;
 }
 
@@ -267,7 +274,7 @@ Robot ParseRobotYaml(const std::string& text, const std::string& file) {
         r.Fail(e["cause"],
                what + ".cause: unknown cause '" + x.cause +
                    "' (expected backlash, compliance, cyclic, gain, "
-                   "elastostatic, thermal, drift or "
+                   "elastostatic, thermal, transmission, drift or "
                    "mount_compliance; axis tilt is a row's beta)");
       }
       if (x.cause != "drift" && x.cause != "mount_compliance") {
@@ -290,6 +297,12 @@ Robot ParseRobotYaml(const std::string& text, const std::string& file) {
       }
       for (const auto& f : it->second) {
         if (!x.values.count(f)) r.Fail(e, what + ": missing field '" + f + "'");
+      }
+      if (x.cause == "transmission" &&
+          !(x.values.at("hi") > x.values.at("lo"))) {
+        r.Fail(e["hi"], what + ": transmission travel needs hi > lo, got lo " +
+                            FormatDouble(x.values.at("lo")) + ", hi " +
+                            FormatDouble(x.values.at("hi")));
       }
       robot.extensions.push_back(x);
     }

@@ -89,6 +89,35 @@ TEST(RobotYamlTest, WriteThenReadIsIdentity) {
   EXPECT_EQ(back.extensions[0].values.at("width"), 0.42);
 }
 
+TEST(RobotYamlTest, TransmissionSeriesRoundTripAndTravelChecked) {
+  Robot r = ParseRobotYaml(kSpecExample, "spec.yaml");
+  r.extensions.push_back({"transmission",
+                          "j3",
+                          {{"lo", -120.5},
+                           {"hi", 35.25},
+                           {"s1", 0.01},
+                           {"s17", -0.0042},
+                           {"s24", 1e-5}}});
+  const Robot back = ParseRobotYaml(FormatRobotYaml(r), "back.yaml");
+  ASSERT_EQ(back.extensions.size(), 1u);
+  EXPECT_EQ(back.extensions[0].values, r.extensions[0].values);
+  // Travel reversed, an unknown term, a missing travel: file:line:column.
+  std::string text = FormatRobotYaml(r);
+  const std::string good = "hi: 35.25";
+  std::string bad = text;
+  bad.replace(bad.find(good), good.size(), "hi: -130");
+  EXPECT_NE(ErrorOf(bad).find("hi > lo"), std::string::npos) << ErrorOf(bad);
+  EXPECT_NE(ErrorOf(bad).find("r.yaml:"), std::string::npos);
+  bad = text;
+  bad.replace(bad.find("s24"), 3, "s25");
+  EXPECT_NE(ErrorOf(bad).find("unknown field 's25'"), std::string::npos)
+      << ErrorOf(bad);
+  bad = text;
+  bad.replace(bad.find("lo: -120.5, "), 12, "");
+  EXPECT_NE(ErrorOf(bad).find("missing field 'lo'"), std::string::npos)
+      << ErrorOf(bad);
+}
+
 TEST(RobotYamlTest, LinkMassAndCentreOfMassRoundTrip) {
   std::string text = kSpecExample;
   const std::string row = "a: 200, theta: 0}";

@@ -56,10 +56,47 @@ double RowLength(const Chain& chain, int row) {
 
 const std::vector<std::string>& CatalogueCauses() {
   static const std::vector<std::string> causes = {
-      "backlash",     "compliance", "cyclic",
-      "gain",         "axis_tilt",  "drift",
-      "elastostatic", "thermal",    "mount_compliance"};
+      "backlash",         "compliance",  "cyclic",       "gain",
+      "axis_tilt",        "drift",       "elastostatic", "thermal",
+      "mount_compliance", "transmission"};
   return causes;
+}
+
+namespace {
+constexpr int kTransmissionTermChoices[] = {8, 16, kMaxTransmissionTerms};
+}  // namespace
+
+int TransmissionTerms(const std::string& cause) {
+  for (int t : kTransmissionTermChoices) {
+    if (cause == TransmissionCause(t)) return t;
+  }
+  return 0;
+}
+
+std::string TransmissionCause(int terms) {
+  return "transmission" + std::to_string(terms);
+}
+
+std::string SpecCauseName(const std::string& cause) {
+  if (CyclicHarmonic(cause) > 0) return "cyclic";
+  if (TransmissionTerms(cause) > 0) return "transmission";
+  return cause;
+}
+
+void SetTransmissionTravel(const std::vector<Measurement>& ms, Chain* chain) {
+  for (int j = 0; j < chain->num_joints(); ++j) {
+    ChainRow& row = chain->rows[j];
+    if (row.transmission_hi > row.transmission_lo) continue;
+    double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+    for (const Measurement& m : ms) {
+      lo = std::min(lo, m.input.q[j]);
+      hi = std::max(hi, m.input.q[j]);
+    }
+    if (hi > lo) {
+      row.transmission_lo = lo;
+      row.transmission_hi = hi;
+    }
+  }
 }
 
 // The scale that turns a candidate's parameter into the spec's magnitude:
@@ -99,6 +136,9 @@ Candidate MakeCandidate(const Chain& chain, const std::string& cause,
     c.params = {JointErrorParam(chain, joint, kThermal)};
   } else if (cause == "mount_compliance") {
     c.params = {MountParams()[0]};
+  } else if (TransmissionTerms(cause) > 0) {
+    for (int k = 0; k < TransmissionTerms(cause); ++k)
+      c.params.push_back(JointErrorParam(chain, joint, kTransmission0 + k));
   }
   return c;
 }
@@ -179,6 +219,13 @@ std::vector<Candidate> CatalogueCandidates(
       }
       if (hi - lo > 1e-9) out.push_back(MakeCandidate(chain, "thermal", j));
     }
+    // The joint's error along its travel, coarse to fine (nested series):
+    // needs the travel (SetTransmissionTravel) and enough distinct readings.
+    const ChainRow& row = chain.rows[j];
+    if (wanted("transmission") && row.transmission_hi > row.transmission_lo) {
+      for (int t : kTransmissionTermChoices)
+        out.push_back(MakeCandidate(chain, TransmissionCause(t), j));
+    }
     if (wanted("axis_tilt") && j >= 1 &&
         std::find(parallel.begin(), parallel.end(), j - 1) != parallel.end()) {
       out.push_back(MakeCandidate(chain, "axis_tilt", j));
@@ -254,6 +301,17 @@ Magnitude CandidateMagnitude(const Candidate& c, const ModelState& state,
     m.unit = "deg";
     m.value = v[0] * kRadToDeg;
     grad[0] = kRadToDeg;
+  } else if (TransmissionTerms(c.cause) > 0) {
+    // RMS of the error over the travel (calib/chain.h TransmissionError):
+    // sqrt(|c|^2 / 2 - (m . c)^2).
+    m.unit = revolute ? "deg" : "mm";
+    Eigen::VectorXd mean(k);
+    for (int a = 0; a < k; ++a)
+      mean[a] = TransmissionMean(c.params[a].index - kTransmission0 + 1);
+    const double mc = mean.dot(v);
+    const double rms = std::sqrt(std::max(0.0, v.squaredNorm() / 2 - mc * mc));
+    m.value = rms * angle_unit;
+    if (rms > 0) grad = (v / 2 - mc * mean) / rms * angle_unit;
   } else {  // cyclic (deg amplitude) and drift (mm/h norm)
     const bool cyclic = CyclicHarmonic(c.cause) > 0;
     const double unit = cyclic ? kRadToDeg : 1.0;
@@ -266,7 +324,8 @@ Magnitude CandidateMagnitude(const Candidate& c, const ModelState& state,
   m.sigma = var >= 0 ? std::sqrt(var) : kNaN;
   m.ci_low = m.value - kZ95 * m.sigma;
   m.ci_high = m.value + kZ95 * m.sigma;
-  if (CyclicHarmonic(c.cause) > 0 || c.cause == "drift")
+  if (CyclicHarmonic(c.cause) > 0 || TransmissionTerms(c.cause) > 0 ||
+      c.cause == "drift")
     m.ci_low = std::max(0.0, m.ci_low);
   return m;
 }

@@ -14,7 +14,8 @@
 //   (the spec's catalogue); elastostatic (joint deflection under the
 //   gravity torque of the link masses), thermal (growth of a row's lengths
 //   with temp_c or time), mount_compliance (base tilt under the arm's
-//   gravity moment).
+//   gravity moment), transmission (a joint error that varies along the
+//   joint's travel: a sine series over the travel of the data).
 
 #include <string>
 #include <vector>
@@ -33,6 +34,21 @@ const std::vector<std::string>& CatalogueCauses();
 // them and 0 for any other cause.
 int CyclicHarmonic(const std::string& cause);
 std::string CyclicCause(int harmonic);
+
+// Transmission candidates carry their number of sine terms: "transmission8",
+// "transmission16", "transmission24" (nested: each series contains the
+// shorter ones). TransmissionTerms returns 8, 16, 24 for them, else 0.
+int TransmissionTerms(const std::string& cause);
+std::string TransmissionCause(int terms);
+// The spec's name of an internal cause: "cyclic" for cyclic2/3,
+// "transmission" for transmissionN, else the cause itself.
+std::string SpecCauseName(const std::string& cause);
+
+// Sets the travel of every moving joint whose chain row has none
+// (ChainRow::transmission_lo/hi) to the range of its readings in
+// `measurements`: the interval the transmission family's series lives on.
+void SetTransmissionTravel(const std::vector<Measurement>& measurements,
+                           Chain* chain);
 
 // One catalogue candidate: a cause on a joint (joint -1 for drift and
 // mount_compliance).

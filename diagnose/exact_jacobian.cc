@@ -3,6 +3,7 @@
 #include <ceres/jet.h>
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <array>
 #include <cmath>
 
@@ -151,15 +152,24 @@ void ResidualsAndJacobian(const std::vector<Measurement>& measurements,
 
   // Which hooks need derivatives: joint values of joints with a free joint
   // error entry (thermal aside), the global block.
+  // The free entries of each joint's error block (thermal aside) are
+  // differentiated in chunks of kChunk (the joint value is cheap; a Jet over
+  // the whole block would mostly carry zeros).
   bool need_dq[kMaxJoints] = {};
+  std::vector<int> free_entries[kMaxJoints];
   bool need_global = false;
   for (const ParamInfo& p : params) {
     if (!jacobian) break;
-    if (p.kind == ParamKind::kJointError && p.index != kThermal)
+    if (p.kind == ParamKind::kJointError && p.index != kThermal) {
       need_dq[p.block] = true;
+      std::vector<int>& f = free_entries[p.block];
+      if (std::find(f.begin(), f.end(), p.index) == f.end())
+        f.push_back(p.index);
+    }
     if (p.kind == ParamKind::kDrift) need_global = true;
   }
-  using JetE = ceres::Jet<double, kJointErrorBlockSize>;
+  constexpr int kChunk = 8;
+  using JetE = ceres::Jet<double, kChunk>;
   using Jet9 = ceres::Jet<double, 9>;
   for (int pose = 0; pose < m; ++pose) {
     const Measurement& meas = measurements[pose];
@@ -175,23 +185,35 @@ void ResidualsAndJacobian(const std::vector<Measurement>& measurements,
       const double tm = masses ? in.tau_mass[j] : 0.0;
       const double* tr = trig ? &in.trig[2 * kMaxHarmonic * j] : nullptr;
       const JointType type = chain.rows[j].type;
+      const double lo = chain.rows[j].transmission_lo;
+      const double hi = chain.rows[j].transmission_hi;
       if (!need_dq[j]) {
         const double* e = chain.joint_errors[j].data();
         q[j] = trig ? ModelJointValueTrig<double>(type, in.q[j], in.s[j],
-                                                  in.tau[j], e, tm, tr)
+                                                  in.tau[j], e, tm, tr, lo, hi)
                     : ModelJointValue<double>(type, in.q[j], in.s[j], in.tau[j],
-                                              e, tm);
+                                              e, tm, lo, hi);
         continue;
       }
+      const std::vector<int>& f = free_entries[j];
       JetE e[kJointErrorBlockSize];
       for (int t = 0; t < kJointErrorBlockSize; ++t)
-        e[t] = JetE(chain.joint_errors[j][t], t);
-      const JetE qj = trig ? ModelJointValueTrig<JetE>(type, in.q[j], in.s[j],
-                                                       in.tau[j], e, tm, tr)
-                           : ModelJointValue<JetE>(type, in.q[j], in.s[j],
-                                                   in.tau[j], e, tm);
-      q[j] = qj.a;
-      dq[j] = qj.v;
+        e[t] = JetE(chain.joint_errors[j][t]);
+      for (size_t first = 0; first < f.size(); first += kChunk) {
+        const size_t last = std::min(f.size(), first + kChunk);
+        for (size_t c = first; c < last; ++c)
+          e[f[c]] = JetE(chain.joint_errors[j][f[c]], int(c - first));
+        const JetE qj =
+            trig ? ModelJointValueTrig<JetE>(type, in.q[j], in.s[j], in.tau[j],
+                                             e, tm, tr, lo, hi)
+                 : ModelJointValue<JetE>(type, in.q[j], in.s[j], in.tau[j], e,
+                                         tm, lo, hi);
+        q[j] = qj.a;
+        for (size_t c = first; c < last; ++c) {
+          dq[j][f[c]] = qj.v[c - first];
+          e[f[c]] = JetE(chain.joint_errors[j][f[c]]);
+        }
+      }
     }
     // Thermal scaling of the rows' lengths (calib/chain.h TipInBase).
     const bool thermal = in.thermal_x != 0.0;

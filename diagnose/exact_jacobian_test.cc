@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <random>
 
 #include "data/urdf.h"
@@ -61,6 +62,17 @@ void Check(const Robot& robot, uint64_t seed) {
   for (auto& e : c.joint_errors)
     for (double& v : e) v = 1e-3 * u(rng);
   c.joint_errors[1].fill(0.0);  // a joint without errors (read angle's trig)
+  // Transmission series on the other joints' travel (part of the readings
+  // fall outside it: both branches).
+  for (int j = 0; j < c.num_joints(); ++j) {
+    double lo = 1e300, hi = -1e300;
+    for (const Measurement& m : ms) {
+      lo = std::min(lo, m.input.q[j]);
+      hi = std::max(hi, m.input.q[j]);
+    }
+    c.rows[j].transmission_lo = lo + 0.1 * (hi - lo);
+    c.rows[j].transmission_hi = hi - 0.1 * (hi - lo);
+  }
   for (double& v : c.drift) v = 1e-3 * u(rng);
   for (int i = 0; i < 3; ++i) {
     state.meas_from_base[i] = 0.3 * u(rng);

@@ -255,7 +255,7 @@ void DiagnoseOptions::Check() const {
                 CatalogueCauses().end(),
             "unknown cause '" + c +
                 "' (backlash, compliance, cyclic, gain, axis_tilt, drift, "
-                "elastostatic, thermal, mount_compliance)");
+                "elastostatic, thermal, mount_compliance, transmission)");
   }
 }
 
@@ -273,6 +273,9 @@ DiagnosisResult DiagnoseModel(const Robot& nominal, const Observations& obs,
                &held_idx);
   pb.train = Pick(pb.all, train_idx);
   pb.held = Pick(pb.all, held_idx);
+  // The transmission family lives on the joints' travel in the training data.
+  SetTransmissionTravel(pb.train, &pb.nominal);
+  SetTransmissionTravel(pb.train, &pb.base_state.chain);
   out.train_poses = static_cast<int>(pb.train.size());
   out.heldout_poses = static_cast<int>(pb.held.size());
   FitBase(pb.train, obs.source, &pb, options.exact_jacobian);
@@ -349,8 +352,26 @@ DiagnosisResult DiagnoseModel(const Robot& nominal, const Observations& obs,
     }
     // Normal equations of the base model, shared by every candidate's
     // Gauss-Newton start.
-    const Eigen::MatrixXd base_ntn = base_raw.transpose() * base_raw;
-    const Eigen::VectorXd base_ntr = base_raw.transpose() * r0;
+    // Screening: each candidate is refitted with the geometry and the frame
+    // free and the extensions accepted in earlier steps held at their fitted
+    // values (a transmission series carries up to 24 of them; freeing them
+    // all in every candidate's refit made series C 10x slower). Holding them
+    // can only raise a candidate's RSS, so its F-test is conservative; the
+    // winner is refitted jointly with everything below.
+    std::vector<ParamInfo> screen_free;
+    std::vector<int> screen_cols;
+    for (size_t q = 0; q < current_free.size(); ++q) {
+      if (current_free[q].kind == ParamKind::kJointError ||
+          current_free[q].kind == ParamKind::kDrift)
+        continue;
+      screen_free.push_back(current_free[q]);
+      screen_cols.push_back(static_cast<int>(q));
+    }
+    Eigen::MatrixXd screen_raw(base_raw.rows(), screen_cols.size());
+    for (size_t q = 0; q < screen_cols.size(); ++q)
+      screen_raw.col(q) = base_raw.col(screen_cols[q]);
+    const Eigen::MatrixXd base_ntn = screen_raw.transpose() * screen_raw;
+    const Eigen::VectorXd base_ntr = screen_raw.transpose() * r0;
     std::vector<bool> usable(pool.size());
     for (size_t c = 0; c < pool.size(); ++c) {
       const int k = static_cast<int>(pool[c].params.size());
@@ -381,13 +402,13 @@ DiagnosisResult DiagnoseModel(const Robot& nominal, const Observations& obs,
         return;
       }
       FitOptions fo;
-      fo.free = current_free;
+      fo.free = screen_free;
       for (const ParamInfo& q : cand.params) fo.free.push_back(q);
       // Start from the Gauss-Newton step of the linearised joint model, so
       // that the refit needs few iterations: normal equations of [base,
       // candidate columns], Jacobi-scaled.
-      const int pb_cols = static_cast<int>(base_raw.cols());
-      Eigen::MatrixXd cc(base_raw.rows(), s.k);
+      const int pb_cols = static_cast<int>(screen_raw.cols());
+      Eigen::MatrixXd cc(screen_raw.rows(), s.k);
       for (int q = 0; q < s.k; ++q) {
         int col = first[c];
         while (all_params[col].name != cand.params[q].name) ++col;
@@ -395,7 +416,7 @@ DiagnosisResult DiagnoseModel(const Robot& nominal, const Observations& obs,
       }
       Eigen::MatrixXd ntn(pb_cols + s.k, pb_cols + s.k);
       ntn.topLeftCorner(pb_cols, pb_cols) = base_ntn;
-      ntn.topRightCorner(pb_cols, s.k) = base_raw.transpose() * cc;
+      ntn.topRightCorner(pb_cols, s.k) = screen_raw.transpose() * cc;
       ntn.bottomLeftCorner(s.k, pb_cols) =
           ntn.topRightCorner(pb_cols, s.k).transpose();
       ntn.bottomRightCorner(s.k, s.k) = cc.transpose() * cc;
@@ -413,8 +434,8 @@ DiagnosisResult DiagnoseModel(const Robot& nominal, const Observations& obs,
                                      .ldlt()
                                      .solve(-(scale.asDiagonal() * ntr));
       } else {  // QR of the scaled Jacobian, as before
-        Eigen::MatrixXd a(base_raw.rows(), pb_cols + s.k);
-        a << base_raw, cc;
+        Eigen::MatrixXd a(screen_raw.rows(), pb_cols + s.k);
+        a << screen_raw, cc;
         step = scale.asDiagonal() *
                (a * scale.asDiagonal()).colPivHouseholderQr().solve(-r0);
       }
@@ -501,6 +522,33 @@ DiagnosisResult DiagnoseModel(const Robot& nominal, const Observations& obs,
       }
     }
     if (best < 0) break;
+    if (screen_free.size() < current_free.size()) {
+      // The winner refitted jointly with the extensions held in screening.
+      FitOptions fo;
+      fo.free = current_free;
+      for (const ParamInfo& q : pool[best].params) fo.free.push_back(q);
+      fo.bounds_center = &pb.nominal;
+      fo.compute_covariance = false;
+      fo.max_iterations = 100;
+      fo.function_tolerance = 1e-10;
+      fo.parameter_tolerance = 1e-10;
+      if (options.free_parameter_fit) {
+        FreeFitOptions ffo = FreeFitOptionsFrom(fo);
+        ffo.exact_jacobian = options.exact_jacobian;
+        FreeFit(pb.train, ffo, &states[best]);
+      } else {
+        fits[best] = Fit(pb.train, fo, &states[best]);
+      }
+      CandidateScore& w = scores[best];
+      w.rss = Rss(states[best], pb.train);
+      w.train_rms_mm = Rms(states[best], pb.train);
+      if (!pb.held.empty()) w.heldout_rms_mm = Rms(states[best], pb.held);
+      if (!validation.empty())
+        w.validation_rms_mm = ValidationRms(states[best], validation);
+      w.magnitude = CandidateMagnitude(pool[best], states[best], fits[best],
+                                       scale_of(pool[best]))
+                        .value;
+    }
     const CandidateScore& b = scores[best];
     Finding f;
     f.cause = b.cause;
@@ -635,6 +683,8 @@ std::vector<Magnitude> FitCandidates(const Robot& nominal,
   pb.nominal = Chain::FromRobot(nominal);
   pb.base_state = StateWithChain(pb.nominal);
   pb.all = Measurements(pb.nominal, obs, &pb.base_state);
+  SetTransmissionTravel(pb.all, &pb.nominal);
+  SetTransmissionTravel(pb.all, &pb.base_state.chain);
   FitBase(pb.all, obs.source, &pb);
   const std::vector<Candidate> catalogue =
       CatalogueCandidates(pb.nominal, pb.all);
@@ -686,8 +736,10 @@ nlohmann::json Num(double v) {
 }
 // Internal causes cyclic2 / cyclic3 are the spec's cyclic at a higher
 // harmonic: reported as cause "cyclic" with "harmonic" 2 or 3.
-std::string SpecCause(const std::string& cause) {
-  return CyclicHarmonic(cause) > 0 ? "cyclic" : cause;
+std::string SpecCause(const std::string& cause) { return SpecCauseName(cause); }
+nlohmann::json TermsOrNull(const std::string& cause) {
+  const int t = TransmissionTerms(cause);
+  return t > 0 ? nlohmann::json(t) : nlohmann::json(nullptr);
 }
 nlohmann::json HarmonicOrNull(const std::string& cause) {
   const int h = CyclicHarmonic(cause);
@@ -707,6 +759,7 @@ nlohmann::json DiagnosisJson(const DiagnosisResult& r,
     for (const Equivalent& e : f.equivalent) {
       eq.push_back({{"cause", SpecCause(e.cause)},
                     {"harmonic", HarmonicOrNull(e.cause)},
+                    {"terms", TermsOrNull(e.cause)},
                     {"joint", JointOrNull(e.joint)},
                     {"magnitude", Num(e.magnitude)},
                     {"unit", e.unit},
@@ -716,6 +769,7 @@ nlohmann::json DiagnosisJson(const DiagnosisResult& r,
     findings.push_back(
         {{"cause", SpecCause(f.cause)},
          {"harmonic", HarmonicOrNull(f.cause)},
+         {"terms", TermsOrNull(f.cause)},
          {"joint", JointOrNull(f.joint)},
          {"magnitude", Num(f.magnitude)},
          {"unit", f.unit},
@@ -748,6 +802,7 @@ nlohmann::json DiagnosisJson(const DiagnosisResult& r,
     for (const CandidateScore& c : step) {
       table.push_back({{"cause", SpecCause(c.cause)},
                        {"harmonic", HarmonicOrNull(c.cause)},
+                       {"terms", TermsOrNull(c.cause)},
                        {"joint", JointOrNull(c.joint)},
                        {"identifiable", c.identifiable},
                        {"parameters", c.k},

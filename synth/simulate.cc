@@ -5,6 +5,7 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <random>
 #include <sstream>
 
@@ -51,6 +52,11 @@ Vec3<Jet> TipJet(const Chain& chain, const PoseInput& in, const Jet* q_read) {
            Jet(e[kCompliance] * in.tau[j]);
     if (in.tau_mass.size() == chain.rows.size() - 1)
       q[j] += Jet(e[kElastostatic] * in.tau_mass[j]);
+    // Its value only: d/dq of the small transmission error is left out of
+    // the IK's Jacobian (Newton still converges on the error's value).
+    q[j] += Jet(TransmissionError(&e[kTransmission0], q_read[j].a,
+                                  chain.rows[j].transmission_lo,
+                                  chain.rows[j].transmission_hi));
     if (chain.rows[j].type == JointType::kRevolute) {
       for (int h = 1; h <= kMaxHarmonic; ++h) {
         const int k = CyclicCosIndex(h);
@@ -127,8 +133,8 @@ Effect ParseEffect(const std::string& text, const Robot& robot) {
   const std::string usage =
       "--effect '" + text +
       "': expected cause:joint:magnitude (backlash, compliance, cyclic, gain, "
-      "axis_tilt, elastostatic, thermal) or drift:magnitude or "
-      "mount_compliance:magnitude";
+      "axis_tilt, elastostatic, thermal, transmission) or drift:magnitude "
+      "or mount_compliance:magnitude";
   if (parts.size() == 2 &&
       (parts[0] == "drift" || parts[0] == "mount_compliance") &&
       ParseFiniteDouble(parts[1], &value)) {
@@ -146,7 +152,8 @@ Effect ParseEffect(const std::string& text, const Robot& robot) {
       e.cause == "cyclic" || e.cause == "cyclic2" || e.cause == "cyclic3";
   if (e.cause != "backlash" && e.cause != "compliance" && !cyclic &&
       e.cause != "gain" && e.cause != "axis_tilt" &&
-      e.cause != "elastostatic" && e.cause != "thermal") {
+      e.cause != "elastostatic" && e.cause != "thermal" &&
+      e.cause != "transmission") {
     throw InputError(usage);
   }
   const int j = robot.JointIndex(e.joint);
@@ -346,6 +353,35 @@ SimulatedSession Simulate(const Robot& nominal, const SimulateOptions& opt) {
       err[kThermal] = e.magnitude / length;
       note << "rate " << err[kThermal] << " per h (row length " << length
            << " mm)";
+    } else if (e.cause == "transmission") {
+      // An error along the joint's travel that is not the diagnosis' own
+      // series: sines 3, 5 and 9 over a travel wider than the readings'
+      // (30 % below, 20 % above; the error is neither zero nor symmetric
+      // at the data's ends), random signs. Magnitude: RMS over that travel.
+      double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+      for (const auto& in : inputs) {
+        lo = std::min(lo, in.q[j]);
+        hi = std::max(hi, in.q[j]);
+      }
+      Require(hi > lo, "transmission on joint '" + e.joint +
+                           "': the joint does not move in these poses");
+      const double range = hi - lo;
+      truth.rows[j].transmission_lo = lo - 0.3 * range;
+      truth.rows[j].transmission_hi = hi + 0.2 * range;
+      const int terms[3] = {3, 5, 9};
+      const double weights[3] = {1.0, 0.7, 0.5};
+      double norm2 = 0.0, mean = 0.0;
+      for (int t = 0; t < 3; ++t) {
+        const double sign = uniform(rng) < 0.5 ? -1.0 : 1.0;
+        err[kTransmission0 + terms[t] - 1] = sign * weights[t];
+        norm2 += weights[t] * weights[t];
+        mean += sign * weights[t] * TransmissionMean(terms[t]);
+      }
+      const double to_rms =
+          e.magnitude * unit / std::sqrt(norm2 / 2 - mean * mean);
+      for (int t = 0; t < 3; ++t) err[kTransmission0 + terms[t] - 1] *= to_rms;
+      note << "sines 3, 5, 9 over [" << truth.rows[j].transmission_lo / unit
+           << ", " << truth.rows[j].transmission_hi / unit << "]";
     } else if (e.cause == "axis_tilt") {
       truth.rows[j - 1].p[4] += e.magnitude * kDegToRad;
       note << "beta on row " << truth.rows[j - 1].name;
@@ -390,7 +426,8 @@ SimulatedSession Simulate(const Robot& nominal, const SimulateOptions& opt) {
     for (int j = 0; j < n; ++j) {
       q[j] = ModelJointValue<double>(
           truth.rows[j].type, inputs[i].q[j], inputs[i].s[j], inputs[i].tau[j],
-          truth.joint_errors[j].data(), inputs[i].tau_mass[j]);
+          truth.joint_errors[j].data(), inputs[i].tau_mass[j],
+          truth.rows[j].transmission_lo, truth.rows[j].transmission_hi);
     }
     Eigen::Matrix4d m = BaseFromTipAt(truth, q);
     for (int k = 0; k < 3; ++k) m(k, 3) += truth.drift[k] * inputs[i].t_h;
