@@ -349,6 +349,8 @@ void CvSimulated(int runs) {
       {&bh7, "backlash:j3:0.03", "backlash", "j3", 0.03, 120, 0.03},
       {&bh7, "cyclic:j2:0.01", "cyclic", "j2", 0.01, 120, 0.03},
       {&bh7, "compliance:j5:0.03", "compliance", "j5", 0.03, 120, 0.03},
+      {&bh7, "compliance:j5:0.2", "compliance", "j5", 0.2, 180, 0.02},
+      {&bh7, "cyclic:j5:0.1", "cyclic", "j5", 0.1, 180, 0.02},
       {&ur10, "elastostatic:shoulder_lift_joint:0.01", "elastostatic",
        "shoulder_lift_joint", 0.01, 150, 0.03},
       {&ur10, "gain:elbow_joint:0.0005", "gain", "elbow_joint", 0.0005, 150,
@@ -363,11 +365,14 @@ void CvSimulated(int runs) {
       "and joint (magnitude within 25 %%); null: false alarms\n",
       runs);
   std::printf("  %-44s %6s  %-22s %-22s %-22s\n", "case", "poses",
-              "single split", "5 folds", "10 folds");
+              "single split", "5 folds, z>0, ties 2",
+              "5 folds, z>1.64, ties 2");
   for (const Case& c : cases) {
     std::string cells[3];
     double seconds[3] = {0, 0, 0};
-    const int folds[3] = {0, 5, 10};
+    const int folds[3] = {0, 5, 5};
+    const double tie_z[3] = {0.0, 2.0, 2.0};
+    const double min_z[3] = {0.0, 0.0, 1.645};
     int hits[3] = {0, 0, 0}, within[3] = {0, 0, 0}, alarms[3] = {0, 0, 0};
     for (int run = 0; run < runs; ++run) {
       const SimulatedSession s =
@@ -379,6 +384,8 @@ void CvSimulated(int runs) {
         DiagnoseOptions o;
         o.folds = folds[m];
         o.folds_given = true;
+        o.cv_tie_z = tie_z[m];
+        o.cv_min_z = min_z[m];
         const auto start = std::chrono::steady_clock::now();
         const DiagnosisResult r = DiagnoseModel(s.nominal, s.observations, o);
         seconds[m] += Seconds(start);

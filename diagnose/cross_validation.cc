@@ -89,6 +89,7 @@ FoldPlan MakeFolds(const std::vector<Measurement>& ms, int folds,
 double CrossValidatedRms(const std::vector<Measurement>& ms,
                          const FoldPlan& plan, const ModelState& fitted,
                          const FreeFitOptions& options, bool refit,
+                         std::vector<double>* per_pose,
                          const Eigen::VectorXd* r_in,
                          const Eigen::MatrixXd* J_in) {
   const int K = plan.folds;
@@ -98,6 +99,7 @@ double CrossValidatedRms(const std::vector<Measurement>& ms,
     members[plan.fold_of[i]].push_back(static_cast<int>(i));
   const int P = static_cast<int>(options.free.size());
   double sum = 0.0;
+  if (per_pose) per_pose->assign(ms.size(), 0.0);
 
   if (refit) {
     for (int f = 0; f < K; ++f) {
@@ -109,6 +111,10 @@ double CrossValidatedRms(const std::vector<Measurement>& ms,
       Eigen::VectorXd rk;
       ResidualsAndJacobian(fold, s, {}, &rk, nullptr);
       sum += rk.squaredNorm();
+      if (per_pose) {
+        for (int j = 0; j < static_cast<int>(members[f].size()); ++j)
+          (*per_pose)[members[f][j]] = rk.segment<3>(3 * j).squaredNorm();
+      }
     }
     return std::sqrt(sum / static_cast<double>(ms.size()));
   }
@@ -152,9 +158,34 @@ double CrossValidatedRms(const std::vector<Measurement>& ms,
       for (int i = 0; i < P; ++i)  // projected onto the box
         d[i] = std::min(std::max(x[i] + d[i], lower[i]), upper[i]) - x[i];
     }
-    sum += (rf[f] + Jf[f] * d).squaredNorm();
+    const Eigen::VectorXd e = rf[f] + Jf[f] * d;
+    sum += e.squaredNorm();
+    if (per_pose) {
+      for (int j = 0; j < static_cast<int>(members[f].size()); ++j)
+        (*per_pose)[members[f][j]] = e.segment<3>(3 * j).squaredNorm();
+    }
   }
   return std::sqrt(sum / static_cast<double>(ms.size()));
+}
+
+double PairedZ(const std::vector<double>& a, const std::vector<double>& b) {
+  const size_t n = std::min(a.size(), b.size());
+  if (n < 2) return 0.0;
+  double mean = 0.0;
+  for (size_t i = 0; i < n; ++i) mean += a[i] - b[i];
+  mean /= static_cast<double>(n);
+  double var = 0.0;
+  for (size_t i = 0; i < n; ++i) {
+    const double d = a[i] - b[i] - mean;
+    var += d * d;
+  }
+  var /= static_cast<double>(n - 1);
+  if (var <= 0.0) {
+    return mean == 0.0
+               ? 0.0
+               : std::copysign(std::numeric_limits<double>::infinity(), mean);
+  }
+  return mean / std::sqrt(var / static_cast<double>(n));
 }
 
 }  // namespace kincal

@@ -48,11 +48,20 @@ FoldPlan MakeFolds(const std::vector<Measurement>& ms, int folds,
 // `r` / `J` given (the residuals and Jacobian of `ms` at `fitted` in
 // options.free) the linearised path does not recompute them. refit = true:
 // full Levenberg-Marquardt fits per fold instead of the linearised step.
+// `per_pose` (optional) receives each measurement's out-of-fold squared
+// error |r_i(x_{-k})|^2 (mm^2), for paired comparisons of two models.
 double CrossValidatedRms(const std::vector<Measurement>& ms,
                          const FoldPlan& plan, const ModelState& fitted,
                          const FreeFitOptions& options, bool refit = false,
+                         std::vector<double>* per_pose = nullptr,
                          const Eigen::VectorXd* r = nullptr,
                          const Eigen::MatrixXd* J = nullptr);
+
+// Paired comparison of two models' out-of-fold squared errors on the same
+// poses: z = mean(a_i - b_i) / (sd(a_i - b_i) / sqrt(n)), > 0 when b
+// predicts better; 0 when the two are identical, +-inf when every pose
+// differs by the same amount.
+double PairedZ(const std::vector<double>& a, const std::vector<double>& b);
 
 }  // namespace kincal
 

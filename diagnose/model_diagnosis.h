@@ -90,6 +90,13 @@ struct DiagnoseOptions {
   // Full Levenberg-Marquardt refits per fold instead of the linearised
   // fold step (the reference of bench/diagnose_bench --only cv).
   bool cv_refit = false;
+  // A candidate's out-of-fold improvement over the current model must
+  // exceed this many standard errors (paired over the training poses; 1.645
+  // = one-sided 5 %; 0 = the cross-validated RMS must drop).
+  double cv_min_z = 1.645;
+  // Candidates within this many standard errors of the lowest
+  // cross-validated RMS count as tied; the most significant of them wins.
+  double cv_tie_z = 2.0;
 
   void Check() const;  // InputError on invalid values
 };
