@@ -514,11 +514,11 @@ DiagnosisResult DiagnoseModel(const Robot& nominal, const Observations& obs,
         s.cv_rms_mm =
             CrossValidatedRms(pb.train, folds, states[c], cv_options(fo.free),
                               options.cv_refit, &cv_err[c]);
+        s.cv_z = PairedZ(current_cv_err, cv_err[c]);
       }
       const bool held_better =
           folds.folds >= 2
-              ? s.cv_rms_mm < current_cv &&
-                    PairedZ(current_cv_err, cv_err[c]) > options.cv_min_z
+              ? s.cv_rms_mm < current_cv && s.cv_z > options.cv_min_z
               : pb.held.empty() || s.heldout_rms_mm < current_held;
       const double explained_mm =
           std::sqrt(drop / static_cast<double>(pb.train.size()));
@@ -846,6 +846,7 @@ nlohmann::json DiagnosisJson(const DiagnosisResult& r,
                        {"significant", c.significant},
                        {"validation_rms_mm", Num(c.validation_rms_mm)},
                        {"cv_rms_mm", Num(c.cv_rms_mm)},
+                       {"cv_z", Num(c.cv_z)},
                        {"magnitude", Num(c.magnitude)},
                        {"unit", c.unit}});
     }

@@ -114,6 +114,9 @@ struct CandidateScore {
   // Cross-validated RMS over the training poses (NaN without folds, or when
   // the F-test already rejects the candidate).
   double cv_rms_mm = std::numeric_limits<double>::quiet_NaN();
+  // Its out-of-fold improvement over the current model in standard errors
+  // (paired over the training poses; NaN when not computed).
+  double cv_z = std::numeric_limits<double>::quiet_NaN();
   double magnitude = 0.0;  // spec units, from the training fit
   std::string unit;
 };
