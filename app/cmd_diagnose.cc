@@ -92,6 +92,10 @@ int RunModel(const ModelArgs& args) {
                 f.cause.c_str(), FormatJoint(f.joint).c_str(), f.magnitude,
                 f.unit.c_str(), ci, f.heldout_rms_before_mm,
                 f.heldout_rms_after_mm);
+    if (r.folds >= 2 && f.cause != "unexplained") {
+      std::printf("    %d-fold cross-validated RMS %.4f -> %.4f mm\n", r.folds,
+                  f.cv_rms_before_mm, f.cv_rms_after_mm);
+    }
     for (const Equivalent& e : f.equivalent) {
       std::printf("    equivalent on this data: %s %s %.5g %s\n",
                   e.cause.c_str(), FormatJoint(e.joint).c_str(), e.magnitude,
