@@ -15,9 +15,13 @@
 //      Fit with the candidate's parameters freed). Nested-model F-test,
 //      F = ((RSS0 - RSS1) / k) / (RSS1 / (n - p - k)), Bonferroni-corrected
 //      over the candidates of the step (family-wise false-alarm rate
-//      `false_alarm` per step), and the held-out RMS must drop as well.
-//   5. Greedy forward selection: the most significant candidate is added and
-//      the step repeats while a candidate stays significant.
+//      `false_alarm` per step), and the candidate must predict the left-out
+//      folds of a K-fold cross-validation of the training poses better
+//      (diagnose/cross_validation.h; folds = 0: the held-out RMS must drop).
+//   5. Greedy forward selection: the step's winner (lowest cross-validated
+//      RMS, ties to the most significant; with folds = 0 the most
+//      significant) is added and the step repeats while a candidate stays
+//      significant.
 //   6. Candidates whose fits explain the data as well as the chosen one (RSS
 //      difference below the chi-square(1) 95 % point of the noise) are
 //      reported as equivalent instead of guessing between them.
