@@ -72,6 +72,11 @@ int RunModel(const ModelArgs& args) {
       static_cast<unsigned long long>(args.options.seed));
   std::printf("  geometric model: train RMS %.4f mm, held-out RMS %.4f mm\n",
               r.nominal_train_rms_mm, r.nominal_heldout_rms_mm);
+  if (r.folds >= 2) {
+    std::printf(
+        "  %d-fold cross-validated RMS (training poses): %.4f -> %.4f mm\n",
+        r.folds, r.nominal_cv_rms_mm, r.final_cv_rms_mm);
+  }
   std::printf("  noise %.4f mm per axis (%s), residual %.4f mm per axis\n",
               r.noise_mm, r.noise_source.c_str(), r.residual_sigma_mm);
   std::printf("  verdict: %s\n", r.verdict.c_str());
@@ -87,6 +92,10 @@ int RunModel(const ModelArgs& args) {
                 f.cause.c_str(), FormatJoint(f.joint).c_str(), f.magnitude,
                 f.unit.c_str(), ci, f.heldout_rms_before_mm,
                 f.heldout_rms_after_mm);
+    if (r.folds >= 2 && f.cause != "unexplained") {
+      std::printf("    %d-fold cross-validated RMS %.4f -> %.4f mm\n", r.folds,
+                  f.cv_rms_before_mm, f.cv_rms_after_mm);
+    }
     for (const Equivalent& e : f.equivalent) {
       std::printf("    equivalent on this data: %s %s %.5g %s\n",
                   e.cause.c_str(), FormatJoint(e.joint).c_str(), e.magnitude,
@@ -229,6 +238,13 @@ void AddDiagnoseCommand(CLI::App& app, Runner* run) {
                     "restrict the catalogue (e.g. --causes backlash gain)");
   model->add_option("--threads", margs->options.num_threads, "threads")
       ->capture_default_str();
+  model
+      ->add_option("--folds", margs->options.folds,
+                   "k-fold cross-validation of the selection on the training "
+                   "poses: a candidate must lower the cross-validated RMS, "
+                   "the lowest wins (0 or 1 = the single held-out split; "
+                   "default: fewer folds when poses are few)")
+      ->capture_default_str();
   model->add_option("--validate", margs->validate,
                     "other series of the same robot for cross-series "
                     "validation (observations.csv; repeatable)");
@@ -242,8 +258,10 @@ void AddDiagnoseCommand(CLI::App& app, Runner* run) {
       "extended.yaml --diagnosis diag.json --out report.html\nUnits: lengths "
       "mm, angles deg, time s (pixels px). Defaults are shown beside each "
       "option.");
-  model->callback(
-      [run, margs] { *run = [margs] { return RunModel(*margs); }; });
+  model->callback([run, margs, model] {
+    margs->options.folds_given = model->get_option("--folds")->count() > 0;
+    *run = [margs] { return RunModel(*margs); };
+  });
 
   auto cargs = std::make_shared<ClearanceArgs>();
   CLI::App* clear = diag->add_subcommand(

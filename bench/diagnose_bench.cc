@@ -10,6 +10,13 @@
 //      comparison of their results (--repeat R runs each, median; default 3);
 //      (--only ur10-240: the 240 poses only);
 //   6. (--only compare) the diagnose tests' simulated cases, before and now.
+//   7. (--only cv) k-fold cross-validation of the selection on UR10 series
+//      C (240 and 2773 poses): time and findings with the single held-out
+//      split (--folds 0), 5 and 10 folds (linearised fold fits) and 5 folds
+//      with full refits per fold, and how far the linearised
+//      cross-validated RMS is from the refitted one; (--only cv-sim) naming
+//      rates of marginal simulated effects and false alarms on null data,
+//      single split against k folds (--runs N seeds each).
 // Usage: diagnose_bench [--runs N] (N seeds per rate, default 40).
 
 #include <algorithm>
@@ -238,6 +245,187 @@ void CompareTestCases() {
   }
 }
 
+std::string FindingsLabel(const DiagnosisResult& r) {
+  std::string s;
+  for (const Finding& f : r.findings) {
+    if (!s.empty()) s += ", ";
+    s += f.cause + (f.joint.empty() ? "" : " " + f.joint);
+  }
+  return s.empty() ? "none" : s;
+}
+
+// Largest relative difference of the candidates' cross-validated RMS
+// between two diagnoses of the same data (same steps and candidates).
+double CvDifference(const DiagnosisResult& a, const DiagnosisResult& b) {
+  double worst =
+      std::abs(a.nominal_cv_rms_mm - b.nominal_cv_rms_mm) / b.nominal_cv_rms_mm;
+  for (size_t s = 0; s < std::min(a.steps.size(), b.steps.size()); ++s) {
+    for (size_t c = 0; c < std::min(a.steps[s].size(), b.steps[s].size());
+         ++c) {
+      const double x = a.steps[s][c].cv_rms_mm, y = b.steps[s][c].cv_rms_mm;
+      if (std::isfinite(x) && std::isfinite(y))
+        worst = std::max(worst, std::abs(x - y) / y);
+    }
+  }
+  return worst;
+}
+
+void CvUr10(int repeat) {
+  const std::string file = std::string(KINCAL_SOURCE_DIR) +
+                           "/../shared/data/ipa-robot-accuracy/Series_C/"
+                           "measurements_random_poses.csv";
+  if (!std::ifstream(file)) {
+    std::printf("== cv: %s absent, skipped\n", file.c_str());
+    return;
+  }
+  const Robot ur10 =
+      ReadRobotYaml(std::string(KINCAL_SOURCE_DIR) + "/data/robots/ur10.yaml");
+  const Observations all = ReadIpaSeries(file, ur10.JointNames()).observations;
+  std::vector<int> first;
+  for (int i = 0; i < 240; ++i) first.push_back(i * 11);
+  const Observations small = Subset(all, first);
+  std::printf(
+      "== cv: UR10 series C, diagnose model, median of %d, wall / process "
+      "CPU seconds (2 threads)\n",
+      repeat);
+  struct Mode {
+    const char* name;
+    int folds;
+    bool refit;
+  };
+  const Mode modes[] = {{"single split (--folds 0)", 0, false},
+                        {"5 folds, linearised", 5, false},
+                        {"10 folds, linearised", 10, false},
+                        {"5 folds, refit per fold", 5, true}};
+  for (const Observations* obs : {&small, &all}) {
+    DiagnosisResult lin5, refit5;
+    for (const Mode& m : modes) {
+      DiagnoseOptions o;
+      o.folds = m.folds;
+      o.cv_refit = m.refit;
+      std::vector<double> walls, cpus;
+      DiagnosisResult r;
+      const int runs = m.refit && obs == &all ? 1 : repeat;
+      for (int run = 0; run < runs; ++run) {
+        double wall = 0, cpu = 0;
+        r = Timed(ur10, *obs, o, &wall, &cpu);
+        walls.push_back(wall);
+        cpus.push_back(cpu);
+      }
+      std::sort(walls.begin(), walls.end());
+      std::sort(cpus.begin(), cpus.end());
+      std::printf(
+          "  %4zu poses, %-26s: %6.2f s wall, %6.2f s CPU, cv %.4f -> %.4f, "
+          "held-out %.4f -> %.4f mm: %s\n",
+          obs->rows.size(), m.name, walls[runs / 2], cpus[runs / 2],
+          r.nominal_cv_rms_mm, r.final_cv_rms_mm, r.nominal_heldout_rms_mm,
+          r.final_heldout_rms_mm, FindingsLabel(r).c_str());
+      if (m.folds == 5 && !m.refit) lin5 = r;
+      if (m.folds == 5 && m.refit) refit5 = r;
+    }
+    std::printf(
+        "  %4zu poses: linearised vs refit cross-validated RMS, largest "
+        "relative difference over all candidates %.1e; findings %s\n",
+        obs->rows.size(), CvDifference(lin5, refit5),
+        FindingsLabel(lin5) == FindingsLabel(refit5) ? "same" : "DIFFER");
+  }
+}
+
+// Naming rates, single split against k folds, on marginal simulated effects
+// (near the detection limit, where one split decides) and on null data.
+void CvSimulated(int runs) {
+  const Robot bh7 = Bh7();
+  const Robot ur10 =
+      ReadRobotYaml(std::string(KINCAL_SOURCE_DIR) + "/data/robots/ur10.yaml");
+  struct Case {
+    const Robot* robot;
+    std::string effect, cause, joint;
+    double magnitude;
+    int poses;
+    double noise;
+  };
+  const std::vector<Case> cases = {
+      {&bh7, "backlash:j3:0.012", "backlash", "j3", 0.012, 240, 0.03},
+      {&bh7, "backlash:j3:0.03", "backlash", "j3", 0.03, 120, 0.03},
+      {&bh7, "cyclic:j2:0.01", "cyclic", "j2", 0.01, 120, 0.03},
+      {&bh7, "compliance:j5:0.03", "compliance", "j5", 0.03, 120, 0.03},
+      {&bh7, "compliance:j5:0.2", "compliance", "j5", 0.2, 180, 0.02},
+      {&bh7, "cyclic:j5:0.1", "cyclic", "j5", 0.1, 180, 0.02},
+      {&ur10, "elastostatic:shoulder_lift_joint:0.01", "elastostatic",
+       "shoulder_lift_joint", 0.01, 150, 0.03},
+      {&ur10, "gain:elbow_joint:0.0005", "gain", "elbow_joint", 0.0005, 150,
+       0.03},
+      {&bh7, "", "", "", 0, 60, 0.03},
+      {&bh7, "", "", "", 0, 120, 0.03},
+      {&bh7, "", "", "", 0, 240, 0.03},
+      {&ur10, "", "", "", 0, 150, 0.03},
+  };
+  std::printf(
+      "== cv-sim: %d seeds per case; named = first finding has the cause "
+      "and joint (magnitude within 25 %%); null: false alarms\n",
+      runs);
+  std::printf("  %-44s %6s  %-22s %-22s %-22s\n", "case", "poses",
+              "single split", "5 folds, lowest cv", "5 folds (default)");
+  for (const Case& c : cases) {
+    std::string cells[3];
+    double seconds[3] = {0, 0, 0};
+    const int folds[3] = {0, 5, 5};
+    // single split; 5 folds where the cross-validated RMS must only drop and
+    // the lowest wins; 5 folds with the defaults (paired z gate, ties).
+    const DiagnoseOptions defaults;
+    const double tie_z[3] = {0.0, 0.0, defaults.cv_tie_z};
+    const double min_z[3] = {0.0, 0.0, defaults.cv_min_z};
+    int hits[3] = {0, 0, 0}, within[3] = {0, 0, 0}, alarms[3] = {0, 0, 0};
+    for (int run = 0; run < runs; ++run) {
+      const SimulatedSession s =
+          Sim(*c.robot,
+              c.effect.empty() ? std::vector<std::string>{}
+                               : std::vector<std::string>{c.effect},
+              5000 + run, c.poses, c.noise);
+      for (int m = 0; m < 3; ++m) {
+        DiagnoseOptions o;
+        o.folds = folds[m];
+        o.folds_given = true;
+        o.cv_tie_z = tie_z[m];
+        o.cv_min_z = min_z[m];
+        const auto start = std::chrono::steady_clock::now();
+        const DiagnosisResult r = DiagnoseModel(s.nominal, s.observations, o);
+        seconds[m] += Seconds(start);
+        if (c.effect.empty()) {
+          alarms[m] += r.verdict != "no_significant_effect";
+          continue;
+        }
+        if (!r.findings.empty() && r.findings[0].cause == c.cause &&
+            r.findings[0].joint == c.joint) {
+          ++hits[m];
+          if (std::abs(std::abs(r.findings[0].magnitude) - c.magnitude) <=
+              0.25 * c.magnitude)
+            ++within[m];
+        }
+        // Any further finding of a named cause counts as a false alarm.
+        for (size_t i = 1; i < r.findings.size(); ++i)
+          alarms[m] += r.findings[i].cause != "unexplained";
+      }
+    }
+    for (int m = 0; m < 3; ++m) {
+      char cell[64];
+      if (c.effect.empty()) {
+        std::snprintf(cell, sizeof(cell), "alarms %d/%d %.2fs", alarms[m], runs,
+                      seconds[m] / runs);
+      } else {
+        std::snprintf(cell, sizeof(cell), "%d/%d (%d) +%d %.2fs", hits[m], runs,
+                      within[m], alarms[m], seconds[m] / runs);
+      }
+      cells[m] = cell;
+    }
+    std::printf("  %-44s %6d  %-22s %-22s %-22s\n",
+                (c.robot->name + " " +
+                 (c.effect.empty() ? std::string("null") : c.effect))
+                    .c_str(),
+                c.poses, cells[0].c_str(), cells[1].c_str(), cells[2].c_str());
+  }
+}
+
 void SmallestBacklash(const Robot& bh7, int runs) {
   std::printf(
       "== smallest backlash in j3, 240 poses, 0.03 mm noise, %d seeds each\n",
@@ -335,6 +523,8 @@ int main(int argc, char** argv) {
   if (only == "ur10") kincal::Ur10Timing(repeat, false);
   if (only == "ur10-240") kincal::Ur10Timing(repeat, true);
   if (only == "compare") kincal::CompareTestCases();
+  if (only == "cv") kincal::CvUr10(repeat);
+  if (only == "cv-sim") kincal::CvSimulated(runs);
   if (only.empty() || only == "backlash") kincal::SmallestBacklash(bh7, runs);
   if (only.empty() || only == "null") kincal::FalseAlarms(bh7, runs);
   if (only.empty() || only == "section4") {

@@ -18,6 +18,7 @@
 #include "data/error.h"
 #include "data/provenance.h"
 #include "data/yaml_util.h"
+#include "diagnose/cross_validation.h"
 #include "diagnose/exact_jacobian.h"
 #include "diagnose/free_fit.h"
 #include "diagnose/nonparametric.h"
@@ -250,6 +251,10 @@ void DiagnoseOptions::Check() const {
   Require(std::isfinite(min_effect_mm) && min_effect_mm >= 0,
           "min effect must be >= 0 mm");
   Require(unexplained_ratio > 1, "unexplained ratio must be > 1");
+  Require(folds >= 0,
+          "--folds must be >= 0 (0 or 1 = the single held-out "
+          "split), got " +
+              std::to_string(folds));
   for (const std::string& c : causes) {
     Require(std::find(CatalogueCauses().begin(), CatalogueCauses().end(), c) !=
                 CatalogueCauses().end(),
@@ -278,7 +283,31 @@ DiagnosisResult DiagnoseModel(const Robot& nominal, const Observations& obs,
   SetTransmissionTravel(pb.train, &pb.base_state.chain);
   out.train_poses = static_cast<int>(pb.train.size());
   out.heldout_poses = static_cast<int>(pb.held.size());
+  // Folds of the cross-validation (training poses only: the held-out poses
+  // stay out of the selection and are reported).
+  {
+    const int distinct = DistinctPoses(pb.train);
+    int k = options.folds <= 1 ? 0 : options.folds;
+    if (options.folds_given && k > distinct) {
+      throw InputError(obs.source, 0, 0,
+                       "--folds " + std::to_string(options.folds) + ": only " +
+                           std::to_string(distinct) +
+                           " distinct training poses (" +
+                           std::to_string(pb.train.size()) + " of " +
+                           std::to_string(pb.all.size()) +
+                           " poses, the rest held out); use at most " +
+                           std::to_string(distinct) +
+                           " folds, or 0 for the single held-out split");
+    }
+    if (!options.folds_given) {
+      k = std::min(k, distinct / DiagnoseOptions::kMinPosesPerFold);
+    }
+    out.folds = k >= 2 ? k : 0;
+  }
   FitBase(pb.train, obs.source, &pb, options.exact_jacobian);
+  const FoldPlan folds = out.folds >= 2
+                             ? MakeFolds(pb.train, out.folds, options.seed)
+                             : FoldPlan{};
 
   ModelState current = pb.base_state;
   std::vector<ParamInfo> current_free = pb.base_free;
@@ -286,6 +315,19 @@ DiagnosisResult DiagnoseModel(const Robot& nominal, const Observations& obs,
   out.nominal_heldout_rms_mm = Rms(current, pb.held);
   double current_rss = Rss(current, pb.train);
   double current_held = out.nominal_heldout_rms_mm;
+  auto cv_options = [&](const std::vector<ParamInfo>& free) {
+    FreeFitOptions o;
+    o.free = free;
+    o.bounds_center = &pb.nominal;
+    o.exact_jacobian = options.exact_jacobian;
+    return o;
+  };
+  // Out-of-fold squared error per training pose of the current model.
+  std::vector<double> current_cv_err;
+  out.nominal_cv_rms_mm =
+      CrossValidatedRms(pb.train, folds, current, cv_options(current_free),
+                        options.cv_refit, &current_cv_err);
+  double current_cv = out.nominal_cv_rms_mm;
   std::vector<Measurement> validation;
   for (const Observations& v : options.validation) {
     ModelState scratch = StateWithChain(pb.nominal);
@@ -389,6 +431,7 @@ DiagnosisResult DiagnoseModel(const Robot& nominal, const Observations& obs,
     std::vector<ModelState> states(pool.size(), current);
     std::vector<FitSummary> fits(pool.size());
     std::vector<double> log_p(pool.size(), 0.0);
+    std::vector<std::vector<double>> cv_err(pool.size());
     ParallelFor(static_cast<int>(pool.size()), options.num_threads, [&](int c) {
       CandidateScore& s = scores[c];
       const Candidate& cand = pool[c];
@@ -481,8 +524,23 @@ DiagnosisResult DiagnoseModel(const Robot& nominal, const Observations& obs,
                       : std::numeric_limits<double>::infinity();
       log_p[c] = LogFUpperTail(s.f, s.k, d2);
       s.p_value = std::exp(log_p[c]);
+      // With folds the cross-validated RMS must drop (computed only for
+      // the candidates that pass the F-test: the few that can win);
+      // without, the single held-out split's.
+      const bool f_passes =
+          std::log(alpha) > log_p[c] && drop > 0 &&
+          std::sqrt(drop / static_cast<double>(pb.train.size())) >=
+              options.min_effect_mm;
+      if (folds.folds >= 2 && f_passes) {
+        s.cv_rms_mm =
+            CrossValidatedRms(pb.train, folds, states[c], cv_options(fo.free),
+                              options.cv_refit, &cv_err[c]);
+        s.cv_z = PairedZ(current_cv_err, cv_err[c]);
+      }
       const bool held_better =
-          pb.held.empty() || s.heldout_rms_mm < current_held;
+          folds.folds >= 2
+              ? s.cv_rms_mm < current_cv && s.cv_z > options.cv_min_z
+              : pb.held.empty() || s.heldout_rms_mm < current_held;
       const double explained_mm =
           std::sqrt(drop / static_cast<double>(pb.train.size()));
       s.validation_rms_mm =
@@ -511,14 +569,36 @@ DiagnosisResult DiagnoseModel(const Robot& nominal, const Observations& obs,
     for (size_t c = 0; c < pool.size(); ++c) {
       if (!scores[c].significant) continue;
       // With validation series the candidate that predicts them best wins
-      // (the F-test only admits); without, the most significant one.
+      // (the F-test only admits); else with folds the lowest
+      // cross-validated RMS; else the most significant one.
       const bool better =
-          validation.empty()
-              ? (log_p[c] < log_p[best] ||
-                 (log_p[c] == log_p[best] && scores[c].rss < scores[best].rss))
-              : scores[c].validation_rms_mm < scores[best].validation_rms_mm;
+          !validation.empty()
+              ? scores[c].validation_rms_mm < scores[best].validation_rms_mm
+          : folds.folds >= 2
+              ? scores[c].cv_rms_mm < scores[best].cv_rms_mm
+              : (log_p[c] < log_p[best] ||
+                 (log_p[c] == log_p[best] && scores[c].rss < scores[best].rss));
       if (best < 0 || better) {
         best = static_cast<int>(c);
+      }
+    }
+    // With folds and no validation series: candidates whose out-of-fold
+    // errors are within `cv_tie_z` standard errors of the winner's (paired
+    // over the training poses) predict as well on this data; among them the
+    // most significant (the F-test's ranking, which prefers fewer
+    // parameters) wins. Without this rule a candidate that nests the true
+    // one (cyclic j5's cos, sin against compliance j5 on BH-7) wins by its
+    // extra parameter's fit to the noise (bench --only cv-sim: compliance
+    // j5 named 35/40 instead of 40/40).
+    if (best >= 0 && validation.empty() && folds.folds >= 2 &&
+        options.cv_tie_z > 0) {
+      const int cv_best = best;
+      for (size_t c = 0; c < pool.size(); ++c) {
+        if (!scores[c].significant || static_cast<int>(c) == cv_best) continue;
+        if (PairedZ(cv_err[c], cv_err[cv_best]) < options.cv_tie_z &&
+            log_p[c] < log_p[best]) {
+          best = static_cast<int>(c);
+        }
       }
     }
     if (best < 0) break;
@@ -557,6 +637,8 @@ DiagnosisResult DiagnoseModel(const Robot& nominal, const Observations& obs,
     f.heldout_rms_after_mm = b.heldout_rms_mm;
     f.validation_rms_before_mm = current_validation;
     f.validation_rms_after_mm = b.validation_rms_mm;
+    f.cv_rms_before_mm = current_cv;
+    f.cv_rms_after_mm = b.cv_rms_mm;
     f.train_rms_after_mm = b.train_rms_mm;
     f.f = b.f;
     f.p_value = b.p_value;
@@ -578,11 +660,14 @@ DiagnosisResult DiagnoseModel(const Robot& nominal, const Observations& obs,
     current_rss = b.rss;
     current_held = b.heldout_rms_mm;
     current_validation = b.validation_rms_mm;
+    current_cv = b.cv_rms_mm;
+    current_cv_err = cv_err[best];
     pool.erase(pool.begin() + best);
   }
   out.final_train_rms_mm = Rms(current, pb.train);
   out.final_heldout_rms_mm = current_held;
   out.final_validation_rms_mm = current_validation;
+  out.final_cv_rms_mm = current_cv;
   out.residual_sigma_mm = std::sqrt(
       current_rss / std::max(1, n_res - static_cast<int>(current_free.size())));
 
@@ -642,6 +727,7 @@ DiagnosisResult DiagnoseModel(const Robot& nominal, const Observations& obs,
       u.heldout_rms_before_mm = u.heldout_rms_after_mm = current_held;
       u.validation_rms_before_mm = u.validation_rms_after_mm =
           current_validation;
+      u.cv_rms_before_mm = u.cv_rms_after_mm = current_cv;
       u.train_rms_after_mm = out.final_train_rms_mm;
       u.p_value = kNaN;
       u.f = s2 / n2;
@@ -779,6 +865,8 @@ nlohmann::json DiagnosisJson(const DiagnosisResult& r,
          {"train_rms_after_mm", Num(f.train_rms_after_mm)},
          {"validation_rms_before_mm", Num(f.validation_rms_before_mm)},
          {"validation_rms_after_mm", Num(f.validation_rms_after_mm)},
+         {"cv_rms_before_mm", Num(f.cv_rms_before_mm)},
+         {"cv_rms_after_mm", Num(f.cv_rms_after_mm)},
          {"f", Num(f.f)},
          {"p_value", Num(f.p_value)},
          {"equivalent", eq}});
@@ -812,6 +900,8 @@ nlohmann::json DiagnosisJson(const DiagnosisResult& r,
                        {"p_value", Num(c.p_value)},
                        {"significant", c.significant},
                        {"validation_rms_mm", Num(c.validation_rms_mm)},
+                       {"cv_rms_mm", Num(c.cv_rms_mm)},
+                       {"cv_z", Num(c.cv_z)},
                        {"magnitude", Num(c.magnitude)},
                        {"unit", c.unit}});
     }
@@ -820,13 +910,24 @@ nlohmann::json DiagnosisJson(const DiagnosisResult& r,
   nlohmann::json j;
   j["verdict"] = r.verdict;
   j["nominal"] = {{"train_rms_mm", Num(r.nominal_train_rms_mm)},
-                  {"heldout_rms_mm", Num(r.nominal_heldout_rms_mm)}};
+                  {"heldout_rms_mm", Num(r.nominal_heldout_rms_mm)},
+                  {"cv_rms_mm", Num(r.nominal_cv_rms_mm)}};
   j["findings"] = findings;
   j["validation"] = {{"series", options.validation.size()},
                      {"nominal_rms_mm", Num(r.nominal_validation_rms_mm)},
                      {"final_rms_mm", Num(r.final_validation_rms_mm)}};
   j["final"] = {{"heldout_rms_mm", Num(r.final_heldout_rms_mm)},
-                {"train_rms_mm", Num(r.final_train_rms_mm)}};
+                {"train_rms_mm", Num(r.final_train_rms_mm)},
+                {"cv_rms_mm", Num(r.final_cv_rms_mm)}};
+  j["folds"] = r.folds;
+  j["cross_validation"] = {
+      {"folds", r.folds},
+      {"selection", r.folds >= 2
+                        ? "k-fold cross-validated RMS of the training poses"
+                        : "single held-out split"},
+      {"fold_fit", options.cv_refit ? "refit" : "linearised"},
+      {"nominal_rms_mm", Num(r.nominal_cv_rms_mm)},
+      {"final_rms_mm", Num(r.final_cv_rms_mm)}};
   j["train_poses"] = r.train_poses;
   j["heldout_poses"] = r.heldout_poses;
   j["noise_mm"] = Num(r.noise_mm);

@@ -15,9 +15,13 @@
 //      Fit with the candidate's parameters freed). Nested-model F-test,
 //      F = ((RSS0 - RSS1) / k) / (RSS1 / (n - p - k)), Bonferroni-corrected
 //      over the candidates of the step (family-wise false-alarm rate
-//      `false_alarm` per step), and the held-out RMS must drop as well.
-//   5. Greedy forward selection: the most significant candidate is added and
-//      the step repeats while a candidate stays significant.
+//      `false_alarm` per step), and the candidate must predict the left-out
+//      folds of a K-fold cross-validation of the training poses better
+//      (diagnose/cross_validation.h; folds = 0: the held-out RMS must drop).
+//   5. Greedy forward selection: the step's winner (lowest cross-validated
+//      RMS, ties to the most significant; with folds = 0 the most
+//      significant) is added and the step repeats while a candidate stays
+//      significant.
 //   6. Candidates whose fits explain the data as well as the chosen one (RSS
 //      difference below the chi-square(1) 95 % point of the noise) are
 //      reported as equivalent instead of guessing between them.
@@ -75,6 +79,28 @@ struct DiagnoseOptions {
   // frame re-registered; with validation data a candidate must also lower
   // the validation RMS, and the lowest validation RMS wins the step.
   std::vector<Observations> validation;
+  // K-fold cross-validation of the selection (diagnose/cross_validation.h):
+  // the training poses in `folds` seeded folds; a candidate that passes the
+  // F-test must also lower the cross-validated RMS (instead of the single
+  // held-out split's RMS, which is then only reported), and the lowest
+  // cross-validated RMS wins the step (with validation series, theirs).
+  // 0 or 1 = the single held-out split, as before. Unless `folds_given`,
+  // fewer folds when the training poses are few (at least
+  // kMinPosesPerFold distinct poses per fold, else the single split); with
+  // `folds_given` more folds than distinct training poses is bad input.
+  int folds = 5;
+  bool folds_given = false;
+  static constexpr int kMinPosesPerFold = 10;
+  // Full Levenberg-Marquardt refits per fold instead of the linearised
+  // fold step (the reference of bench/diagnose_bench --only cv).
+  bool cv_refit = false;
+  // A candidate's out-of-fold improvement over the current model must
+  // exceed this many standard errors (paired over the training poses; 1.645
+  // = one-sided 5 %; 0 = the cross-validated RMS must drop).
+  double cv_min_z = 1.645;
+  // Candidates within this many standard errors of the lowest
+  // cross-validated RMS count as tied; the most significant of them wins.
+  double cv_tie_z = 2.0;
 
   void Check() const;  // InputError on invalid values
 };
@@ -89,7 +115,13 @@ struct CandidateScore {
   double f = 0.0, p_value = 1.0;
   bool significant = false;
   double validation_rms_mm = 0.0;  // NaN without validation data
-  double magnitude = 0.0;          // spec units, from the training fit
+  // Cross-validated RMS over the training poses (NaN without folds, or when
+  // the F-test already rejects the candidate).
+  double cv_rms_mm = std::numeric_limits<double>::quiet_NaN();
+  // Its out-of-fold improvement over the current model in standard errors
+  // (paired over the training poses; NaN when not computed).
+  double cv_z = std::numeric_limits<double>::quiet_NaN();
+  double magnitude = 0.0;  // spec units, from the training fit
   std::string unit;
 };
 
@@ -109,6 +141,9 @@ struct Finding {
   double train_rms_after_mm = 0.0;
   // Cross-series validation RMS (NaN without validation data).
   double validation_rms_before_mm = 0.0, validation_rms_after_mm = 0.0;
+  // Cross-validated RMS of the training poses (NaN without folds).
+  double cv_rms_before_mm = std::numeric_limits<double>::quiet_NaN();
+  double cv_rms_after_mm = std::numeric_limits<double>::quiet_NaN();
   double f = 0.0, p_value = 1.0;
   std::vector<Equivalent> equivalent;
   // `unexplained` only: the inputs the systematic rest depends on, strongest
@@ -132,6 +167,11 @@ struct DiagnosisResult {
   double final_train_rms_mm = 0.0, final_heldout_rms_mm = 0.0;
   // Cross-series validation (options.validation), frame re-registered only.
   double nominal_validation_rms_mm = 0.0, final_validation_rms_mm = 0.0;
+  // Folds of the cross-validation used (0 = the single held-out split) and
+  // the cross-validated RMS of the geometric and the final model.
+  int folds = 0;
+  double nominal_cv_rms_mm = std::numeric_limits<double>::quiet_NaN();
+  double final_cv_rms_mm = std::numeric_limits<double>::quiet_NaN();
   // Noise per axis (mm) and where it came from: "stated", "repeated poses",
   // "nearest poses (upper bound)", "none".
   double noise_mm = 0.0;
