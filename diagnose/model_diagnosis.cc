@@ -628,6 +628,11 @@ DiagnosisResult DiagnoseModel(const Robot& nominal, const Observations& obs,
       w.magnitude = CandidateMagnitude(pool[best], states[best], fits[best],
                                        scale_of(pool[best]))
                         .value;
+      if (folds.folds >= 2) {
+        w.cv_rms_mm = CrossValidatedRms(pb.train, folds, states[best],
+                                        cv_options(fo.free), options.cv_refit,
+                                        &cv_err[best]);
+      }
     }
     const CandidateScore& b = scores[best];
     Finding f;
