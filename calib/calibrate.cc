@@ -77,6 +77,8 @@ CalibrateResult Calibrate(const Robot& nominal, const Observations& obs,
   const auto start = std::chrono::steady_clock::now();
   Require(options.holdout_fraction >= 0 && options.holdout_fraction < 0.9,
           "--holdout must be in [0, 0.9)");
+  Require(options.distance_weight > 0 && std::isfinite(options.distance_weight),
+          "--distance-weight must be positive and finite");
   CalibrateResult result;
   result.method =
       options.method == CalibrateOptions::kPaper ? "paper" : "least_squares";
@@ -107,7 +109,7 @@ CalibrateResult Calibrate(const Robot& nominal, const Observations& obs,
                        "' in " + obs.source);
     }
     pd.distance_mm = d.distance_mm;
-    pd.weight = 10.0;
+    pd.weight = options.distance_weight;
     distances.push_back(pd);
   }
 

@@ -36,6 +36,11 @@ struct CalibrateOptions {
   double loss_scale_mm = 1.0;
   IdentifiabilityOptions identifiability;
   std::vector<FixedDistance> distances;
+  // Weight of each known distance's residual weight * (|a - b| - d) beside
+  // the tip residuals (mm). 10 makes the distance all but exact for tip
+  // noise of ~0.1-1 mm; measured on the MUKCa Pandas (docs/REAL_DATA.md),
+  // 1 to 10000 change the held-out figures by less than their noise.
+  double distance_weight = 10.0;
   // Extra parameters to free besides the row geometry (e.g. "j2.beta").
   std::vector<std::string> extra_params;
   // Fit the geometry (false: only the frame / fixed points, as `evaluate`).
