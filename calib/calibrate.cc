@@ -112,6 +112,16 @@ void HoldWeakJointErrors(const std::vector<Measurement>& ms,
                          const IdentifiabilityOptions& options,
                          Identifiability* id) {
   if (!(options.noise_sigma_mm > 0)) return;
+  // The largest lever of each family over the joints: a joint whose input
+  // stays below a tenth of it (a Panda's joint 7 carries a torque arm of
+  // the ball's 7 mm offset, joint 2 of ~600 mm) sees too little of the
+  // cause to tell it from the geometry it shares the tip motion with.
+  std::map<int, double> family_lever;
+  for (const ParamInfo& p : id->identifiable) {
+    if (p.kind != ParamKind::kJointError) continue;
+    family_lever[p.index] =
+        std::max(family_lever[p.index], JointErrorLever(ms, p));
+  }
   Identifiability kept = *id;
   kept.identifiable.clear();
   kept.conditional_sigma.clear();
@@ -125,8 +135,10 @@ void HoldWeakJointErrors(const std::vector<Measurement>& ms,
           id->conditional_sigma[i] * (p.angle ? M_PI / 180 : 1);
       const double bound =
           revolute ? state.chain.bound_angle_rad : state.chain.bound_length_mm;
-      const double effect = sigma * JointErrorLever(ms, p);
-      keep = !(effect >= options.max_sigma_fraction * bound);
+      const double lever = JointErrorLever(ms, p);
+      const double effect = sigma * lever;
+      keep = !(effect >= options.max_sigma_fraction * bound) &&
+             lever >= 0.1 * family_lever[p.index];
     }
     if (keep) {
       kept.identifiable.push_back(p);
