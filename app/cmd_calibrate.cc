@@ -233,7 +233,8 @@ void AddCalibrateCommand(CLI::App& app, Runner* run) {
       ->check(CLI::Range(1e-3, 1e6))
       ->capture_default_str();
   sub->add_option("--free", args->free,
-                  "extra parameters to fit, e.g. j2.beta (repeatable)");
+                  "extra parameters to fit, e.g. j2.beta, or a joint-error "
+                  "family for every joint, e.g. compliance (repeatable)");
   sub->add_flag("--json", args->json, "print one JSON object");
   sub->footer(
       "Example (the demo session):\n  kincal calibrate --robot "
