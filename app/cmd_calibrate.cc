@@ -227,8 +227,14 @@ void AddCalibrateCommand(CLI::App& app, Runner* run) {
       ->capture_default_str();
   sub->add_option("--fixed-distance", args->distances,
                   "known distance between fixed points: A,B,MM (repeatable)");
+  sub->add_option("--distance-weight", args->options.distance_weight,
+                  "weight of each --fixed-distance residual beside the tip "
+                  "residuals (mm-equivalent per mm)")
+      ->check(CLI::Range(1e-3, 1e6))
+      ->capture_default_str();
   sub->add_option("--free", args->free,
-                  "extra parameters to fit, e.g. j2.beta (repeatable)");
+                  "extra parameters to fit, e.g. j2.beta, or a joint-error "
+                  "family for every joint, e.g. compliance (repeatable)");
   sub->add_flag("--json", args->json, "print one JSON object");
   sub->footer(
       "Example (the demo session):\n  kincal calibrate --robot "

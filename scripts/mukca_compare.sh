@@ -15,9 +15,13 @@ for robot_dir in "$M"/data/${3:-panda_*}; do
   robot=$(basename "$robot_dir")
   authors="$M/calibrated_urdf/$(authors_of "$robot")/panda.urdf"
   import_recordings "$K" "$robot_dir" "$W/$robot."
+  declare -A theirs=()  # the authors' model on each recording, once
+  for test in "${recs[@]}"; do
+    theirs[$test]=$("$K" evaluate --robot "$authors" --tip ball_link --obs "$W/$robot.$test.csv" --json | stats)
+  done
   for train in "${recs[@]}"; do
     cal=$(
-      "$K" calibrate --robot "$M/urdf/panda.urdf" --tip ball_link \
+      "$K" calibrate --robot "$M/urdf/panda.urdf" --tip ball_link ${CAL_ARGS:-} \
         --obs "$W/$robot.$train.csv" --fixed-distance hole_0,hole_1,50 \
         --holdout 0 --out "$W/cal.yaml" --json |
         python3 -c 'import json,sys
@@ -27,8 +31,7 @@ print("%.4f\t%d\t%d" % (j["train_rms_mm"], len(j["identifiable"]), j["identifiab
     for test in "${recs[@]}"; do
       [ "$test" = "$train" ] && continue
       ours=$("$K" evaluate --robot "$W/cal.yaml" --obs "$W/$robot.$test.csv" --json | stats)
-      theirs=$("$K" evaluate --robot "$authors" --tip ball_link --obs "$W/$robot.$test.csv" --json | stats)
-      printf "%s\t%s\t%s\t%s\t%s\t%s\n" "$robot" "$train" "$test" "$ours" "$theirs" "$cal"
+      printf "%s\t%s\t%s\t%s\t%s\t%s\n" "$robot" "$train" "$test" "$ours" "${theirs[$test]}" "$cal"
     done
   done
 done

@@ -26,7 +26,7 @@ for robot_dir in "$M"/data/${3:-panda_*}; do
         sed -E "s/,(hole_[01])\$/,${r}_\1/; s/^([^,]*),/${r}_\1,/" >>"$pooled"
       dist+=(--fixed-distance "${r}_hole_0,${r}_hole_1,50")
     done
-    cal=$("$K" calibrate --robot "$M/urdf/panda.urdf" --tip ball_link \
+    cal=$("$K" calibrate --robot "$M/urdf/panda.urdf" --tip ball_link ${CAL_ARGS:-} \
       --obs "$pooled" "${dist[@]}" --holdout 0 --out "$W/cal.yaml" --json |
       python3 -c 'import json,sys
 try: j=json.load(sys.stdin)
