@@ -106,7 +106,12 @@ TEST(KFoldSelectionTest, RightWhereTheSingleSplitIsWrong) {
     const SimulatedSession s = Sim(bh7, "compliance:j5:0.03", seed, 120);
     const DiagnosisResult single =
         DiagnoseModel(s.nominal, s.observations, Folds(0));
-    EXPECT_EQ(single.verdict, "no_significant_effect") << seed;
+    // The single split misses the compliance (seed 5004 now names the
+    // transmission series of j5 in its place, which can take the shape of a
+    // j5 torque over the travel; 5028 names nothing).
+    EXPECT_TRUE(single.verdict == "no_significant_effect" ||
+                single.findings[0].cause != "compliance")
+        << seed;
     const DiagnosisResult kfold =
         DiagnoseModel(s.nominal, s.observations, Folds(5));
     ASSERT_EQ(kfold.verdict, "effect_found") << seed;

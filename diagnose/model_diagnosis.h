@@ -54,7 +54,7 @@ struct DiagnoseOptions {
   // Family-wise false-alarm probability of one selection step (Bonferroni
   // over that step's candidates).
   double false_alarm = 0.01;
-  int max_findings = 5;
+  int max_findings = 10;  // a cap; the steps stop when nothing is significant
   // Smallest effect worth naming: RMS (3D, over the training poses) of the
   // tip error a candidate explains, mm. Far below any measuring system's
   // resolution; it stops noise-free data from naming second-order
