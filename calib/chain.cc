@@ -194,6 +194,26 @@ Robot Chain::ToRobot(const Robot& description) const {
   return robot;
 }
 
+void FillTransmissionSines(const Chain& chain, PoseInput* in) {
+  const int n = chain.num_joints();
+  bool any = false;
+  for (int j = 0; j < n; ++j)
+    any = any || chain.rows[j].transmission_hi > chain.rows[j].transmission_lo;
+  in->transmission_sines.clear();
+  if (!any) return;
+  in->transmission_sines.assign(kMaxTransmissionTerms * n, 0.0);
+  for (int j = 0; j < n; ++j) {
+    // Each term through the hook itself (a unit coefficient vector).
+    for (int k = 0; k < kMaxTransmissionTerms; ++k) {
+      double unit[kMaxTransmissionTerms] = {};
+      unit[k] = 1.0;
+      in->transmission_sines[kMaxTransmissionTerms * j + k] =
+          TransmissionError(unit, in->q[j], chain.rows[j].transmission_lo,
+                            chain.rows[j].transmission_hi);
+    }
+  }
+}
+
 double Chain::ReadingToInternal(int joint, double reading) const {
   return rows[joint].type == JointType::kRevolute ? reading * kDegToRad
                                                   : reading;

@@ -159,7 +159,15 @@ struct PoseInput {
   // cos(h q), sin(h q) for h = 1..3 per joint (6 per joint), precomputed by
   // MakePoseInputs; empty = computed on the fly.
   std::vector<double> trig;
+  // sin(k pi u) - m_k, k = 1..24, per joint (TransmissionError) for the
+  // chain's travels, precomputed by FillTransmissionSines; empty = computed
+  // on the fly.
+  std::vector<double> transmission_sines;
 };
+
+// Fills PoseInput::transmission_sines for `chain`'s travels (clears it when
+// no joint has one). Must be called again when a travel changes.
+void FillTransmissionSines(const Chain& chain, PoseInput* in);
 
 // Builds PoseInputs for the rows of `obs` (in visit order). `s` follows the
 // spec: the sign of the joint's last motion before the pose; a joint that did
@@ -305,8 +313,14 @@ inline double TransmissionMean(int k) {  // m_k, k = 1..24
   return (k % 2 == 1) ? 2.0 / (k * M_PI) : 0.0;
 }
 template <typename T>
-T TransmissionError(const T* c, double q_read, double lo, double hi) {
+T TransmissionError(const T* c, double q_read, double lo, double hi,
+                    const double* sines = nullptr) {
   if (!(hi > lo) || q_read <= lo || q_read >= hi) return T(0);
+  if (sines != nullptr) {  // precomputed (PoseInput::transmission_sines)
+    T e(0);
+    for (int k = 0; k < kMaxTransmissionTerms; ++k) e += c[k] * sines[k];
+    return e;
+  }
   if constexpr (std::is_same_v<T, double>) {  // most joints have no series
     bool any = false;
     for (int k = 0; k < kMaxTransmissionTerms && !any; ++k) any = c[k] != 0.0;
@@ -354,11 +368,13 @@ T ModelJointValue(JointType type, double q_read, double s, double tau,
 template <typename T>
 T ModelJointValueTrig(JointType type, double q_read, double s, double tau,
                       const T* err, double tau_mass, const double* trig,
-                      double travel_lo = 0.0, double travel_hi = 0.0) {
+                      double travel_lo = 0.0, double travel_hi = 0.0,
+                      const double* transmission_sines = nullptr) {
   if (err == nullptr) return T(q_read);
   T q = (T(1) + err[kGain]) * q_read - T(0.5 * s) * err[kBacklash] +
         err[kCompliance] * tau + err[kElastostatic] * tau_mass +
-        TransmissionError(err + kTransmission0, q_read, travel_lo, travel_hi);
+        TransmissionError(err + kTransmission0, q_read, travel_lo, travel_hi,
+                          transmission_sines);
   if (type == JointType::kRevolute) {
     for (int h = 1; h <= kMaxHarmonic; ++h) {
       const int k = CyclicCosIndex(h);
@@ -502,6 +518,8 @@ Vec3<T> TipInBase(const Chain& chain, const T* const* rows,
       static_cast<int>(in.tau_mass.size()) == chain.num_joints();
   const bool trig =
       static_cast<int>(in.trig.size()) == 2 * kMaxHarmonic * chain.num_joints();
+  const bool sines = static_cast<int>(in.transmission_sines.size()) ==
+                     kMaxTransmissionTerms * chain.num_joints();
   for (int j = 0; j < chain.num_joints(); ++j) {
     const double tm = masses ? in.tau_mass[j] : 0.0;
     const T* err = joint_errors ? joint_errors[j] : nullptr;
@@ -509,7 +527,10 @@ Vec3<T> TipInBase(const Chain& chain, const T* const* rows,
     q[j] =
         trig ? ModelJointValueTrig<T>(row.type, in.q[j], in.s[j], in.tau[j],
                                       err, tm, &in.trig[2 * kMaxHarmonic * j],
-                                      row.transmission_lo, row.transmission_hi)
+                                      row.transmission_lo, row.transmission_hi,
+                                      sines ? &in.transmission_sines
+                                                  [kMaxTransmissionTerms * j]
+                                            : nullptr)
              : ModelJointValue<T>(row.type, in.q[j], in.s[j], in.tau[j], err,
                                   tm, row.transmission_lo, row.transmission_hi);
   }

@@ -281,6 +281,8 @@ DiagnosisResult DiagnoseModel(const Robot& nominal, const Observations& obs,
   // The transmission family lives on the joints' travel in the training data.
   SetTransmissionTravel(pb.train, &pb.nominal);
   SetTransmissionTravel(pb.train, &pb.base_state.chain);
+  for (auto* set : {&pb.all, &pb.train, &pb.held})
+    for (Measurement& m : *set) FillTransmissionSines(pb.nominal, &m.input);
   out.train_poses = static_cast<int>(pb.train.size());
   out.heldout_poses = static_cast<int>(pb.held.size());
   // Folds of the cross-validation (training poses only: the held-out poses
@@ -776,6 +778,7 @@ std::vector<Magnitude> FitCandidates(const Robot& nominal,
   pb.all = Measurements(pb.nominal, obs, &pb.base_state);
   SetTransmissionTravel(pb.all, &pb.nominal);
   SetTransmissionTravel(pb.all, &pb.base_state.chain);
+  for (Measurement& m : pb.all) FillTransmissionSines(pb.nominal, &m.input);
   FitBase(pb.all, obs.source, &pb);
   const std::vector<Candidate> catalogue =
       CatalogueCandidates(pb.nominal, pb.all);
