@@ -605,7 +605,12 @@ DiagnosisResult DiagnoseModel(const Robot& nominal, const Observations& obs,
     }
     if (best < 0) break;
     if (screen_free.size() < current_free.size()) {
-      // The winner refitted jointly with the extensions held in screening.
+      // The winner refitted jointly with the extensions held in screening,
+      // kept only when it fits the training poses better without predicting
+      // the validation series worse.
+      const ModelState screened_state = states[best];
+      const CandidateScore screened = scores[best];
+      const std::vector<double> screened_cv_err = cv_err[best];
       FitOptions fo;
       fo.free = current_free;
       for (const ParamInfo& q : pool[best].params) fo.free.push_back(q);
@@ -634,6 +639,13 @@ DiagnosisResult DiagnoseModel(const Robot& nominal, const Observations& obs,
         w.cv_rms_mm = CrossValidatedRms(pb.train, folds, states[best],
                                         cv_options(fo.free), options.cv_refit,
                                         &cv_err[best]);
+      }
+      if (!(w.rss <= screened.rss) ||
+          (!validation.empty() &&
+           !(w.validation_rms_mm <= screened.validation_rms_mm))) {
+        states[best] = screened_state;
+        scores[best] = screened;
+        cv_err[best] = screened_cv_err;
       }
     }
     const CandidateScore& b = scores[best];
@@ -670,6 +682,26 @@ DiagnosisResult DiagnoseModel(const Robot& nominal, const Observations& obs,
     current_cv = b.cv_rms_mm;
     current_cv_err = cv_err[best];
     pool.erase(pool.begin() + best);
+    // A joint's error along the travel (transmission) and its low harmonics
+    // and gain describe nearly the same function inside the travel and
+    // differ outside it: once one kind is in the model, the other leaves the
+    // pool (together they drift apart along that near-degenerate direction
+    // and extrapolate wildly: UR10 C --validate A gave 128 mm on A).
+    const Candidate& won = accepted.back();
+    auto along_travel = [](const std::string& cause) {
+      return TransmissionTerms(cause) > 0 ? 1
+             : (CyclicHarmonic(cause) > 0 || cause == "gain") ? 2
+                                                                : 0;
+    };
+    if (along_travel(won.cause) > 0) {
+      pool.erase(std::remove_if(pool.begin(), pool.end(),
+                                [&](const Candidate& c) {
+                                  const int kind = along_travel(c.cause);
+                                  return c.joint == won.joint && kind > 0 &&
+                                         kind != along_travel(won.cause);
+                                }),
+                 pool.end());
+    }
   }
   out.final_train_rms_mm = Rms(current, pb.train);
   out.final_heldout_rms_mm = current_held;
