@@ -381,12 +381,26 @@ DiagnosisResult DiagnoseModel(const Robot& nominal, const Observations& obs,
     const Eigen::MatrixXd basis = Basis(Normalized(base_raw));
     // One Jacobian for all candidates' parameters, sliced per candidate.
     std::vector<ParamInfo> all_params;
-    std::vector<int> first(pool.size());
     for (size_t c = 0; c < pool.size(); ++c) {
       pool[c] = MakeCandidate(pb.nominal, pool[c].cause, pool[c].joint);
-      first[c] = static_cast<int>(all_params.size());
-      for (const ParamInfo& q : pool[c].params) all_params.push_back(q);
     }
+    // Each parameter once (nested candidates share theirs: transmission8 is
+    // the start of transmission16 and 24), its column by name.
+    std::map<std::string, int> column_of;
+    for (const Candidate& cand : pool) {
+      for (const ParamInfo& q : cand.params) {
+        if (column_of.emplace(q.name, static_cast<int>(all_params.size()))
+                .second)
+          all_params.push_back(q);
+      }
+    }
+    auto candidate_columns = [&](const Eigen::MatrixXd& jac,
+                                 const Candidate& cand) {
+      Eigen::MatrixXd cols(jac.rows(), cand.params.size());
+      for (size_t q = 0; q < cand.params.size(); ++q)
+        cols.col(q) = jac.col(column_of.at(cand.params[q].name));
+      return cols;
+    };
     Eigen::MatrixXd cand_jac;
     if (options.exact_jacobian) {
       Eigen::VectorXd unused;
@@ -418,9 +432,8 @@ DiagnosisResult DiagnoseModel(const Robot& nominal, const Observations& obs,
     const Eigen::VectorXd base_ntr = screen_raw.transpose() * r0;
     std::vector<bool> usable(pool.size());
     for (size_t c = 0; c < pool.size(); ++c) {
-      const int k = static_cast<int>(pool[c].params.size());
-      usable[c] = ReduceToIdentifiable(basis, cand_jac.middleCols(first[c], k),
-                                       &pool[c]);
+      usable[c] = ReduceToIdentifiable(
+          basis, candidate_columns(cand_jac, pool[c]), &pool[c]);
     }
     const int p = static_cast<int>(current_free.size());
     int tested = 0;
@@ -453,12 +466,7 @@ DiagnosisResult DiagnoseModel(const Robot& nominal, const Observations& obs,
       // that the refit needs few iterations: normal equations of [base,
       // candidate columns], Jacobi-scaled.
       const int pb_cols = static_cast<int>(screen_raw.cols());
-      Eigen::MatrixXd cc(screen_raw.rows(), s.k);
-      for (int q = 0; q < s.k; ++q) {
-        int col = first[c];
-        while (all_params[col].name != cand.params[q].name) ++col;
-        cc.col(q) = cand_jac.col(col);
-      }
+      const Eigen::MatrixXd cc = candidate_columns(cand_jac, cand);
       Eigen::MatrixXd ntn(pb_cols + s.k, pb_cols + s.k);
       ntn.topLeftCorner(pb_cols, pb_cols) = base_ntn;
       ntn.topRightCorner(pb_cols, s.k) = screen_raw.transpose() * cc;
@@ -496,7 +504,22 @@ DiagnosisResult DiagnoseModel(const Robot& nominal, const Observations& obs,
       // Differentiated in the free parameters only (diagnose/free_fit.h).
       FreeFitOptions ffo = FreeFitOptionsFrom(fo);
       ffo.exact_jacobian = options.exact_jacobian;
-      if (options.free_parameter_fit) {
+      // A candidate whose linearised gain (the Gauss-Newton start's) is far
+      // from significant (p above 100x the step's alpha) keeps the start:
+      // its RSS there is that of a feasible model, an upper bound of the
+      // refit's, so its F-test can only be conservative. Most candidates of
+      // the later steps are such; the refits were most of the time.
+      const double lin_drop = std::max(0.0, -ntr.dot(step));
+      const double lin_d2 = n_res - p - s.k;
+      const double lin_rss = std::max(current_rss - lin_drop, 1e-300);
+      const bool hopeless =
+          options.exact_jacobian && options.free_parameter_fit &&
+          lin_d2 > 0 &&
+          LogFUpperTail((lin_drop / s.k) / (lin_rss / lin_d2), s.k, lin_d2) >
+              std::log(100.0 * alpha);
+      if (hopeless) {
+        // the start is the model scored below
+      } else if (options.free_parameter_fit) {
         FreeFit(pb.train, ffo, &states[c]);
       } else {
         fits[c] = Fit(pb.train, fo, &states[c]);

@@ -95,18 +95,25 @@ Eigen::MatrixXd Basis(const Eigen::MatrixXd& a) {
 std::vector<bool> IndependentColumns(const Eigen::MatrixXd& basis,
                                      Eigen::MatrixXd cand) {
   cand = Normalized(cand);
-  Eigen::MatrixXd q = basis;
+  // The basis and the accepted columns so far, without copying the basis
+  // (it has thousands of rows and up to ~150 columns, and this runs for
+  // every candidate of every step).
+  Eigen::MatrixXd extra(cand.rows(), cand.cols());
+  int accepted = 0;
   std::vector<bool> out(cand.cols(), false);
   for (int c = 0; c < cand.cols(); ++c) {
     Eigen::VectorXd rest = cand.col(c);
     if (rest.norm() == 0) continue;
-    for (int pass = 0; pass < 2 && q.cols() > 0; ++pass) {
-      rest -= q * (q.transpose() * rest);
+    for (int pass = 0; pass < 2; ++pass) {
+      if (basis.cols() > 0) rest -= basis * (basis.transpose() * rest);
+      if (accepted > 0) {
+        const auto q = extra.leftCols(accepted);
+        rest -= q * (q.transpose() * rest);
+      }
     }
     if (rest.norm() < kIdentifiableSine) continue;
     out[c] = true;
-    q.conservativeResize(q.rows(), q.cols() + 1);
-    q.col(q.cols() - 1) = rest / rest.norm();
+    extra.col(accepted++) = rest / rest.norm();
   }
   return out;
 }
