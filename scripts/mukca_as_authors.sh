@@ -23,14 +23,8 @@ for spec in "panda_2 panda_2_clean/front_center panda_2_clean" \
   shift 2
   authors="$M/calibrated_urdf/$model/panda.urdf"
   "$K" import mukca --dir "$M/data/$train" --out "$W/train.csv" >/dev/null
-  cal=$(
-    "$K" calibrate --robot "$M/urdf/panda.urdf" --tip ball_link ${CAL_ARGS:-} \
-      --obs "$W/train.csv" --fixed-distance hole_0,hole_1,50 \
-      --holdout 0 --out "$W/cal.yaml" --json |
-      python3 -c 'import json,sys
-try: j=json.load(sys.stdin)
-except Exception: print("NA\tNA\tNA"); sys.exit()
-print("%.4f\t%d\t%d" % (j["train_rms_mm"], len(j["identifiable"]), j["identifiability_passes"]))')
+  cal=$(calibrate_nominal "$K" "$M" "$W/cal.yaml" --obs "$W/train.csv" \
+    --fixed-distance hole_0,hole_1,50)
   for robot in "$@"; do
     import_recordings "$K" "$M/data/$robot" "$W/$robot."
     for test in "${recs[@]}"; do

@@ -1,6 +1,7 @@
-# Shared by scripts/mukca_compare.sh and scripts/mukca_pooled.sh (sourced):
-# the authors' calibrated URDF of a recording folder, the evaluate JSON as a
-# table row, and the import of every recording of one robot.
+# Shared by scripts/mukca_compare.sh, mukca_pooled.sh and mukca_as_authors.sh
+# (sourced): the authors' calibrated URDF of a recording folder, the evaluate
+# JSON as a table row, the import of every recording of one robot, and the
+# calibration from the nominal Panda.
 
 authors_of() {  # recording folder -> calibrated_urdf folder
   case $1 in
@@ -28,4 +29,18 @@ import_recordings() {
     "$1" import mukca --dir "$rec" --out "$3$r.csv" >/dev/null
     recs+=("$r")
   done
+}
+
+# calibrate_nominal KINCAL MUKCA_DIR OUT.yaml CALIBRATE_ARGS...: kincal
+# calibrate from the nominal Panda (ball_link tip, no hold-out, CAL_ARGS
+# from the environment passed through); prints "train_rms free passes".
+calibrate_nominal() {
+  local k=$1 m=$2 out=$3
+  shift 3
+  "$k" calibrate --robot "$m/urdf/panda.urdf" --tip ball_link ${CAL_ARGS:-} \
+    "$@" --holdout 0 --out "$out" --json |
+    python3 -c 'import json,sys
+try: j=json.load(sys.stdin)
+except Exception: print("NA\tNA\tNA"); sys.exit()
+print("%.4f\t%d\t%d" % (j["train_rms_mm"], len(j["identifiable"]), j["identifiability_passes"]))'
 }

@@ -20,14 +20,8 @@ for robot_dir in "$M"/data/${3:-panda_*}; do
     theirs[$test]=$("$K" evaluate --robot "$authors" --tip ball_link --obs "$W/$robot.$test.csv" --json | stats)
   done
   for train in "${recs[@]}"; do
-    cal=$(
-      "$K" calibrate --robot "$M/urdf/panda.urdf" --tip ball_link ${CAL_ARGS:-} \
-        --obs "$W/$robot.$train.csv" --fixed-distance hole_0,hole_1,50 \
-        --holdout 0 --out "$W/cal.yaml" --json |
-        python3 -c 'import json,sys
-try: j=json.load(sys.stdin)
-except Exception: print("NA\tNA\tNA"); sys.exit()
-print("%.4f\t%d\t%d" % (j["train_rms_mm"], len(j["identifiable"]), j["identifiability_passes"]))')
+    cal=$(calibrate_nominal "$K" "$M" "$W/cal.yaml" \
+      --obs "$W/$robot.$train.csv" --fixed-distance hole_0,hole_1,50)
     for test in "${recs[@]}"; do
       [ "$test" = "$train" ] && continue
       ours=$("$K" evaluate --robot "$W/cal.yaml" --obs "$W/$robot.$test.csv" --json | stats)
