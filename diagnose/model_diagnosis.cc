@@ -55,9 +55,9 @@ double Rms(const ModelState& state, const std::vector<Measurement>& ms) {
 // drift keeps its identifiable components (a drift along a direction that
 // geometry already explains is that geometry); other causes need all their
 // parameters. Returns false when nothing is left.
-bool ReduceToIdentifiable(const Eigen::MatrixXd& basis,
-                          const Eigen::MatrixXd& cols, Candidate* c) {
-  const std::vector<bool> ok = IndependentColumns(basis, cols);
+// `projected`: the candidate's columns after ProjectedOffBasis.
+bool ReduceToIdentifiable(const Eigen::MatrixXd& projected, Candidate* c) {
+  const std::vector<bool> ok = IndependentProjectedColumns(projected);
   if (c->cause != "drift") {
     return std::all_of(ok.begin(), ok.end(), [](bool b) { return b; });
   }
@@ -430,10 +430,12 @@ DiagnosisResult DiagnoseModel(const Robot& nominal, const Observations& obs,
       screen_raw.col(q) = base_raw.col(screen_cols[q]);
     const Eigen::MatrixXd base_ntn = screen_raw.transpose() * screen_raw;
     const Eigen::VectorXd base_ntr = screen_raw.transpose() * r0;
+    // Every candidate column off the current model's span, in one product.
+    const Eigen::MatrixXd projected = ProjectedOffBasis(basis, cand_jac);
     std::vector<bool> usable(pool.size());
     for (size_t c = 0; c < pool.size(); ++c) {
-      usable[c] = ReduceToIdentifiable(
-          basis, candidate_columns(cand_jac, pool[c]), &pool[c]);
+      usable[c] =
+          ReduceToIdentifiable(candidate_columns(projected, pool[c]), &pool[c]);
     }
     const int p = static_cast<int>(current_free.size());
     int tested = 0;

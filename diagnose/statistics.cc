@@ -90,32 +90,41 @@ Eigen::MatrixXd Basis(const Eigen::MatrixXd& a) {
   return q;
 }
 
+// The columns of `cand`, normalised, minus their part in the span of the
+// orthonormal `basis` (two passes).
+Eigen::MatrixXd ProjectedOffBasis(const Eigen::MatrixXd& basis,
+                                  const Eigen::MatrixXd& cand) {
+  Eigen::MatrixXd rest = Normalized(cand);
+  if (basis.cols() == 0) return rest;
+  for (int pass = 0; pass < 2; ++pass)
+    rest -= basis * (basis.transpose() * rest);
+  return rest;
+}
+
+// Which of the projected columns keep a part outside the span of the
+// earlier accepted ones (Gram-Schmidt, two passes).
+std::vector<bool> IndependentProjectedColumns(const Eigen::MatrixXd& rest) {
+  Eigen::MatrixXd accepted_cols(rest.rows(), rest.cols());
+  int accepted = 0;
+  std::vector<bool> out(rest.cols(), false);
+  for (int c = 0; c < rest.cols(); ++c) {
+    Eigen::VectorXd r = rest.col(c);
+    for (int pass = 0; pass < 2 && accepted > 0; ++pass) {
+      const auto q = accepted_cols.leftCols(accepted);
+      r -= q * (q.transpose() * r);
+    }
+    if (r.norm() < kIdentifiableSine) continue;
+    out[c] = true;
+    accepted_cols.col(accepted++) = r / r.norm();
+  }
+  return out;
+}
+
 // Which columns of `cand` (normalised) keep a part outside the span of
 // `basis` and of the candidate's earlier accepted columns.
 std::vector<bool> IndependentColumns(const Eigen::MatrixXd& basis,
-                                     Eigen::MatrixXd cand) {
-  cand = Normalized(cand);
-  // The basis and the accepted columns so far, without copying the basis
-  // (it has thousands of rows and up to ~150 columns, and this runs for
-  // every candidate of every step).
-  Eigen::MatrixXd extra(cand.rows(), cand.cols());
-  int accepted = 0;
-  std::vector<bool> out(cand.cols(), false);
-  for (int c = 0; c < cand.cols(); ++c) {
-    Eigen::VectorXd rest = cand.col(c);
-    if (rest.norm() == 0) continue;
-    for (int pass = 0; pass < 2; ++pass) {
-      if (basis.cols() > 0) rest -= basis * (basis.transpose() * rest);
-      if (accepted > 0) {
-        const auto q = extra.leftCols(accepted);
-        rest -= q * (q.transpose() * rest);
-      }
-    }
-    if (rest.norm() < kIdentifiableSine) continue;
-    out[c] = true;
-    extra.col(accepted++) = rest / rest.norm();
-  }
-  return out;
+                                     const Eigen::MatrixXd& cand) {
+  return IndependentProjectedColumns(ProjectedOffBasis(basis, cand));
 }
 
 // True when every column of `cand` is independent of `basis`.

@@ -28,7 +28,13 @@ Eigen::MatrixXd Basis(const Eigen::MatrixXd& a);
 // Which columns of `cand` (normalised) keep a part outside the span of
 // `basis` and of the candidate's earlier accepted columns (sine > 1e-5).
 std::vector<bool> IndependentColumns(const Eigen::MatrixXd& basis,
-                                     Eigen::MatrixXd cand);
+                                     const Eigen::MatrixXd& cand);
+// The same in two parts, so that many candidates share one projection: the
+// normalised columns minus their part in the span of `basis`, then which of
+// those keep a part outside the earlier accepted ones.
+Eigen::MatrixXd ProjectedOffBasis(const Eigen::MatrixXd& basis,
+                                  const Eigen::MatrixXd& cand);
+std::vector<bool> IndependentProjectedColumns(const Eigen::MatrixXd& rest);
 // True when every column of `cand` is independent of `basis`.
 bool IdentifiableAgainst(const Eigen::MatrixXd& basis,
                          const Eigen::MatrixXd& cand);
