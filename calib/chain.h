@@ -308,7 +308,7 @@ Mat4<T> RowTransform(Convention convention, const ChainRow& row, const T* p,
 // for k = 1..24 inside the travel, and 0 outside: the mean error is the
 // geometry's offset, which is also the prediction outside the travel the
 // series was fitted on. RMS over the travel: sqrt(|c|^2 / 2 - (m . c)^2)
-// (TransmissionRms). `c` points at kMaxTransmissionTerms values.
+// (the catalogue's magnitude). `c` points at kMaxTransmissionTerms values.
 inline double TransmissionMean(int k) {  // m_k, k = 1..24
   return (k % 2 == 1) ? 2.0 / (k * M_PI) : 0.0;
 }
