@@ -6,6 +6,7 @@
 
 #include <Eigen/Geometry>
 #include <cmath>
+#include <cstring>
 #include <map>
 #include <mutex>
 #include <regex>
@@ -130,6 +131,29 @@ struct Lines {
   const tinyxml2::XMLElement* robot = nullptr;
 };
 
+// urdfdom passes names and values it complains about to console_bridge as
+// part of a printf format: a '%' there (a material named "or%nge" with a bad
+// colour) is read as a conversion and crashed the parser (fuzz finding). No
+// URDF name or number contains '%', so the file is refused before urdfdom
+// sees it.
+void RejectPercent(const Locator& loc, const tinyxml2::XMLElement* el) {
+  for (const tinyxml2::XMLAttribute* a = el->FirstAttribute(); a;
+       a = a->Next()) {
+    if (std::strchr(a->Value(), '%')) {
+      loc.Fail(el, std::string(a->Name()) + "=",
+               std::string("<") + el->Name() + "> attribute " + a->Name() +
+                   ": '%' is not allowed in URDF names and values");
+    }
+  }
+  if (el->GetText() && std::strchr(el->GetText(), '%')) {
+    loc.Fail(el, std::string("<") + el->Name(),
+             std::string("<") + el->Name() +
+                 "> text: '%' is not allowed in URDF names and values");
+  }
+  for (auto* c = el->FirstChildElement(); c; c = c->NextSiblingElement())
+    RejectPercent(loc, c);
+}
+
 void PrePass(const Locator& loc, const tinyxml2::XMLDocument& doc,
              Lines* lines) {
   const tinyxml2::XMLElement* robot_el = doc.FirstChildElement("robot");
@@ -137,6 +161,7 @@ void PrePass(const Locator& loc, const tinyxml2::XMLDocument& doc,
     throw InputError(loc.file, 0, 0, "expected a <robot> element");
   }
   lines->robot = robot_el;
+  RejectPercent(loc, robot_el);
   if (IsXacro(robot_el)) {
     loc.Fail(robot_el, "<robot",
              "this is a xacro file, not URDF: expand it first (xacro in.xacro "

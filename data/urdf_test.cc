@@ -339,6 +339,12 @@ TEST(UrdfTest, ErrorsCarryFileLineColumn) {
                   "<link name=\"c\">\n <inertial><mass value=\"1\"/>"
                   "</inertial></link>\n</robot>",
               "5:2", "without <inertia>");
+  // Fuzz finding: urdfdom logs a bad material's name as a printf format
+  // ("%n" wrote through a null pointer); refused before urdfdom runs.
+  ExpectError(head +
+                  "<material name=\"or%nge\"><color rgba=\"1.x 0.5 0 1\"/>"
+                  "</material>\n</robot>",
+              "4:11", "'%' is not allowed");
   ExpectError(
       "<robot name=\"x\" xmlns:xacro=\"http://www.ros.org/wiki/xacro\">"
       "\n<link name=\"a\"/></robot>",
