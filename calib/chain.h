@@ -525,12 +525,12 @@ Vec3<T> TipInBase(const Chain& chain, const T* const* rows,
     const T* err = joint_errors ? joint_errors[j] : nullptr;
     const ChainRow& row = chain.rows[j];
     q[j] =
-        trig ? ModelJointValueTrig<T>(row.type, in.q[j], in.s[j], in.tau[j],
-                                      err, tm, &in.trig[2 * kMaxHarmonic * j],
-                                      row.transmission_lo, row.transmission_hi,
-                                      sines ? &in.transmission_sines
-                                                  [kMaxTransmissionTerms * j]
-                                            : nullptr)
+        trig ? ModelJointValueTrig<T>(
+                   row.type, in.q[j], in.s[j], in.tau[j], err, tm,
+                   &in.trig[2 * kMaxHarmonic * j], row.transmission_lo,
+                   row.transmission_hi,
+                   sines ? &in.transmission_sines[kMaxTransmissionTerms * j]
+                         : nullptr)
              : ModelJointValue<T>(row.type, in.q[j], in.s[j], in.tau[j], err,
                                   tm, row.transmission_lo, row.transmission_hi);
   }

@@ -187,18 +187,17 @@ void ResidualsAndJacobian(const std::vector<Measurement>& measurements,
       const JointType type = chain.rows[j].type;
       const double lo = chain.rows[j].transmission_lo;
       const double hi = chain.rows[j].transmission_hi;
-      const double* ts =
-          static_cast<int>(in.transmission_sines.size()) ==
-                  kMaxTransmissionTerms * n
-              ? &in.transmission_sines[kMaxTransmissionTerms * j]
-              : nullptr;
+      const double* ts = static_cast<int>(in.transmission_sines.size()) ==
+                                 kMaxTransmissionTerms * n
+                             ? &in.transmission_sines[kMaxTransmissionTerms * j]
+                             : nullptr;
       if (!need_dq[j]) {
         const double* e = chain.joint_errors[j].data();
-        q[j] = trig ? ModelJointValueTrig<double>(type, in.q[j], in.s[j],
-                                                  in.tau[j], e, tm, tr, lo, hi,
-                                                  ts)
-                    : ModelJointValue<double>(type, in.q[j], in.s[j], in.tau[j],
-                                              e, tm, lo, hi);
+        q[j] =
+            trig ? ModelJointValueTrig<double>(type, in.q[j], in.s[j],
+                                               in.tau[j], e, tm, tr, lo, hi, ts)
+                 : ModelJointValue<double>(type, in.q[j], in.s[j], in.tau[j], e,
+                                           tm, lo, hi);
         continue;
       }
       const std::vector<int>& f = free_entries[j];
