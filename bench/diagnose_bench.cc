@@ -149,20 +149,30 @@ DiagnosisResult Timed(const Robot& robot, const Observations& obs,
 // the path before (DiagnoseOptions::exact_jacobian = false: Ceres autodiff
 // refits, as on main before the speed-up) and now, in one run; medians of
 // `repeat` runs each, and the comparison of the results.
-void Ur10Timing(int repeat, bool small_only) {
-  const std::string dir =
-      std::string(KINCAL_SOURCE_DIR) + "/../shared/data/ipa-robot-accuracy/";
-  const std::string file = dir + "Series_C/measurements_random_poses.csv";
+// UR10 series C from ../shared/data and its every 11th pose (240); false
+// (with a line saying so) when the data are absent.
+bool LoadUr10SeriesC(const char* tag, Robot* ur10, Observations* all,
+                     Observations* small) {
+  const std::string file = std::string(KINCAL_SOURCE_DIR) +
+                           "/../shared/data/ipa-robot-accuracy/Series_C/"
+                           "measurements_random_poses.csv";
   if (!std::ifstream(file)) {
-    std::printf("== ur10: %s absent, skipped\n", file.c_str());
-    return;
+    std::printf("== %s: %s absent, skipped\n", tag, file.c_str());
+    return false;
   }
-  const Robot ur10 =
+  *ur10 =
       ReadRobotYaml(std::string(KINCAL_SOURCE_DIR) + "/data/robots/ur10.yaml");
-  const Observations all = ReadIpaSeries(file, ur10.JointNames()).observations;
+  *all = ReadIpaSeries(file, ur10->JointNames()).observations;
   std::vector<int> first;
   for (int i = 0; i < 240; ++i) first.push_back(i * 11);
-  const Observations small = Subset(all, first);
+  *small = Subset(*all, first);
+  return true;
+}
+
+void Ur10Timing(int repeat, bool small_only) {
+  Robot ur10;
+  Observations all, small;
+  if (!LoadUr10SeriesC("ur10", &ur10, &all, &small)) return;
   std::printf(
       "== ur10 series C: diagnose model (default options), median of %d, "
       "wall / process CPU seconds (2 threads)\n",
@@ -271,19 +281,9 @@ double CvDifference(const DiagnosisResult& a, const DiagnosisResult& b) {
 }
 
 void CvUr10(int repeat) {
-  const std::string file = std::string(KINCAL_SOURCE_DIR) +
-                           "/../shared/data/ipa-robot-accuracy/Series_C/"
-                           "measurements_random_poses.csv";
-  if (!std::ifstream(file)) {
-    std::printf("== cv: %s absent, skipped\n", file.c_str());
-    return;
-  }
-  const Robot ur10 =
-      ReadRobotYaml(std::string(KINCAL_SOURCE_DIR) + "/data/robots/ur10.yaml");
-  const Observations all = ReadIpaSeries(file, ur10.JointNames()).observations;
-  std::vector<int> first;
-  for (int i = 0; i < 240; ++i) first.push_back(i * 11);
-  const Observations small = Subset(all, first);
+  Robot ur10;
+  Observations all, small;
+  if (!LoadUr10SeriesC("cv", &ur10, &all, &small)) return;
   std::printf(
       "== cv: UR10 series C, diagnose model, median of %d, wall / process "
       "CPU seconds (2 threads)\n",
