@@ -23,8 +23,6 @@ namespace {
 // its values are never read here.
 class TipResidual {
  public:
-  static constexpr int kStride = 8;
-
   TipResidual(const Chain& chain, const Measurement& m)
       : chain_(chain), m_(m) {}
 
@@ -46,25 +44,81 @@ class TipResidual {
     return true;
   }
 
-  static ceres::CostFunction* Create(const Chain& chain, const Measurement& m) {
-    auto* cost = new ceres::DynamicAutoDiffCostFunction<TipResidual, kStride>(
-        new TipResidual(chain, m));
-    for (int r = 0; r <= chain.num_joints(); ++r) {
-      cost->AddParameterBlock(kRowBlockSize);
-    }
-    for (int j = 0; j < chain.num_joints(); ++j) {
-      cost->AddParameterBlock(kJointErrorBlockSize);
-    }
-    cost->AddParameterBlock(kDriftBlockSize);
-    cost->AddParameterBlock(m.kind == Measurement::kMeasured ? kFrameBlockSize
-                                                             : 3);
-    cost->SetNumResiduals(3);
-    return cost;
-  }
-
  private:
   const Chain chain_;
   const Measurement m_;
+};
+
+// TipResidual as a Ceres cost function whose Jacobian is taken by
+// forward-mode autodiff over only the entries asked for (`entries`, per
+// block in TipResidual's order), in chunks of kStride; the other columns of
+// the blocks Ceres asks for are zero. Ceres's DynamicAutoDiffCostFunction
+// differentiates every entry of every block it is asked for: with the
+// 35-entry joint-error blocks that is 28 passes through the chain per pose
+// for a 5-joint robot in ResidualJacobian, against 3 here for 18 geometry
+// parameters and the frame. Ceres passes null for constant blocks; the
+// entries a SubsetManifold holds are multiplied by zero, so their columns
+// need not be computed.
+class TipCost : public ceres::CostFunction {
+ public:
+  static constexpr int kStride = 8;
+  using Entries = std::vector<std::vector<int>>;
+
+  TipCost(const Chain& chain, const Measurement& m, Entries entries)
+      : functor_(chain, m), entries_(std::move(entries)) {
+    const int n = chain.num_joints();
+    for (int r = 0; r <= n; ++r)
+      mutable_parameter_block_sizes()->push_back(kRowBlockSize);
+    for (int j = 0; j < n; ++j)
+      mutable_parameter_block_sizes()->push_back(kJointErrorBlockSize);
+    mutable_parameter_block_sizes()->push_back(kDriftBlockSize);
+    mutable_parameter_block_sizes()->push_back(
+        m.kind == Measurement::kMeasured ? kFrameBlockSize : 3);
+    set_num_residuals(3);
+    entries_.resize(parameter_block_sizes().size());
+  }
+
+  bool Evaluate(double const* const* params, double* residuals,
+                double** jacobians) const override {
+    if (jacobians == nullptr) return functor_(params, residuals);
+    using Jet = ceres::Jet<double, kStride>;
+    const std::vector<int32_t>& sizes = parameter_block_sizes();
+    const int num_blocks = static_cast<int>(sizes.size());
+    std::vector<int> offset(num_blocks + 1, 0);
+    for (int b = 0; b < num_blocks; ++b) offset[b + 1] = offset[b] + sizes[b];
+    std::vector<Jet> jets(offset[num_blocks]);
+    std::vector<const Jet*> blocks(num_blocks);
+    std::vector<std::pair<int, int>> active;  // (block, entry)
+    for (int b = 0; b < num_blocks; ++b) {
+      for (int e = 0; e < sizes[b]; ++e)
+        jets[offset[b] + e] = Jet(params[b][e]);
+      blocks[b] = jets.data() + offset[b];
+      if (jacobians[b] == nullptr) continue;
+      std::fill(jacobians[b], jacobians[b] + 3 * sizes[b], 0.0);
+      for (int e : entries_[b]) active.emplace_back(b, e);
+    }
+    if (active.empty()) return functor_(params, residuals);
+    const int num_active = static_cast<int>(active.size());
+    for (int first = 0; first < num_active; first += kStride) {
+      const int last = std::min(num_active, first + kStride);
+      for (int c = first; c < last; ++c)
+        jets[offset[active[c].first] + active[c].second].v[c - first] = 1.0;
+      Jet r[3];
+      if (!functor_(blocks.data(), r)) return false;
+      for (int k = 0; k < 3; ++k) residuals[k] = r[k].a;
+      for (int c = first; c < last; ++c) {
+        const int b = active[c].first, e = active[c].second;
+        for (int k = 0; k < 3; ++k)
+          jacobians[b][k * sizes[b] + e] = r[k].v[c - first];
+        jets[offset[b] + e].v[c - first] = 0.0;
+      }
+    }
+    return true;
+  }
+
+ private:
+  const TipResidual functor_;
+  Entries entries_;
 };
 
 // A known distance between two fixed points:
@@ -190,6 +244,12 @@ FitSummary Fit(const std::vector<Measurement>& measurements,
   KINCAL_CHECK(!measurements.empty(), "no measurements to fit");
   FitSummary summary;
   ceres::Problem problem;
+  // The free entries of each block: the only columns the tip residuals
+  // differentiate.
+  std::map<const double*, std::vector<int>> free_entries;
+  for (const ParamInfo& p : options.free) {
+    free_entries[ParamAddress(state, p) - p.index].push_back(p.index);
+  }
   for (const Measurement& m : measurements) {
     ceres::LossFunction* loss = nullptr;
     if (options.loss == "huber") {
@@ -199,8 +259,14 @@ FitSummary Fit(const std::vector<Measurement>& measurements,
     } else {
       KINCAL_CHECK(options.loss == "none", "unknown loss " << options.loss);
     }
-    problem.AddResidualBlock(TipResidual::Create(state->chain, m), loss,
-                             BlocksOf(state, m));
+    const std::vector<double*> blocks = BlocksOf(state, m);
+    TipCost::Entries entries(blocks.size());
+    for (size_t b = 0; b < blocks.size(); ++b) {
+      auto it = free_entries.find(blocks[b]);
+      if (it != free_entries.end()) entries[b] = it->second;
+    }
+    problem.AddResidualBlock(new TipCost(state->chain, m, std::move(entries)),
+                             loss, blocks);
   }
   for (const PointDistance& d : options.distances) {
     problem.AddResidualBlock(DistanceResidual::Create(d.distance_mm, d.weight),
@@ -366,8 +432,16 @@ Eigen::MatrixXd ResidualJacobian(const std::vector<Measurement>& measurements,
       3 * measurements.size() + distances.size(), params.size());
   for (size_t i = 0; i < measurements.size(); ++i) {
     const Measurement& m = measurements[i];
-    std::unique_ptr<ceres::CostFunction> cost(TipResidual::Create(s.chain, m));
     const std::vector<double*> blocks = BlocksOf(&s, m);
+    TipCost::Entries entries(blocks.size());
+    for (const ParamInfo& p : params) {
+      const double* address = ParamAddress(&s, p);
+      for (size_t b = 0; b < blocks.size(); ++b) {
+        if (address == blocks[b] + p.index) entries[b].push_back(p.index);
+      }
+    }
+    std::unique_ptr<ceres::CostFunction> cost(
+        new TipCost(s.chain, m, std::move(entries)));
     const auto& sizes = cost->parameter_block_sizes();
     std::vector<std::vector<double>> jac_blocks(blocks.size());
     std::vector<double*> jac_ptrs(blocks.size());
