@@ -45,6 +45,9 @@ int RunCalibrate(CalibrateArgs args) {
   Robot nominal = ReadRobot(args.robot, args.root, args.tip);
   if (args.bound_length_mm > 0) nominal.bound_length_mm = args.bound_length_mm;
   if (args.bound_angle_deg > 0) nominal.bound_angle_deg = args.bound_angle_deg;
+  if (args.bound_length_mm > 0 || args.bound_angle_deg > 0) {
+    nominal.bounds_stated = true;
+  }
   const Observations obs = ReadObservationsCsv(args.obs, nominal.JointNames());
   if (args.method == "paper") {
     args.options.method = CalibrateOptions::kPaper;
@@ -106,6 +109,13 @@ int RunCalibrate(CalibrateArgs args) {
                       {"undone", p.undone}});
   }
   j["passes"] = passes;
+  nlohmann::json widened = nlohmann::json::array();
+  for (const WidenedBound& w : r.widened_bounds) {
+    widened.push_back(
+        {{"name", w.name}, {"from", Number(w.from)}, {"to", Number(w.to)}});
+  }
+  j["widened_bounds"] = widened;
+  j["at_bound"] = r.at_bound;
   j["condition_number"] = Number(id.condition);
   j["parameters"] = ParametersJson(r.fit, [&] {
     ModelState s;
@@ -157,6 +167,20 @@ int RunCalibrate(CalibrateArgs args) {
     std::printf(", held at the solution: %zu", r.held.size());
   std::printf("\n");
   for (const auto& rel : id.relations) std::printf("    %s\n", rel.c_str());
+  for (const WidenedBound& w : r.widened_bounds) {
+    std::printf(
+        "  bound of %s widened %g -> %g (the data pressed it to its bound)\n",
+        w.name.c_str(), w.from, w.to);
+  }
+  if (!r.at_bound.empty()) {
+    std::string names;
+    for (const auto& n : r.at_bound) names += (names.empty() ? "" : ", ") + n;
+    std::printf(
+        "  warning: on their bound at the end: %s; the robot may deviate "
+        "from its nominal model by more than --bound-length / --bound-angle "
+        "allow\n",
+        names.c_str());
+  }
   std::printf("  %-14s %12s %12s %10s\n", "parameter", "nominal", "value",
               "sigma");
   for (const auto& p : j["parameters"]) {

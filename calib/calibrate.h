@@ -68,6 +68,13 @@ struct IdentifiabilityPass {
   bool undone = false;  // its fit ended worse: the pass before was kept
 };
 
+// A bound calibrate widened because the data pressed a well-determined
+// parameter against it (interface units: mm, deg).
+struct WidenedBound {
+  std::string name;
+  double from = 0.0, to = 0.0;
+};
+
 struct CalibrateResult {
   Robot calibrated;  // nominal description with fitted values
   ModelState state;
@@ -84,6 +91,10 @@ struct CalibrateResult {
   bool has_epsilon = false;
   ErrorStats epsilon;
   std::vector<double> distance_errors_mm;  // per FixedDistance
+  // Bounds widened during the fit, in order, and the parameters that still
+  // end on their bound (the robot may deviate more than the bounds allow).
+  std::vector<WidenedBound> widened_bounds;
+  std::vector<std::string> at_bound;
   double seconds = 0.0;
   std::string method;
 };

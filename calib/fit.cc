@@ -199,6 +199,12 @@ double RowBound(const Chain& center, const ParamInfo& p) {
   return IsAngle(center, p) ? center.bound_angle_rad : center.bound_length_mm;
 }
 
+double RowBound(const Chain& center, const ParamInfo& p,
+                const FitOptions& options) {
+  auto it = options.bound_override.find(p.name);
+  return it != options.bound_override.end() ? it->second : RowBound(center, p);
+}
+
 std::vector<Measurement> MakeMeasurements(const Chain& nominal,
                                           const Observations& obs,
                                           ModelState* state) {
@@ -309,7 +315,7 @@ FitSummary Fit(const std::vector<Measurement>& measurements,
       if (p.kind != ParamKind::kRow) continue;
       double* address = ParamAddress(state, p);
       const double center = c.rows.at(p.block).p.at(p.index);
-      const double bound = RowBound(c, p);
+      const double bound = RowBound(c, p, options);
       problem.SetParameterLowerBound(address - p.index, p.index,
                                      center - bound);
       problem.SetParameterUpperBound(address - p.index, p.index,
@@ -326,8 +332,8 @@ FitSummary Fit(const std::vector<Measurement>& measurements,
       double* block = ParamAddress(state, p) - p.index;
       problem.AddResidualBlock(
           new PriorResidual(problem.ParameterBlockSize(block), p.index,
-                            c.rows.at(p.block).p.at(p.index), RowBound(c, p),
-                            options.prior_weight),
+                            c.rows.at(p.block).p.at(p.index),
+                            RowBound(c, p, options), options.prior_weight),
           nullptr, block);
     }
   }

@@ -7,6 +7,7 @@
 // (as Ceres' Solver::Options / Summary).
 
 #include <Eigen/Core>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -59,6 +60,10 @@ struct FitOptions {
   // it (ridge regularisation), residual prior_weight * (x - center) / bound,
   // in mm-equivalents beside the tip residuals. 0 = none.
   double prior_weight = 0.0;
+  // Bounds (internal units: mm, rad) that replace RowBound for the named
+  // parameters: calibrate widens the bound of a well-determined parameter
+  // the data press against (CalibrateResult::widened_bounds).
+  std::map<std::string, double> bound_override;
   // Robust loss on the 3D residual: "none", "huber" or "cauchy", scale in mm.
   std::string loss = "none";
   double loss_scale_mm = 1.0;
@@ -94,6 +99,9 @@ FitSummary Fit(const std::vector<Measurement>& measurements,
 // (internal units): the chain's bound_angle_rad for an angle,
 // bound_length_mm for a length.
 double RowBound(const Chain& center, const ParamInfo& p);
+// RowBound unless `options` overrides the parameter's bound.
+double RowBound(const Chain& center, const ParamInfo& p,
+                const FitOptions& options);
 
 // Jacobian of all stacked residuals (3 per measurement, then one per
 // distance) with respect to `params` (internal units), evaluated at `state`,

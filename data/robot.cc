@@ -253,6 +253,7 @@ Robot ParseRobotYaml(const std::string& text, const std::string& file) {
     r.CheckKeys(b, {"length", "angle"}, "bounds");
     robot.bound_length_mm = r.NumberOr(b, "length", 5.0, "bounds");
     robot.bound_angle_deg = r.NumberOr(b, "angle", 5.0, "bounds");
+    robot.bounds_stated = true;
     if (!(robot.bound_length_mm > 0 && robot.bound_length_mm <= 1e4 &&
           robot.bound_angle_deg > 0 && robot.bound_angle_deg <= 180)) {
       r.Fail(b,

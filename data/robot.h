@@ -73,6 +73,11 @@ struct Robot {
   RobotRow tool;  // fixed last row (type kFixed, name "tool")
   double bound_length_mm = 5.0;
   double bound_angle_deg = 5.0;
+  // True when the bounds were stated (robot.yaml `bounds:`, or calibrate's
+  // --bound-length / --bound-angle): a hard constraint, the seed's delta.
+  // Otherwise they are defaults that calibrate may widen where the data
+  // press a parameter against them (CalibrateResult::widened_bounds).
+  bool bounds_stated = false;
   std::vector<Extension> extensions;
 
   int JointIndex(const std::string& name) const;  // -1 when absent

@@ -37,7 +37,7 @@ import_recordings() {
 calibrate_nominal() {
   local k=$1 m=$2 out=$3
   shift 3
-  "$k" calibrate --robot "$m/urdf/panda.urdf" --tip ball_link ${CAL_ARGS:-} \
+  "$k" calibrate --robot "${NOMINAL_URDF:-$m/urdf/panda.urdf}" --tip ball_link ${CAL_ARGS:-} \
     "$@" --holdout 0 --out "$out" --json |
     python3 -c 'import json,sys
 try: j=json.load(sys.stdin)
