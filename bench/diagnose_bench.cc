@@ -19,6 +19,8 @@
 //      single split against k folds (--runs N seeds each).
 // Usage: diagnose_bench [--runs N] (N seeds per rate, default 40).
 
+#include <malloc.h>
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -511,6 +513,10 @@ void Section4(const Robot& bh7, int runs, bool nominal_robot,
 }  // namespace kincal
 
 int main(int argc, char** argv) {
+  // As the kincal executable does (app/main.cc): large Jacobians from the
+  // heap, freed memory kept, so that the figures are the command's.
+  mallopt(M_MMAP_THRESHOLD, 32 << 20);
+  mallopt(M_TRIM_THRESHOLD, 1 << 30);
   int runs = 40, repeat = 3;
   std::string only;
   for (int i = 1; i + 1 < argc; ++i) {
