@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <functional>
 #include <map>
 #include <random>
 #include <set>
@@ -161,6 +162,199 @@ std::vector<double> Norms(const ModelState& state,
 
 }  // namespace
 
+GeometryFit FitGeometry(
+    const Observations& obs, const Chain& nominal_chain, bool bounds_stated,
+    const std::vector<ParamInfo>& candidates, double registered_sigma0_mm,
+    const std::vector<PointDistance>& distances,
+    const CalibrateOptions& options,
+    const std::function<void(const Identifiability&)>& check,
+    std::vector<Measurement>* train, std::vector<Measurement>* held,
+    ModelState* state) {
+  GeometryFit g;
+  // First look, at the start values: structural redundancy (the sine test)
+  // and, with a noise level of a fraction of the registered misfit, the
+  // parameters so weakly determined that a first fit would send them
+  // across the admissible range (a Panda's joint-7 tilt with single-point
+  // data) and into another minimum.
+  IdentifiabilityOptions first_look = options.identifiability;
+  if (options.fit_geometry && options.first_look_noise_fraction > 0 &&
+      first_look.noise_sigma_mm <= 0) {
+    first_look.noise_sigma_mm =
+        options.first_look_noise_fraction * registered_sigma0_mm;
+  }
+  g.identifiability =
+      AnalyzeIdentifiability(*train, *state, candidates, first_look, distances);
+  HoldWeakJointErrors(*train, *state, first_look, &g.identifiability);
+  check(g.identifiability);
+  const int num_free = static_cast<int>(g.identifiability.identifiable.size());
+  FitOptions fit;
+  fit.bounds_center = &nominal_chain;
+  fit.loss = options.loss;
+  fit.loss_scale_mm = options.loss_scale_mm;
+  fit.distances = distances;
+  fit.prior_weight = options.prior_weight;
+  // Least squares for the passes (the seed's eq. (9), --method paper, runs
+  // once on the final set, in Calibrate).
+  auto lsq_fit = [&](const std::vector<ParamInfo>& free) {
+    fit.free = free;
+    return Fit(*train, fit, state);
+  };
+  // Joint-error families multiply inputs computed from the geometry (the
+  // gravity torque of compliance and elastostatic): computed from the
+  // nominal model at first, they are recomputed from the fitted one before
+  // each pass. A tool offset the nominal model lacks (the MUKCa ball sits
+  // 7 mm off the flange axis, the nominal one on it) otherwise leaves joint
+  // 7's torque ~0 in the fit and ~5 mm in every prediction: measured 1.24 mm
+  // held-out RMS instead of 0.25 on panda_4 with --free compliance.
+  const bool joint_errors = std::any_of(
+      candidates.begin(), candidates.end(),
+      [](const ParamInfo& p) { return p.kind == ParamKind::kJointError; });
+  auto refresh_inputs = [&]() {
+    const std::vector<PoseInput> inputs = MakePoseInputs(state->chain, obs);
+    for (Measurement& m : *train) m.input = inputs[m.row];
+    if (held != nullptr)
+      for (Measurement& m : *held) m.input = inputs[m.row];
+  };
+  auto names_of = [](const std::vector<ParamInfo>& ps) {
+    std::set<std::string> out;
+    for (const ParamInfo& p : ps) out.insert(p.name);
+    return out;
+  };
+  g.fit = lsq_fit(g.identifiability.identifiable);
+  {
+    IdentifiabilityPass pass;
+    pass.num_free = num_free;
+    pass.train_rms_mm = g.fit.final_rms_mm;
+    g.passes.push_back(pass);
+  }
+
+  // Identifiability at the solution, not at the guess: a nominal model with
+  // exactly perpendicular or parallel axes hides parameters that the real
+  // robot's data determine (and the reverse), so decide the free set again
+  // where the model fits, with the noise level the fit found, refit from
+  // there, and repeat until the set is stable. A parameter that leaves the
+  // set keeps its value (a jump back to nominal would throw away the fit
+  // and can land LM in another minimum) and may come back in a later pass.
+  // A pass whose fit ends worse than the one before is undone.
+  const std::set<std::string> first_set =
+      names_of(g.identifiability.identifiable);
+  std::vector<std::set<std::string>> seen = {first_set};
+  auto run_passes = [&]() {
+    for (int k = 1; k < options.max_identifiability_passes; ++k) {
+      if (!(g.fit.sigma0_mm > 0)) break;
+      if (joint_errors) refresh_inputs();
+      IdentifiabilityOptions at = options.identifiability;
+      at.noise_sigma_mm = g.fit.sigma0_mm;
+      Identifiability next =
+          AnalyzeIdentifiability(*train, *state, candidates, at, distances);
+      HoldWeakJointErrors(*train, *state, at, &next);
+      const std::set<std::string> now =
+          names_of(g.identifiability.identifiable);
+      const std::set<std::string> then = names_of(next.identifiable);
+      if (then == now) {
+        g.identifiability = next;
+        break;
+      }
+      IdentifiabilityPass pass;
+      for (const ParamInfo& p : next.identifiable)
+        if (!now.count(p.name)) pass.freed.push_back(p.name);
+      for (const ParamInfo& p : g.identifiability.identifiable)
+        if (!then.count(p.name)) pass.held.push_back(p.name);
+      const bool cycle =
+          std::find(seen.begin(), seen.end(), then) != seen.end();
+      seen.push_back(then);
+      const ModelState before_state = *state;
+      const FitSummary before_fit = g.fit;
+      FitSummary refit = lsq_fit(next.identifiable);
+      pass.num_free = static_cast<int>(next.identifiable.size());
+      pass.train_rms_mm = refit.final_rms_mm;
+      if (!(refit.final_rms_mm <=
+            before_fit.final_rms_mm * (1 + 1e-6) + 1e-9)) {
+        pass.undone = true;
+        g.passes.push_back(pass);
+        *state = before_state;
+        g.fit = before_fit;
+        break;
+      }
+      g.passes.push_back(pass);
+      g.identifiability = next;
+      g.fit = refit;
+      if (cycle) break;  // a set seen before: stop on this fit
+    }
+  };
+  if (options.fit_geometry) run_passes();
+
+  // Bounds the data press against. Bounds the robot file does not state
+  // (a URDF's 20 mm / 10 deg, a robot.yaml without `bounds:`) are a guess
+  // that keeps weakly determined parameters from wandering into another
+  // minimum, not knowledge of the robot. A free parameter (determined, by
+  // the identifiability test) that ends on such a bound says the robot
+  // deviates from its nominal model by more than the guess (a tool or a
+  // joint origin 30 mm from its nominal place; measured: a simulated Panda
+  // with 10 mm / 3 deg deviations stopped at 5.04 mm RMS with two origins
+  // on the 20 mm bound, 0.050 mm after widening). Its bound is doubled and
+  // the fit repeated, kept when it fits better by more than 1 %; at most
+  // kMaxWidenings doublings, angles up to 180 deg. Stated bounds (the
+  // seed's |x - t0| <= delta) are kept; parameters on them are reported.
+  auto pressed = [&]() {
+    std::vector<ParamInfo> out;
+    for (size_t i = 0; i < g.fit.params.size(); ++i) {
+      const ParamInfo& p = g.fit.params[i];
+      if (p.kind != ParamKind::kRow) continue;
+      const double bound = RowBound(nominal_chain, p, fit);
+      const double center = nominal_chain.rows.at(p.block).p.at(p.index);
+      const double deviation = std::abs(ParamValue(*state, p) - center);
+      if (deviation >= bound * (1 - 1e-6)) out.push_back(p);
+    }
+    return out;
+  };
+  if (options.fit_geometry && options.method != CalibrateOptions::kPaper &&
+      !bounds_stated) {
+    constexpr int kMaxWidenings = 4;
+    bool widened_any = false;
+    for (int round = 0; round < kMaxWidenings; ++round) {
+      const ModelState before_state = *state;
+      const FitSummary before_fit = g.fit;
+      const std::map<std::string, double> before_bounds = fit.bound_override;
+      std::vector<WidenedBound> widened;
+      for (const ParamInfo& p : pressed()) {
+        const double from = RowBound(nominal_chain, p, fit);
+        const double to = p.angle ? std::min(2 * from, M_PI) : 2 * from;
+        if (!(to > from)) continue;
+        fit.bound_override[p.name] = to;
+        widened.push_back({p.name, p.ToInterface(from), p.ToInterface(to)});
+      }
+      if (widened.empty()) break;
+      FitSummary refit = lsq_fit(g.identifiability.identifiable);
+      if (!(refit.final_rms_mm < 0.99 * before_fit.final_rms_mm)) {
+        *state = before_state;
+        g.fit = before_fit;
+        fit.bound_override = before_bounds;
+        break;
+      }
+      g.fit = refit;
+      g.widened_bounds.insert(g.widened_bounds.end(), widened.begin(),
+                              widened.end());
+      widened_any = true;
+    }
+    // The free set where the widened fit ended.
+    if (widened_any) run_passes();
+  }
+
+  // The inputs of the final fit from the geometry it starts at, so that the
+  // calibrated model (whose `evaluate` computes them from its own geometry)
+  // predicts what was fitted.
+  if (joint_errors && options.method != CalibrateOptions::kPaper) {
+    refresh_inputs();
+    g.fit = lsq_fit(g.identifiability.identifiable);
+  }
+  for (const ParamInfo& p : pressed()) g.at_bound.push_back(p.name);
+  g.first_set = first_set;
+  g.fit_options = fit;
+  g.fit_options.bounds_center = nullptr;  // the caller's nominal chain
+  return g;
+}
+
 CalibrateResult Calibrate(const Robot& nominal, const Observations& obs,
                           const CalibrateOptions& options) {
   const auto start = std::chrono::steady_clock::now();
@@ -231,217 +425,43 @@ CalibrateResult Calibrate(const Robot& nominal, const Observations& obs,
         candidates.push_back(p);
     }
   }
-  // First look, at the start values: structural redundancy (the sine test)
-  // and, with a noise level of a fraction of the registered misfit, the
-  // parameters so weakly determined that a first fit would send them
-  // across the admissible range (a Panda's joint-7 tilt with single-point
-  // data) and into another minimum.
-  IdentifiabilityOptions first_look = options.identifiability;
-  if (options.fit_geometry && options.first_look_noise_fraction > 0 &&
-      first_look.noise_sigma_mm <= 0) {
-    first_look.noise_sigma_mm =
-        options.first_look_noise_fraction * registered.sigma0_mm;
-  }
-  result.identifiability =
-      AnalyzeIdentifiability(train, state, candidates, first_look, distances);
-  HoldWeakJointErrors(train, state, first_look, &result.identifiability);
-  const int robot_params = result.identifiability.RobotParameterCount();
-  if (options.fit_geometry && robot_params == 0) {
-    throw InputError(obs.source, 0, 0,
-                     "the data determine no robot parameter (" +
-                         std::to_string(distinct) +
-                         " distinct poses): use more poses that differ in "
-                         "every joint");
-  }
-  const int num_free =
-      static_cast<int>(result.identifiability.identifiable.size());
-  const int num_residuals =
-      3 * static_cast<int>(train.size()) + static_cast<int>(distances.size());
-  if (num_residuals <= num_free) {
-    throw InputError(obs.source, 0, 0,
-                     "too few poses: " + std::to_string(train.size()) +
-                         " training poses give " +
-                         std::to_string(num_residuals) + " equations for " +
-                         std::to_string(num_free) +
-                         " identifiable parameters; need at least " +
-                         std::to_string(num_free / 3 + 1) +
-                         " distinct training poses (more for a useful fit)");
-  }
-
-  FitOptions fit;
-  fit.bounds_center = &nominal_chain;
-  fit.loss = options.loss;
-  fit.loss_scale_mm = options.loss_scale_mm;
-  fit.distances = distances;
-  fit.prior_weight = options.prior_weight;
-  auto run_fit = [&](const std::vector<ParamInfo>& free) {
-    fit.free = free;
-    if (options.method == CalibrateOptions::kPaper) {
-      PaperOptions paper;
-      for (const ParamInfo& p : free) {
-        if (p.kind != ParamKind::kFrame && p.kind != ParamKind::kPoint) {
-          paper.free.push_back(p);
-        }
-      }
-      paper.bounds_center = &nominal_chain;
-      paper.distances = distances;
-      return FitPaperObjective(train, paper, &state);
+  auto check = [&](const Identifiability& id) {
+    const int robot_params = id.RobotParameterCount();
+    if (options.fit_geometry && robot_params == 0) {
+      throw InputError(obs.source, 0, 0,
+                       "the data determine no robot parameter (" +
+                           std::to_string(distinct) +
+                           " distinct poses): use more poses that differ in "
+                           "every joint");
     }
-    return Fit(train, fit, &state);
+    const int num_free = static_cast<int>(id.identifiable.size());
+    const int num_residuals =
+        3 * static_cast<int>(train.size()) + static_cast<int>(distances.size());
+    if (num_residuals <= num_free) {
+      throw InputError(obs.source, 0, 0,
+                       "too few poses: " + std::to_string(train.size()) +
+                           " training poses give " +
+                           std::to_string(num_residuals) + " equations for " +
+                           std::to_string(num_free) +
+                           " identifiable parameters; need at least " +
+                           std::to_string(num_free / 3 + 1) +
+                           " distinct training poses (more for a useful fit)");
+    }
   };
-  // Least squares for the passes; eq. (9) once on the final set.
-  auto lsq_fit = [&](const std::vector<ParamInfo>& free) {
-    fit.free = free;
-    return Fit(train, fit, &state);
-  };
-  // Joint-error families multiply inputs computed from the geometry (the
-  // gravity torque of compliance and elastostatic): computed from the
-  // nominal model at first, they are recomputed from the fitted one before
-  // each pass. A tool offset the nominal model lacks (the MUKCa ball sits
-  // 7 mm off the flange axis, the nominal one on it) otherwise leaves joint
-  // 7's torque ~0 in the fit and ~5 mm in every prediction: measured 1.24 mm
-  // held-out RMS instead of 0.25 on panda_4 with --free compliance.
-  const bool joint_errors = std::any_of(
-      candidates.begin(), candidates.end(),
-      [](const ParamInfo& p) { return p.kind == ParamKind::kJointError; });
-  auto refresh_inputs = [&]() {
-    const std::vector<PoseInput> inputs = MakePoseInputs(state.chain, obs);
-    for (Measurement& m : train) m.input = inputs[m.row];
-    for (Measurement& m : held) m.input = inputs[m.row];
-  };
+  GeometryFit g = FitGeometry(obs, nominal_chain, nominal.bounds_stated,
+                              candidates, registered.sigma0_mm, distances,
+                              options, check, &train, &held, &state);
+  result.identifiability = g.identifiability;
+  result.passes = g.passes;
+  result.fit = g.fit;
+  result.widened_bounds = g.widened_bounds;
+  result.at_bound = g.at_bound;
   auto names_of = [](const std::vector<ParamInfo>& ps) {
     std::set<std::string> out;
     for (const ParamInfo& p : ps) out.insert(p.name);
     return out;
   };
-  result.fit = lsq_fit(result.identifiability.identifiable);
-  {
-    IdentifiabilityPass pass;
-    pass.num_free = num_free;
-    pass.train_rms_mm = result.fit.final_rms_mm;
-    result.passes.push_back(pass);
-  }
-
-  // Identifiability at the solution, not at the guess: a nominal model with
-  // exactly perpendicular or parallel axes hides parameters that the real
-  // robot's data determine (and the reverse), so decide the free set again
-  // where the model fits, with the noise level the fit found, refit from
-  // there, and repeat until the set is stable. A parameter that leaves the
-  // set keeps its value (a jump back to nominal would throw away the fit
-  // and can land LM in another minimum) and may come back in a later pass.
-  // A pass whose fit ends worse than the one before is undone.
-  const std::set<std::string> first_set =
-      names_of(result.identifiability.identifiable);
-  std::vector<std::set<std::string>> seen = {first_set};
-  auto run_passes = [&]() {
-    for (int k = 1; k < options.max_identifiability_passes; ++k) {
-      if (!(result.fit.sigma0_mm > 0)) break;
-      if (joint_errors) refresh_inputs();
-      IdentifiabilityOptions at = options.identifiability;
-      at.noise_sigma_mm = result.fit.sigma0_mm;
-      Identifiability next =
-          AnalyzeIdentifiability(train, state, candidates, at, distances);
-      HoldWeakJointErrors(train, state, at, &next);
-      const std::set<std::string> now =
-          names_of(result.identifiability.identifiable);
-      const std::set<std::string> then = names_of(next.identifiable);
-      if (then == now) {
-        result.identifiability = next;
-        break;
-      }
-      IdentifiabilityPass pass;
-      for (const ParamInfo& p : next.identifiable)
-        if (!now.count(p.name)) pass.freed.push_back(p.name);
-      for (const ParamInfo& p : result.identifiability.identifiable)
-        if (!then.count(p.name)) pass.held.push_back(p.name);
-      const bool cycle =
-          std::find(seen.begin(), seen.end(), then) != seen.end();
-      seen.push_back(then);
-      const ModelState before_state = state;
-      const FitSummary before_fit = result.fit;
-      FitSummary refit = lsq_fit(next.identifiable);
-      pass.num_free = static_cast<int>(next.identifiable.size());
-      pass.train_rms_mm = refit.final_rms_mm;
-      if (!(refit.final_rms_mm <=
-            before_fit.final_rms_mm * (1 + 1e-6) + 1e-9)) {
-        pass.undone = true;
-        result.passes.push_back(pass);
-        state = before_state;
-        result.fit = before_fit;
-        break;
-      }
-      result.passes.push_back(pass);
-      result.identifiability = next;
-      result.fit = refit;
-      if (cycle) break;  // a set seen before: stop on this fit
-    }
-  };
-  if (options.fit_geometry) run_passes();
-
-  // Bounds the data press against. Bounds the robot file does not state
-  // (a URDF's 20 mm / 10 deg, a robot.yaml without `bounds:`) are a guess
-  // that keeps weakly determined parameters from wandering into another
-  // minimum, not knowledge of the robot. A free parameter (determined, by
-  // the identifiability test) that ends on such a bound says the robot
-  // deviates from its nominal model by more than the guess (a tool or a
-  // joint origin 30 mm from its nominal place; measured: a simulated Panda
-  // with 10 mm / 3 deg deviations stopped at 5.04 mm RMS with two origins
-  // on the 20 mm bound, 0.050 mm after widening). Its bound is doubled and
-  // the fit repeated, kept when it fits better by more than 1 %; at most
-  // kMaxWidenings doublings, angles up to 180 deg. Stated bounds (the
-  // seed's |x - t0| <= delta) are kept; parameters on them are reported.
-  auto pressed = [&]() {
-    std::vector<ParamInfo> out;
-    for (size_t i = 0; i < result.fit.params.size(); ++i) {
-      const ParamInfo& p = result.fit.params[i];
-      if (p.kind != ParamKind::kRow) continue;
-      const double bound = RowBound(nominal_chain, p, fit);
-      const double center = nominal_chain.rows.at(p.block).p.at(p.index);
-      const double deviation = std::abs(ParamValue(state, p) - center);
-      if (deviation >= bound * (1 - 1e-6)) out.push_back(p);
-    }
-    return out;
-  };
-  if (options.fit_geometry && options.method != CalibrateOptions::kPaper &&
-      !nominal.bounds_stated) {
-    constexpr int kMaxWidenings = 4;
-    bool widened_any = false;
-    for (int round = 0; round < kMaxWidenings; ++round) {
-      const ModelState before_state = state;
-      const FitSummary before_fit = result.fit;
-      const std::map<std::string, double> before_bounds = fit.bound_override;
-      std::vector<WidenedBound> widened;
-      for (const ParamInfo& p : pressed()) {
-        const double from = RowBound(nominal_chain, p, fit);
-        const double to = p.angle ? std::min(2 * from, M_PI) : 2 * from;
-        if (!(to > from)) continue;
-        fit.bound_override[p.name] = to;
-        widened.push_back({p.name, p.ToInterface(from), p.ToInterface(to)});
-      }
-      if (widened.empty()) break;
-      FitSummary refit = lsq_fit(result.identifiability.identifiable);
-      if (!(refit.final_rms_mm < 0.99 * before_fit.final_rms_mm)) {
-        state = before_state;
-        result.fit = before_fit;
-        fit.bound_override = before_bounds;
-        break;
-      }
-      result.fit = refit;
-      result.widened_bounds.insert(result.widened_bounds.end(), widened.begin(),
-                                   widened.end());
-      widened_any = true;
-    }
-    // The free set where the widened fit ended.
-    if (widened_any) run_passes();
-  }
-
-  // The inputs of the final fit from the geometry it starts at, so that the
-  // calibrated model (whose `evaluate` computes them from its own geometry)
-  // predicts what was fitted.
-  if (joint_errors && options.method != CalibrateOptions::kPaper) {
-    refresh_inputs();
-    result.fit = lsq_fit(result.identifiability.identifiable);
-  }
+  const std::set<std::string>& first_set = g.first_set;
   const std::set<std::string> final_set =
       names_of(result.identifiability.identifiable);
   for (const std::string& n : final_set)
@@ -449,7 +469,15 @@ CalibrateResult Calibrate(const Robot& nominal, const Observations& obs,
   for (const std::string& n : first_set)
     if (!final_set.count(n)) result.held.push_back(n);
   if (options.method == CalibrateOptions::kPaper) {
-    result.fit = run_fit(result.identifiability.identifiable);
+    PaperOptions paper;
+    for (const ParamInfo& p : result.identifiability.identifiable) {
+      if (p.kind != ParamKind::kFrame && p.kind != ParamKind::kPoint) {
+        paper.free.push_back(p);
+      }
+    }
+    paper.bounds_center = &nominal_chain;
+    paper.distances = distances;
+    result.fit = FitPaperObjective(train, paper, &state);
   }
   if (!std::isfinite(result.fit.final_rms_mm)) {
     throw std::runtime_error(
@@ -472,7 +500,6 @@ CalibrateResult Calibrate(const Robot& nominal, const Observations& obs,
     result.has_epsilon = true;
     result.epsilon = ComputeErrorStats(eps);
   }
-  for (const ParamInfo& p : pressed()) result.at_bound.push_back(p.name);
   result.calibrated = state.chain.ToRobot(nominal);
   result.seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start)

@@ -7,6 +7,8 @@
 // file's +-delta), and report training and held-out error.
 
 #include <cstdint>
+#include <functional>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -101,6 +103,41 @@ struct CalibrateResult {
 
 CalibrateResult Calibrate(const Robot& nominal, const Observations& obs,
                           const CalibrateOptions& options);
+
+// The geometry from the nominal model, as `calibrate` fits it, for callers
+// with measurements of their own (diagnose's base model):
+//   1. the first look at the start values: the sine test and, with a noise
+//      level of options.first_look_noise_fraction x `registered_sigma0_mm`
+//      (the misfit after registering the frame / points), the parameters
+//      too weak to free;
+//   2. `check` on that set (callers throw their InputError there);
+//   3. fit, identifiability at the solution, refit, until the free set is
+//      stable (at most options.max_identifiability_passes);
+//   4. bounds the robot does not state (`bounds_stated` false) widened where
+//      a free parameter ends on them (CalibrateResult::widened_bounds).
+// `state` holds the registered frame / points on entry, the fitted model on
+// return. Joint-error candidates' inputs are recomputed from the fitted
+// geometry (from `obs`) in `train` and `held` (may be null). Least squares
+// only: options.method is not used.
+struct GeometryFit {
+  Identifiability identifiability;  // of the final pass
+  std::vector<IdentifiabilityPass> passes;
+  std::set<std::string> first_set;  // the free set of the first look
+  FitSummary fit;
+  // The options of the last fit (free set, bounds widened): bounds_center
+  // is null, the caller's nominal chain goes there.
+  FitOptions fit_options;
+  std::vector<WidenedBound> widened_bounds;
+  std::vector<std::string> at_bound;
+};
+GeometryFit FitGeometry(
+    const Observations& obs, const Chain& nominal_chain, bool bounds_stated,
+    const std::vector<ParamInfo>& candidates, double registered_sigma0_mm,
+    const std::vector<PointDistance>& distances,
+    const CalibrateOptions& options,
+    const std::function<void(const Identifiability&)>& check,
+    std::vector<Measurement>* train, std::vector<Measurement>* held,
+    ModelState* state);
 
 // Splits measurement indices into train / held-out, seeded; fixed-point
 // groups are split per group so that each keeps at least 3 training poses.

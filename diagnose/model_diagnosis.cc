@@ -71,23 +71,25 @@ bool ReduceToIdentifiable(const Eigen::MatrixXd& projected, Candidate* c) {
 
 struct Problem {
   Chain nominal;
+  // The geometry's box: nominal +- its bounds, widened by FitBase where the
+  // data press a parameter against bounds the robot file does not state.
+  Chain bounds;
   std::vector<Measurement> all, train, held;
   std::vector<ParamInfo> base_free;  // nuisance + identifiable geometry
   ModelState base_state;             // fitted on the training poses
 };
 
-// Frame (and points) registration, identifiability, geometric fit.
-// exact: the fits by diagnose/free_fit.h's exact-Jacobian path (same
-// problem, same bounds, calib/fit.h's tolerances).
-void FitBase(const std::vector<Measurement>& fit_on, const std::string& source,
-             Problem* pb, bool exact = false) {
-  auto fit = [&](const FitOptions& fo, ModelState* state) {
-    if (!exact) {
-      Fit(fit_on, fo, state);
-      return;
-    }
-    FreeFit(fit_on, FreeFitOptionsFrom(fo), state);
-  };
+// Frame (and points) registration, then the geometry as `calibrate` fits
+// it from the nominal model (calib/calibrate.h FitGeometry: the first look,
+// identifiability at the solution until the free set is stable, unstated
+// bounds widened where the data press against them). With the first look
+// alone a 7-joint URDF arm 10 mm / 3 deg from its nominal model stopped at
+// 1.88 mm RMS (another minimum, 0.14 after the passes) and the catalogue
+// found nothing; with bounds pressed it named `thermal` for a backlash.
+// exact: the frame-only fit by diagnose/free_fit.h's exact-Jacobian path
+// (same problem, calib/fit.h's tolerances).
+void FitBase(const std::vector<Measurement>& fit_on, const Observations& obs,
+             bool bounds_stated, Problem* pb, bool exact = false) {
   ModelState& state = pb->base_state;
   InitializeFrameAndPoints(fit_on, &state);
   std::vector<ParamInfo> nuisance;
@@ -100,40 +102,58 @@ void FitBase(const std::vector<Measurement>& fit_on, const std::string& source,
   FitOptions frame_only;
   frame_only.free = nuisance;
   frame_only.compute_covariance = false;
-  fit(frame_only, &state);
+  if (exact) {
+    FreeFit(fit_on, FreeFitOptionsFrom(frame_only), &state);
+  } else {
+    Fit(fit_on, frame_only, &state);
+  }
+  const double registered_sigma0 =
+      std::sqrt(Rss(state, fit_on) /
+                std::max(1.0, 3.0 * fit_on.size() -
+                                  static_cast<double>(nuisance.size())));
 
   std::vector<ParamInfo> candidates = nuisance;
   for (const ParamInfo& p : GeometryParams(state.chain))
     candidates.push_back(p);
-  const Identifiability id = AnalyzeIdentifiability(fit_on, state, candidates);
-  const int robot_params = id.RobotParameterCount();
-  const int distinct = DistinctPoses(fit_on);
-  if (robot_params == 0) {
-    throw InputError(source, 0, 0,
-                     "the data determine no robot parameter (" +
-                         std::to_string(distinct) +
-                         " distinct poses): use more poses that differ in "
-                         "every joint");
+  auto check = [&](const Identifiability& id) {
+    const int robot_params = id.RobotParameterCount();
+    const int distinct = DistinctPoses(fit_on);
+    if (robot_params == 0) {
+      throw InputError(obs.source, 0, 0,
+                       "the data determine no robot parameter (" +
+                           std::to_string(distinct) +
+                           " distinct poses): use more poses that differ in "
+                           "every joint");
+    }
+    const int num_free = static_cast<int>(id.identifiable.size());
+    if (3 * static_cast<int>(fit_on.size()) <= num_free + 3) {
+      throw InputError(obs.source, 0, 0,
+                       "too few poses: " + std::to_string(fit_on.size()) +
+                           " training poses give " +
+                           std::to_string(3 * fit_on.size()) +
+                           " equations for " + std::to_string(num_free) +
+                           " identifiable parameters plus the candidates; "
+                           "need at least " +
+                           std::to_string(num_free / 3 + 3) +
+                           " distinct training poses (more for a useful "
+                           "diagnosis)");
+    }
+  };
+  std::vector<Measurement> train = fit_on;
+  const GeometryFit g = FitGeometry(obs, pb->nominal, bounds_stated, candidates,
+                                    registered_sigma0, {}, CalibrateOptions{},
+                                    check, &train, nullptr, &state);
+  pb->base_free = g.identifiability.identifiable;
+  // The box of every later fit: the nominal one, each kind (lengths,
+  // angles) as wide as the widest bound FitGeometry widened.
+  pb->bounds = pb->nominal;
+  for (const ParamInfo& p : pb->base_free) {
+    auto it = g.fit_options.bound_override.find(p.name);
+    if (it == g.fit_options.bound_override.end()) continue;
+    double& bound =
+        p.angle ? pb->bounds.bound_angle_rad : pb->bounds.bound_length_mm;
+    bound = std::max(bound, it->second);
   }
-  const int num_free = static_cast<int>(id.identifiable.size());
-  if (3 * static_cast<int>(fit_on.size()) <= num_free + 3) {
-    throw InputError(source, 0, 0,
-                     "too few poses: " + std::to_string(fit_on.size()) +
-                         " training poses give " +
-                         std::to_string(3 * fit_on.size()) + " equations for " +
-                         std::to_string(num_free) +
-                         " identifiable parameters plus the candidates; need "
-                         "at least " +
-                         std::to_string(num_free / 3 + 3) +
-                         " distinct training poses (more for a useful "
-                         "diagnosis)");
-  }
-  pb->base_free = id.identifiable;
-  FitOptions geo;
-  geo.free = pb->base_free;
-  geo.bounds_center = &pb->nominal;
-  geo.compute_covariance = false;
-  fit(geo, &state);
 }
 
 // Measurements of `obs` with the validity checks of the spec.
@@ -306,7 +326,7 @@ DiagnosisResult DiagnoseModel(const Robot& nominal, const Observations& obs,
     }
     out.folds = k >= 2 ? k : 0;
   }
-  FitBase(pb.train, obs.source, &pb, options.exact_jacobian);
+  FitBase(pb.train, obs, nominal.bounds_stated, &pb, options.exact_jacobian);
   const FoldPlan folds = out.folds >= 2
                              ? MakeFolds(pb.train, out.folds, options.seed)
                              : FoldPlan{};
@@ -320,7 +340,7 @@ DiagnosisResult DiagnoseModel(const Robot& nominal, const Observations& obs,
   auto cv_options = [&](const std::vector<ParamInfo>& free) {
     FreeFitOptions o;
     o.free = free;
-    o.bounds_center = &pb.nominal;
+    o.bounds_center = &pb.bounds;
     o.exact_jacobian = options.exact_jacobian;
     return o;
   };
@@ -498,7 +518,7 @@ DiagnosisResult DiagnoseModel(const Robot& nominal, const Observations& obs,
         if (std::isfinite(step[q]))
           *ParamAddress(&states[c], fo.free[q]) += step[q];
       }
-      fo.bounds_center = &pb.nominal;
+      fo.bounds_center = &pb.bounds;
       fo.compute_covariance = false;
       fo.max_iterations = 100;
       fo.function_tolerance = 1e-10;
@@ -638,7 +658,7 @@ DiagnosisResult DiagnoseModel(const Robot& nominal, const Observations& obs,
       FitOptions fo;
       fo.free = current_free;
       for (const ParamInfo& q : pool[best].params) fo.free.push_back(q);
-      fo.bounds_center = &pb.nominal;
+      fo.bounds_center = &pb.bounds;
       fo.compute_covariance = false;
       fo.max_iterations = 100;
       fo.function_tolerance = 1e-10;
@@ -738,7 +758,7 @@ DiagnosisResult DiagnoseModel(const Robot& nominal, const Observations& obs,
   ModelState final_state = current;
   FitOptions fo;
   fo.free = current_free;
-  fo.bounds_center = &pb.nominal;
+  fo.bounds_center = &pb.bounds;
   fo.compute_covariance = true;
   FitSummary final_fit;
   if (options.exact_jacobian) {
@@ -835,7 +855,7 @@ std::vector<Magnitude> FitCandidates(const Robot& nominal,
   SetTransmissionTravel(pb.all, &pb.nominal);
   SetTransmissionTravel(pb.all, &pb.base_state.chain);
   for (Measurement& m : pb.all) FillTransmissionSines(pb.nominal, &m.input);
-  FitBase(pb.all, obs.source, &pb);
+  FitBase(pb.all, obs, nominal.bounds_stated, &pb);
   const std::vector<Candidate> catalogue =
       CatalogueCandidates(pb.nominal, pb.all);
   const Eigen::MatrixXd basis =
@@ -844,7 +864,7 @@ std::vector<Magnitude> FitCandidates(const Robot& nominal,
   std::vector<bool> found(labels.size(), false);
   FitOptions fo;
   fo.free = pb.base_free;
-  fo.bounds_center = &pb.nominal;
+  fo.bounds_center = &pb.bounds;
   Eigen::MatrixXd model = basis;
   for (size_t i = 0; i < labels.size(); ++i) {
     for (const Candidate& c : catalogue) {
