@@ -33,7 +33,9 @@ import_recordings() {
 
 # calibrate_nominal KINCAL MUKCA_DIR OUT.yaml CALIBRATE_ARGS...: kincal
 # calibrate from the nominal Panda (ball_link tip, no hold-out, CAL_ARGS
-# from the environment passed through); prints "train_rms free passes".
+# from the environment passed through; NOMINAL_URDF replaces the nominal
+# urdf/panda.urdf, e.g. a copy with <inertial> elements); prints
+# "train_rms free passes".
 calibrate_nominal() {
   local k=$1 m=$2 out=$3
   shift 3
