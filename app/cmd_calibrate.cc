@@ -175,12 +175,20 @@ int RunCalibrate(CalibrateArgs args) {
   if (!r.at_bound.empty()) {
     std::string names;
     for (const auto& n : r.at_bound) names += (names.empty() ? "" : ", ") + n;
-    std::printf(
-        "  warning: on their bound at the end: %s; the robot may deviate "
-        "from its nominal model by more than --bound-length / --bound-angle "
-        "allow\n",
-        names.c_str());
+    if (nominal.bounds_stated ||
+        args.options.method == CalibrateOptions::kPaper) {
+      std::printf(
+          "  warning: on their bound at the end: %s; the robot may "
+          "deviate from its nominal model by more than the bounds allow\n",
+          names.c_str());
+    } else {
+      std::printf(
+          "  note: on their bound at the end: %s; a wider bound did not fit "
+          "better by 1 %%: these data determine them weakly\n",
+          names.c_str());
+    }
   }
+
   std::printf("  %-14s %12s %12s %10s\n", "parameter", "nominal", "value",
               "sigma");
   for (const auto& p : j["parameters"]) {
