@@ -169,7 +169,7 @@ GeometryFit FitGeometry(
     const CalibrateOptions& options,
     const std::function<void(const Identifiability&)>& check,
     std::vector<Measurement>* train, std::vector<Measurement>* held,
-    ModelState* state) {
+    ModelState* state, const GeometryFitter& fitter) {
   GeometryFit g;
   // First look, at the start values: structural redundancy (the sine test)
   // and, with a noise level of a fraction of the registered misfit, the
@@ -197,7 +197,7 @@ GeometryFit FitGeometry(
   // once on the final set, in Calibrate).
   auto lsq_fit = [&](const std::vector<ParamInfo>& free) {
     fit.free = free;
-    return Fit(*train, fit, state);
+    return fitter ? fitter(*train, fit, state) : Fit(*train, fit, state);
   };
   // Joint-error families multiply inputs computed from the geometry (the
   // gravity torque of compliance and elastostatic): computed from the

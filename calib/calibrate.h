@@ -130,6 +130,9 @@ struct GeometryFit {
   std::vector<WidenedBound> widened_bounds;
   std::vector<std::string> at_bound;
 };
+// The least-squares fit FitGeometry runs: calib/fit.h's Fit when empty.
+using GeometryFitter = std::function<FitSummary(
+    const std::vector<Measurement>&, const FitOptions&, ModelState*)>;
 GeometryFit FitGeometry(
     const Observations& obs, const Chain& nominal_chain, bool bounds_stated,
     const std::vector<ParamInfo>& candidates, double registered_sigma0_mm,
@@ -137,7 +140,7 @@ GeometryFit FitGeometry(
     const CalibrateOptions& options,
     const std::function<void(const Identifiability&)>& check,
     std::vector<Measurement>* train, std::vector<Measurement>* held,
-    ModelState* state);
+    ModelState* state, const GeometryFitter& fitter = nullptr);
 
 // Splits measurement indices into train / held-out, seeded; fixed-point
 // groups are split per group so that each keeps at least 3 training poses.

@@ -25,8 +25,8 @@ void Box(const FreeFitOptions& o, Eigen::VectorXd* lower,
     const ParamInfo& p = o.free[i];
     if (p.kind != ParamKind::kRow) continue;
     const double center = o.bounds_center->rows.at(p.block).p.at(p.index);
-    (*lower)[i] = center - RowBound(*o.bounds_center, p);
-    (*upper)[i] = center + RowBound(*o.bounds_center, p);
+    (*lower)[i] = center - FreeFitBound(o, p);
+    (*upper)[i] = center + FreeFitBound(o, p);
   }
 }
 

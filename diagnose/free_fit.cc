@@ -98,8 +98,8 @@ void Bounds(const FreeFitOptions& options, std::vector<double>* lower,
     const ParamInfo& p = options.free[i];
     if (p.kind != ParamKind::kRow) continue;
     const double center = c.rows.at(p.block).p.at(p.index);
-    (*lower)[i] = center - RowBound(c, p);
-    (*upper)[i] = center + RowBound(c, p);
+    (*lower)[i] = center - FreeFitBound(options, p);
+    (*upper)[i] = center + FreeFitBound(options, p);
   }
 }
 
@@ -207,10 +207,18 @@ double ExactFreeFit(const std::vector<Measurement>& ms,
 
 }  // namespace
 
+double FreeFitBound(const FreeFitOptions& options, const ParamInfo& p) {
+  auto it = options.bound_override.find(p.name);
+  return it != options.bound_override.end()
+             ? it->second
+             : RowBound(*options.bounds_center, p);
+}
+
 FreeFitOptions FreeFitOptionsFrom(const FitOptions& fit_options) {
   FreeFitOptions o;
   o.free = fit_options.free;
   o.bounds_center = fit_options.bounds_center;
+  o.bound_override = fit_options.bound_override;
   o.max_iterations = fit_options.max_iterations;
   o.function_tolerance = fit_options.function_tolerance;
   o.parameter_tolerance = fit_options.parameter_tolerance;

@@ -9,6 +9,8 @@
 // ~25, so autodiff does ~5x less work. Same model (calib/chain.h TipInBase),
 // same bounds (+-delta about the nominal geometry), no covariance.
 
+#include <map>
+#include <string>
 #include <vector>
 
 #include "calib/fit.h"
@@ -19,6 +21,9 @@ namespace kincal {
 struct FreeFitOptions {
   std::vector<ParamInfo> free;
   const Chain* bounds_center = nullptr;
+  // Per-parameter bounds replacing the chain's (calib/fit.h FitOptions::
+  // bound_override).
+  std::map<std::string, double> bound_override;
   int max_iterations = 100;
   double function_tolerance = 1e-10;
   double parameter_tolerance = 1e-10;
@@ -31,6 +36,10 @@ struct FreeFitOptions {
 // The same free parameters, box and stopping rules as a calib/fit.h fit
 // (its distances, prior and covariance are not carried over).
 FreeFitOptions FreeFitOptionsFrom(const FitOptions& fit_options);
+
+// The +-bound of a free row entry about options.bounds_center (calib/fit.h
+// RowBound with the options' overrides).
+double FreeFitBound(const FreeFitOptions& options, const ParamInfo& p);
 
 // Fits the free parameters of `state` to the measured rows (kMeasured
 // only); returns the final sum of squared residuals, mm^2.

@@ -71,9 +71,10 @@ bool ReduceToIdentifiable(const Eigen::MatrixXd& projected, Candidate* c) {
 
 struct Problem {
   Chain nominal;
-  // The geometry's box: nominal +- its bounds, widened by FitBase where the
-  // data press a parameter against bounds the robot file does not state.
-  Chain bounds;
+  // Bounds FitBase widened where the data press a parameter against bounds
+  // the robot file does not state (calib/fit.h FitOptions::bound_override),
+  // for every later fit.
+  std::map<std::string, double> bound_override;
   std::vector<Measurement> all, train, held;
   std::vector<ParamInfo> base_free;  // nuisance + identifiable geometry
   ModelState base_state;             // fitted on the training poses
@@ -86,8 +87,8 @@ struct Problem {
 // alone a 7-joint URDF arm 10 mm / 3 deg from its nominal model stopped at
 // 1.88 mm RMS (another minimum, 0.14 after the passes) and the catalogue
 // found nothing; with bounds pressed it named `thermal` for a backlash.
-// exact: the frame-only fit by diagnose/free_fit.h's exact-Jacobian path
-// (same problem, calib/fit.h's tolerances).
+// exact: the fits by diagnose/free_fit.h's exact-Jacobian path (same
+// problem, calib/fit.h's tolerances).
 void FitBase(const std::vector<Measurement>& fit_on, const Observations& obs,
              bool bounds_stated, Problem* pb, bool exact = false) {
   ModelState& state = pb->base_state;
@@ -139,21 +140,21 @@ void FitBase(const std::vector<Measurement>& fit_on, const Observations& obs,
                            "diagnosis)");
     }
   };
+  // The geometry's fits by the exact-Jacobian path when asked (same
+  // problem and bounds, calib/fit.h's tolerances).
+  GeometryFitter fitter;
+  if (exact) {
+    fitter = [](const std::vector<Measurement>& ms, const FitOptions& fo,
+                ModelState* s) {
+      return FreeFitWithCovariance(ms, FreeFitOptionsFrom(fo), s);
+    };
+  }
   std::vector<Measurement> train = fit_on;
   const GeometryFit g = FitGeometry(obs, pb->nominal, bounds_stated, candidates,
                                     registered_sigma0, {}, CalibrateOptions{},
-                                    check, &train, nullptr, &state);
+                                    check, &train, nullptr, &state, fitter);
   pb->base_free = g.identifiability.identifiable;
-  // The box of every later fit: the nominal one, each kind (lengths,
-  // angles) as wide as the widest bound FitGeometry widened.
-  pb->bounds = pb->nominal;
-  for (const ParamInfo& p : pb->base_free) {
-    auto it = g.fit_options.bound_override.find(p.name);
-    if (it == g.fit_options.bound_override.end()) continue;
-    double& bound =
-        p.angle ? pb->bounds.bound_angle_rad : pb->bounds.bound_length_mm;
-    bound = std::max(bound, it->second);
-  }
+  pb->bound_override = g.fit_options.bound_override;
 }
 
 // Measurements of `obs` with the validity checks of the spec.
@@ -340,7 +341,8 @@ DiagnosisResult DiagnoseModel(const Robot& nominal, const Observations& obs,
   auto cv_options = [&](const std::vector<ParamInfo>& free) {
     FreeFitOptions o;
     o.free = free;
-    o.bounds_center = &pb.bounds;
+    o.bounds_center = &pb.nominal;
+    o.bound_override = pb.bound_override;
     o.exact_jacobian = options.exact_jacobian;
     return o;
   };
@@ -518,7 +520,8 @@ DiagnosisResult DiagnoseModel(const Robot& nominal, const Observations& obs,
         if (std::isfinite(step[q]))
           *ParamAddress(&states[c], fo.free[q]) += step[q];
       }
-      fo.bounds_center = &pb.bounds;
+      fo.bounds_center = &pb.nominal;
+      fo.bound_override = pb.bound_override;
       fo.compute_covariance = false;
       fo.max_iterations = 100;
       fo.function_tolerance = 1e-10;
@@ -658,7 +661,8 @@ DiagnosisResult DiagnoseModel(const Robot& nominal, const Observations& obs,
       FitOptions fo;
       fo.free = current_free;
       for (const ParamInfo& q : pool[best].params) fo.free.push_back(q);
-      fo.bounds_center = &pb.bounds;
+      fo.bounds_center = &pb.nominal;
+      fo.bound_override = pb.bound_override;
       fo.compute_covariance = false;
       fo.max_iterations = 100;
       fo.function_tolerance = 1e-10;
@@ -758,7 +762,8 @@ DiagnosisResult DiagnoseModel(const Robot& nominal, const Observations& obs,
   ModelState final_state = current;
   FitOptions fo;
   fo.free = current_free;
-  fo.bounds_center = &pb.bounds;
+  fo.bounds_center = &pb.nominal;
+  fo.bound_override = pb.bound_override;
   fo.compute_covariance = true;
   FitSummary final_fit;
   if (options.exact_jacobian) {
@@ -864,7 +869,8 @@ std::vector<Magnitude> FitCandidates(const Robot& nominal,
   std::vector<bool> found(labels.size(), false);
   FitOptions fo;
   fo.free = pb.base_free;
-  fo.bounds_center = &pb.bounds;
+  fo.bounds_center = &pb.nominal;
+  fo.bound_override = pb.bound_override;
   Eigen::MatrixXd model = basis;
   for (size_t i = 0; i < labels.size(); ++i) {
     for (const Candidate& c : catalogue) {
