@@ -116,6 +116,7 @@ int RunCalibrate(CalibrateArgs args) {
   }
   j["widened_bounds"] = widened;
   j["at_bound"] = r.at_bound;
+  j["prior_weight"] = r.prior_weight;
   j["condition_number"] = Number(id.condition);
   j["parameters"] = ParametersJson(r.fit, [&] {
     ModelState s;
@@ -249,7 +250,8 @@ void AddCalibrateCommand(CLI::App& app, Runner* run) {
       ->capture_default_str();
   sub->add_option("--prior", args->options.prior_weight,
                   "ridge pull of the geometry towards nominal: residual "
-                  "W * deviation / bound, mm-equivalent (0 = none)")
+                  "W * deviation / bound, mm-equivalent (0 = none; default "
+                  "-1: 1 for single-point data, 0 with measured tip points)")
       ->check(CLI::Range(0.0, 1e6))
       ->capture_default_str();
   sub->add_option("--id-passes", args->options.max_identifiability_passes,

@@ -192,7 +192,14 @@ GeometryFit FitGeometry(
   fit.loss = options.loss;
   fit.loss_scale_mm = options.loss_scale_mm;
   fit.distances = distances;
-  fit.prior_weight = options.prior_weight;
+  // The automatic ridge: on for single-point data only.
+  const bool measured = std::any_of(
+      train->begin(), train->end(),
+      [](const Measurement& m) { return m.kind == Measurement::kMeasured; });
+  fit.prior_weight = options.prior_weight >= 0 ? options.prior_weight
+                     : measured                ? 0.0
+                                               : 1.0;
+  g.prior_weight = fit.prior_weight;
   // Least squares for the passes (the seed's eq. (9), --method paper, runs
   // once on the final set, in Calibrate).
   auto lsq_fit = [&](const std::vector<ParamInfo>& free) {
@@ -455,6 +462,7 @@ CalibrateResult Calibrate(const Robot& nominal, const Observations& obs,
   result.passes = g.passes;
   result.fit = g.fit;
   result.widened_bounds = g.widened_bounds;
+  result.prior_weight = g.prior_weight;
   result.at_bound = g.at_bound;
   auto names_of = [](const std::vector<ParamInfo>& ps) {
     std::set<std::string> out;

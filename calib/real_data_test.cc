@@ -375,6 +375,8 @@ TEST(RealDataTest, MukcaPandaTrainedWhereTheAuthorsTrainedPredictsAsTheyDo) {
   CalibrateOptions opt;
   opt.holdout_fraction = 0.0;
   opt.distances.push_back({"hole_0", "hole_1", 50.0});
+  opt.prior_weight = 0.0;  // the least-squares optimum, without the default
+                           // ridge of single-point data
   const CalibrateResult r =
       Calibrate(nominal, ReadMukcaDir(Mukca("data/panda_3/frontcenter")), opt);
   for (const char* test :

@@ -1,6 +1,7 @@
 #include "calib/urdf_export.h"
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <random>
@@ -182,10 +183,16 @@ Robot ConvertToDh(const Robot& robot) {
   const Eigen::Matrix4d tip = BaseFromTipAt(chain, zero);
 
   constexpr double kTol = 1e-9;
+  // Below this sine of the angle between consecutive axes the row takes
+  // Hayati's beta instead of a common normal.
+  constexpr double kNearParallel = 1e-3;
   const Eigen::Vector3d z0 = Eigen::Vector3d::UnitZ();
   const bool prismatic0 = chain.rows[0].type == JointType::kPrismatic;
   const bool on_axis = prismatic0 || origins[0].head<2>().norm() < 1e-7;
-  if (axes[0].dot(z0) < 1.0 - kTol || !on_axis) {
+  // The sine of the tilt, not 1 - cos: a tilt of 4.5e-5 rad passed
+  // 1 - cos < 1e-9 and the conversion, which drops it, was 1.2e-5 mm off.
+  const bool along_z = axes[0].dot(z0) > 0 && axes[0].cross(z0).norm() < kTol;
+  if (!along_z || !on_axis) {
     std::ostringstream msg;
     msg << "robot '" << robot.name << "': standard DH needs joint 1 ("
         << robot.joints[0].name << ") to move about the base z axis"
@@ -216,9 +223,9 @@ Robot ConvertToDh(const Robot& robot) {
     const Eigen::Vector3d w =
         last ? Eigen::Vector3d(tip.block<3, 1>(0, 2)) : axes[k + 1];
     const Eigen::Vector3d c = z.cross(w);
-    double d = 0.0;
-    Eigen::Vector3d xn, on;
-    if (c.norm() > kTol) {  // skew or intersecting: the common normal
+    double d = 0.0, a = 0.0, alpha = 0.0, beta = 0.0;
+    Eigen::Vector3d xn, on, x_next;
+    if (c.norm() > kNearParallel) {  // skew or intersecting: the common normal
       xn = c.normalized();
       // o + t z and p + s w closest: solve the 2x2 normal equations.
       const Eigen::Vector3d r = p - o;
@@ -228,32 +235,39 @@ Robot ConvertToDh(const Robot& robot) {
       const double s = (b * dz - dw) / den;
       d = t;
       on = p + s * w;
-    } else {  // parallel: the normal through o (d = 0)
+      a = (on - (o + d * z)).dot(xn);
+      alpha = std::atan2(z.cross(w).dot(xn), z.dot(w));
+      x_next = xn;
+    } else {
+      // Parallel or nearly so: the common normal runs off to d ~ distance /
+      // angle (a calibrated Panda's tip z against joint 7: d ~ 1e9 mm, the
+      // conversion 1.2e-5 mm off), so Hayati's form: d = 0, the normal in
+      // the plane through o normal to z to where the next line crosses it,
+      // then Rx(alpha) Ry(beta) turn z onto w.
       const Eigen::Vector3d r = p - o;
-      const Eigen::Vector3d v = r - r.dot(z) * z;
-      if (v.norm() > 1e-9) {
-        xn = v.normalized();
-        on = o + v;
-      } else {  // the same line: no offset along the normal
-        xn = x;
-        on = o;
-      }
+      on = p - (r.dot(z) / w.dot(z)) * w;
+      const Eigen::Vector3d v = on - o;  // normal to z
+      xn = v.norm() > 1e-9 ? Eigen::Vector3d(v.normalized()) : x;
+      a = v.dot(xn);
+      const Eigen::Vector3d yn = z.cross(xn);
+      beta = std::asin(std::clamp(w.dot(xn), -1.0, 1.0));
+      alpha = std::atan2(-w.dot(yn), w.dot(z));
+      x_next = std::cos(beta) * xn +
+               std::sin(beta) * (std::sin(alpha) * yn - std::cos(alpha) * z);
     }
-    const double a = (on - (o + d * z)).dot(xn);
     const double theta = std::atan2(x.cross(xn).dot(z), x.dot(xn));
-    const double alpha = std::atan2(z.cross(w).dot(xn), z.dot(w));
     RobotRow row = robot.joints[k];
     row.theta_deg = theta * kRadToDeg;
     row.d_mm = d;
     row.a_mm = a;
     row.alpha_deg = alpha * kRadToDeg;
-    row.beta_deg = 0.0;
+    row.beta_deg = beta * kRadToDeg;
     row.xyz_mm.setZero();
     row.rpy_deg.setZero();
     row.axis = Eigen::Vector3d::UnitZ();
     dh.joints.push_back(row);
     o = on;
-    x = xn;
+    x = x_next;
     z = w;
   }
   // Tool: frame n's z is the tip's z through the tip; Rz(theta) Tz(d).

@@ -156,6 +156,23 @@ TEST(UrdfExportTest, DhConversionBothWays) {
   }
 }
 
+// Consecutive axes 1e-7 rad from parallel (the UR10's shoulder, elbow and
+// wrist-1 axes after a calibration that tilts them a little): the common
+// normal would sit ~1e10 mm away and the conversion lose precision, so the
+// row takes Hayati's beta. The DH model moves the tip as the URDF does.
+TEST(UrdfExportTest, DhConversionOfNearlyParallelAxesUsesBeta) {
+  for (const double tilt_deg : {1e-5, 1e-2, 0.0}) {
+    Robot cal = Bundled("ur10.yaml");
+    cal.joints[1].beta_deg = tilt_deg;
+    cal.joints[2].beta_deg = -0.5 * tilt_deg;
+    const Robot dh = ConvertToDh(RoundTrip(cal));
+    EXPECT_LT(MaxTipDifference(cal, dh), 1e-9) << tilt_deg;
+    for (const RobotRow& row : dh.joints) {
+      EXPECT_LT(std::abs(row.d_mm), 1e4) << row.name << " " << tilt_deg;
+    }
+  }
+}
+
 // Centres of mass in the base frame at random poses (mm), one per row with
 // a mass.
 std::vector<Eigen::Vector3d> MassCentresInBase(const Robot& robot,
