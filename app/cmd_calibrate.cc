@@ -236,11 +236,14 @@ void AddCalibrateCommand(CLI::App& app, Runner* run) {
                   "identifiability threshold (sine of the angle to the span)")
       ->capture_default_str();
   sub->add_option("--bound-length", args->bound_length_mm,
-                  "admissible deviation of lengths from nominal, mm "
-                  "(default: the robot file's bounds, 5 for a URDF)")
+                  "admissible deviation of lengths from nominal, mm, a hard "
+                  "limit (default: the robot file's bounds; a URDF's 20 mm "
+                  "are widened where the data press against them)")
       ->check(CLI::Range(1e-6, 1e4));
   sub->add_option("--bound-angle", args->bound_angle_deg,
-                  "admissible deviation of angles from nominal, deg")
+                  "admissible deviation of angles from nominal, deg, a hard "
+                  "limit (default: the robot file's bounds; a URDF's 10 deg "
+                  "are widened where the data press against them)")
       ->check(CLI::Range(1e-6, 180.0));
   sub->add_option("--max-sigma-fraction",
                   args->options.identifiability.max_sigma_fraction,
