@@ -78,6 +78,25 @@ struct Problem {
   std::vector<Measurement> all, train, held;
   std::vector<ParamInfo> base_free;  // nuisance + identifiable geometry
   ModelState base_state;             // fitted on the training poses
+
+  // A fit of `free` in the geometry's box: nominal +- its bounds, the
+  // widened ones included.
+  FitOptions Boxed(const std::vector<ParamInfo>& free) const {
+    FitOptions fo;
+    fo.free = free;
+    fo.bounds_center = &nominal;
+    fo.bound_override = bound_override;
+    return fo;
+  }
+  // A candidate's refit: the box, no covariance, the refits' tolerances.
+  FitOptions CandidateRefit(const std::vector<ParamInfo>& free) const {
+    FitOptions fo = Boxed(free);
+    fo.compute_covariance = false;
+    fo.max_iterations = 100;
+    fo.function_tolerance = 1e-10;
+    fo.parameter_tolerance = 1e-10;
+    return fo;
+  }
 };
 
 // Frame (and points) registration, then the geometry as `calibrate` fits
@@ -483,9 +502,9 @@ DiagnosisResult DiagnoseModel(const Robot& nominal, const Observations& obs,
         s.train_rms_mm = s.heldout_rms_mm = kNaN;
         return;
       }
-      FitOptions fo;
-      fo.free = screen_free;
-      for (const ParamInfo& q : cand.params) fo.free.push_back(q);
+      std::vector<ParamInfo> refit_free = screen_free;
+      for (const ParamInfo& q : cand.params) refit_free.push_back(q);
+      const FitOptions fo = pb.CandidateRefit(refit_free);
       // Start from the Gauss-Newton step of the linearised joint model, so
       // that the refit needs few iterations: normal equations of [base,
       // candidate columns], Jacobi-scaled.
@@ -520,12 +539,6 @@ DiagnosisResult DiagnoseModel(const Robot& nominal, const Observations& obs,
         if (std::isfinite(step[q]))
           *ParamAddress(&states[c], fo.free[q]) += step[q];
       }
-      fo.bounds_center = &pb.nominal;
-      fo.bound_override = pb.bound_override;
-      fo.compute_covariance = false;
-      fo.max_iterations = 100;
-      fo.function_tolerance = 1e-10;
-      fo.parameter_tolerance = 1e-10;
       // Differentiated in the free parameters only (diagnose/free_fit.h).
       FreeFitOptions ffo = FreeFitOptionsFrom(fo);
       ffo.exact_jacobian = options.exact_jacobian;
@@ -658,15 +671,9 @@ DiagnosisResult DiagnoseModel(const Robot& nominal, const Observations& obs,
       const ModelState screened_state = states[best];
       const CandidateScore screened = scores[best];
       const std::vector<double> screened_cv_err = cv_err[best];
-      FitOptions fo;
-      fo.free = current_free;
-      for (const ParamInfo& q : pool[best].params) fo.free.push_back(q);
-      fo.bounds_center = &pb.nominal;
-      fo.bound_override = pb.bound_override;
-      fo.compute_covariance = false;
-      fo.max_iterations = 100;
-      fo.function_tolerance = 1e-10;
-      fo.parameter_tolerance = 1e-10;
+      std::vector<ParamInfo> refit_free = current_free;
+      for (const ParamInfo& q : pool[best].params) refit_free.push_back(q);
+      const FitOptions fo = pb.CandidateRefit(refit_free);
       if (options.free_parameter_fit) {
         FreeFitOptions ffo = FreeFitOptionsFrom(fo);
         ffo.exact_jacobian = options.exact_jacobian;
@@ -760,10 +767,7 @@ DiagnosisResult DiagnoseModel(const Robot& nominal, const Observations& obs,
 
   // Final model on all poses: magnitudes and 95 % intervals.
   ModelState final_state = current;
-  FitOptions fo;
-  fo.free = current_free;
-  fo.bounds_center = &pb.nominal;
-  fo.bound_override = pb.bound_override;
+  FitOptions fo = pb.Boxed(current_free);
   fo.compute_covariance = true;
   FitSummary final_fit;
   if (options.exact_jacobian) {
@@ -867,10 +871,7 @@ std::vector<Magnitude> FitCandidates(const Robot& nominal,
       Basis(Normalized(ResidualJacobian(pb.all, pb.base_state, pb.base_free)));
   std::vector<Candidate> chosen(labels.size());
   std::vector<bool> found(labels.size(), false);
-  FitOptions fo;
-  fo.free = pb.base_free;
-  fo.bounds_center = &pb.nominal;
-  fo.bound_override = pb.bound_override;
+  FitOptions fo = pb.Boxed(pb.base_free);
   Eigen::MatrixXd model = basis;
   for (size_t i = 0; i < labels.size(); ++i) {
     for (const Candidate& c : catalogue) {
