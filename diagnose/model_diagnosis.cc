@@ -122,15 +122,16 @@ void FitBase(const std::vector<Measurement>& fit_on, const Observations& obs,
   FitOptions frame_only;
   frame_only.free = nuisance;
   frame_only.compute_covariance = false;
+  // The misfit after registering, per axis (calib/fit.h's sigma0).
+  double registered_sigma0 = 0.0;
   if (exact) {
-    FreeFit(fit_on, FreeFitOptionsFrom(frame_only), &state);
+    const double rss = FreeFit(fit_on, FreeFitOptionsFrom(frame_only), &state);
+    registered_sigma0 = std::sqrt(
+        rss / std::max(1.0, 3.0 * fit_on.size() -
+                                static_cast<double>(nuisance.size())));
   } else {
-    Fit(fit_on, frame_only, &state);
+    registered_sigma0 = Fit(fit_on, frame_only, &state).sigma0_mm;
   }
-  const double registered_sigma0 =
-      std::sqrt(Rss(state, fit_on) /
-                std::max(1.0, 3.0 * fit_on.size() -
-                                  static_cast<double>(nuisance.size())));
 
   std::vector<ParamInfo> candidates = nuisance;
   for (const ParamInfo& p : GeometryParams(state.chain))
