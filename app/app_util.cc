@@ -4,6 +4,7 @@
 
 #include <cerrno>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 
 #include "data/error.h"
@@ -61,6 +62,45 @@ nlohmann::json ParametersJson(const FitSummary& fit,
     out.push_back(j);
   }
   return out;
+}
+
+nlohmann::json OutliersJson(const std::vector<RowOutlier>& outliers) {
+  nlohmann::json out = nlohmann::json::array();
+  for (const RowOutlier& o : outliers) {
+    nlohmann::json j = {{"pose", o.pose},
+                        {"row", o.row},
+                        {"error_mm", Number(o.error_mm)},
+                        {"sigmas", Number(o.sigmas)},
+                        {"excluded", o.excluded},
+                        {"heldout", o.heldout}};
+    if (!o.near_point.empty()) {
+      j["near_point"] = o.near_point;
+      j["near_point_mm"] = Number(o.near_point_mm);
+    }
+    out.push_back(j);
+  }
+  return out;
+}
+
+void PrintOutliers(const std::vector<RowOutlier>& outliers,
+                   double axis_sigma_mm, double sigmas) {
+  if (outliers.empty()) return;
+  std::printf(
+      "  %zu row(s) beyond %g robust sigmas (sigma %.4f mm per axis, from "
+      "the median error): gross errors of the data, or poses where the "
+      "model fails\n",
+      outliers.size(), sigmas, axis_sigma_mm);
+  for (const RowOutlier& o : outliers) {
+    std::printf("    %s (data row %d%s): %.3f mm, %.0f sigma, %s",
+                o.pose.c_str(), o.row + 1, o.heldout ? ", held out" : "",
+                o.error_mm, o.sigmas,
+                o.excluded ? "left out" : "kept (too many to leave out)");
+    if (!o.near_point.empty()) {
+      std::printf("; %.3f mm from %s: saved under the wrong label?",
+                  o.near_point_mm, o.near_point.c_str());
+    }
+    std::printf("\n");
+  }
 }
 
 }  // namespace kincal::app

@@ -10,6 +10,7 @@
 
 #include "calib/fit.h"
 #include "calib/identifiability.h"
+#include "calib/outliers.h"
 #include "data/observations.h"
 #include "data/robot.h"
 
@@ -29,6 +30,14 @@ std::string ParamUnit(const ParamInfo& p);
 
 // Per free parameter: name, value, sigma (interface units), nominal.
 nlohmann::json ParametersJson(const FitSummary& fit, const ModelState& nominal);
+
+// Gross-error rows (calib/outliers.h) as a JSON array: pose, row, error_mm,
+// sigmas, excluded, heldout, near_point / near_point_mm when set.
+nlohmann::json OutliersJson(const std::vector<RowOutlier>& outliers);
+
+// The same in words, one line each after a header line; nothing when empty.
+void PrintOutliers(const std::vector<RowOutlier>& outliers,
+                   double axis_sigma_mm, double sigmas);
 
 }  // namespace kincal::app
 

@@ -139,6 +139,11 @@ int RunCalibrate(CalibrateArgs args) {
   }
   if (!r.distance_errors_mm.empty())
     j["distance_errors_mm"] = r.distance_errors_mm;
+  j["outlier_sigmas"] = args.options.outlier_sigmas;
+  j["outlier_axis_sigma_mm"] = Number(r.outlier_axis_sigma_mm);
+  j["outlier_rounds"] = r.outlier_rounds;
+  j["outliers"] = OutliersJson(r.outliers);
+  j["outliers_too_many"] = r.outliers_too_many;
   if (!args.out.empty()) j["out"] = args.out;
   if (args.json) {
     PrintJson(j);
@@ -157,6 +162,13 @@ int RunCalibrate(CalibrateArgs args) {
         "  epsilon (mean distance to the fixed point) %.4f mm, max %.4f, std "
         "%.4f\n",
         r.epsilon.mean_mm, r.epsilon.max_mm, r.epsilon.std_mm);
+  }
+  PrintOutliers(r.outliers, r.outlier_axis_sigma_mm,
+                args.options.outlier_sigmas);
+  if (r.outliers_too_many) {
+    std::printf(
+        "  warning: more rows are beyond the threshold than a fit can spare "
+        "(a quarter, or a fixed point left with < 3): every row was fitted\n");
   }
   std::printf("  %zu identifiable parameters, %zu held at nominal; %s\n",
               id.identifiable.size(), id.unidentifiable.size(),
@@ -261,6 +273,12 @@ void AddCalibrateCommand(CLI::App& app, Runner* run) {
                   "most passes of fit -> identifiability at the solution -> "
                   "fit (1 = decide once, at the start values)")
       ->check(CLI::Range(1, 20))
+      ->capture_default_str();
+  sub->add_option("--outlier-sigma", args->options.outlier_sigmas,
+                  "rows whose error exceeds this many robust sigmas (per "
+                  "axis, from the median error) are gross errors: left out "
+                  "of the fit and listed (0 = keep every row)")
+      ->check(CLI::Range(0.0, 1e6))
       ->capture_default_str();
   sub->add_option("--fixed-distance", args->distances,
                   "known distance between fixed points: A,B,MM (repeatable)");

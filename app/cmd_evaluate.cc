@@ -21,12 +21,55 @@ namespace {
 struct EvaluateArgs {
   std::string robot, obs, residuals, root, tip;
   bool json = false;
+  double outlier_sigmas = kDefaultOutlierSigmas;
 };
+
+// Single-point data: per fixed point, the scatter about its fitted
+// position, and the distances between the fitted points (the model's
+// prediction of a known distance, e.g. two sockets 50 mm apart). Rows
+// flagged in `excluded` (may be empty) are left out of the scatter.
+void AddPointsJson(const ModelState& st, const Observations& obs,
+                   const std::vector<int>& rows,
+                   const std::vector<double>& errors_mm,
+                   const std::vector<char>& excluded, nlohmann::json* j) {
+  if (st.point_labels.empty()) return;
+  nlohmann::json points = nlohmann::json::object();
+  for (size_t k = 0; k < st.point_labels.size(); ++k) {
+    double sum = 0;
+    int n = 0;
+    for (size_t i = 0; i < rows.size(); ++i) {
+      if (!excluded.empty() && excluded[i]) continue;
+      if (obs.rows[rows[i]].fixed_point != st.point_labels[k]) continue;
+      sum += errors_mm[i] * errors_mm[i];
+      ++n;
+    }
+    const auto& p = st.points_in_base[k];
+    points[st.point_labels[k]] = {
+        {"n", n},
+        {"rms_mm", Number(n > 0 ? std::sqrt(sum / n) : NAN)},
+        {"in_base_mm", {p[0], p[1], p[2]}}};
+  }
+  (*j)["fixed_points"] = points;
+  nlohmann::json dist = nlohmann::json::array();
+  for (size_t a = 0; a < st.point_labels.size(); ++a) {
+    for (size_t b = a + 1; b < st.point_labels.size(); ++b) {
+      const auto& pa = st.points_in_base[a];
+      const auto& pb = st.points_in_base[b];
+      const double d = std::sqrt((pa[0] - pb[0]) * (pa[0] - pb[0]) +
+                                 (pa[1] - pb[1]) * (pa[1] - pb[1]) +
+                                 (pa[2] - pb[2]) * (pa[2] - pb[2]));
+      dist.push_back({{"a", st.point_labels[a]},
+                      {"b", st.point_labels[b]},
+                      {"distance_mm", d}});
+    }
+  }
+  (*j)["point_distances"] = dist;
+}
 
 int RunEvaluate(const EvaluateArgs& args) {
   const Robot robot = ReadRobot(args.robot, args.root, args.tip);
   const Observations obs = ReadObservationsCsv(args.obs, robot.JointNames());
-  const EvaluateResult r = Evaluate(robot, obs);
+  const EvaluateResult r = Evaluate(robot, obs, args.outlier_sigmas);
   if (!args.residuals.empty()) {
     std::ostringstream os;
     os << "# written by " << ToolVersion() << ": " << CommandLine() << "\n";
@@ -40,41 +83,14 @@ int RunEvaluate(const EvaluateArgs& args) {
   if (args.json) {
     nlohmann::json j = StatsJson(r.stats);
     j["extensions"] = robot.extensions.size();
-    // Single-point data: per fixed point, the scatter about its fitted
-    // position, and the distances between the fitted points (the model's
-    // prediction of a known distance, e.g. two sockets 50 mm apart).
-    const ModelState& st = r.state;
-    if (!st.point_labels.empty()) {
-      nlohmann::json points = nlohmann::json::object();
-      for (size_t k = 0; k < st.point_labels.size(); ++k) {
-        double sum = 0;
-        int n = 0;
-        for (size_t i = 0; i < r.rows.size(); ++i) {
-          if (obs.rows[r.rows[i]].fixed_point != st.point_labels[k]) continue;
-          sum += r.errors_mm[i] * r.errors_mm[i];
-          ++n;
-        }
-        const auto& p = st.points_in_base[k];
-        points[st.point_labels[k]] = {
-            {"n", n},
-            {"rms_mm", Number(n > 0 ? std::sqrt(sum / n) : NAN)},
-            {"in_base_mm", {p[0], p[1], p[2]}}};
-      }
-      j["fixed_points"] = points;
-      nlohmann::json dist = nlohmann::json::array();
-      for (size_t a = 0; a < st.point_labels.size(); ++a) {
-        for (size_t b = a + 1; b < st.point_labels.size(); ++b) {
-          const auto& pa = st.points_in_base[a];
-          const auto& pb = st.points_in_base[b];
-          const double d = std::sqrt((pa[0] - pb[0]) * (pa[0] - pb[0]) +
-                                     (pa[1] - pb[1]) * (pa[1] - pb[1]) +
-                                     (pa[2] - pb[2]) * (pa[2] - pb[2]));
-          dist.push_back({{"a", st.point_labels[a]},
-                          {"b", st.point_labels[b]},
-                          {"distance_mm", d}});
-        }
-      }
-      j["point_distances"] = dist;
+    AddPointsJson(r.state, obs, r.rows, r.errors_mm, {}, &j);
+    j["outlier_sigmas"] = args.outlier_sigmas;
+    j["outliers"] = OutliersJson(r.outliers);
+    if (r.has_robust) {
+      nlohmann::json w = StatsJson(r.robust.stats);
+      AddPointsJson(r.robust.state, obs, r.rows, r.robust.errors_mm, r.excluded,
+                    &w);
+      j["without_outliers"] = w;
     }
     PrintJson(j);
     return 0;
@@ -82,6 +98,18 @@ int RunEvaluate(const EvaluateArgs& args) {
   std::printf("kincal evaluate: %d poses, frame registered only\n", r.stats.n);
   std::printf("  RMS %.4f mm, mean %.4f, max %.4f, std %.4f\n", r.stats.rms_mm,
               r.stats.mean_mm, r.stats.max_mm, r.stats.std_mm);
+  if (!r.outliers.empty()) {
+    const double sigma =
+        r.outliers.front().error_mm / r.outliers.front().sigmas;
+    PrintOutliers(r.outliers, sigma, args.outlier_sigmas);
+  }
+  if (r.has_robust) {
+    const ErrorStats& w = r.robust.stats;
+    std::printf(
+        "  without them (frame registered on the other %d): RMS %.4f mm, "
+        "mean %.4f, max %.4f, std %.4f\n",
+        w.n, w.rms_mm, w.mean_mm, w.max_mm, w.std_mm);
+  }
   return 0;
 }
 
@@ -100,6 +128,12 @@ void AddEvaluateCommand(CLI::App& app, Runner* run) {
   sub->add_option("--obs", args->obs, "observations.csv")->required();
   sub->add_option("--residuals", args->residuals,
                   "write per-pose errors to this CSV");
+  sub->add_option("--outlier-sigma", args->outlier_sigmas,
+                  "list rows whose error exceeds this many robust sigmas "
+                  "(per axis, from the median error) and add the figures "
+                  "without them (0 = none)")
+      ->check(CLI::Range(0.0, 1e6))
+      ->capture_default_str();
   sub->add_flag("--json", args->json, "print one JSON object");
   sub->footer(
       "Example: the calibrated model on new poses:\n  kincal evaluate --robot "

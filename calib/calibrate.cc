@@ -362,51 +362,26 @@ GeometryFit FitGeometry(
   return g;
 }
 
-CalibrateResult Calibrate(const Robot& nominal, const Observations& obs,
-                          const CalibrateOptions& options) {
-  const auto start = std::chrono::steady_clock::now();
-  Require(options.holdout_fraction >= 0 && options.holdout_fraction < 0.9,
-          "--holdout must be in [0, 0.9)");
-  Require(options.distance_weight > 0 && std::isfinite(options.distance_weight),
-          "--distance-weight must be positive and finite");
-  CalibrateResult result;
-  result.method =
-      options.method == CalibrateOptions::kPaper ? "paper" : "least_squares";
-  const Chain nominal_chain = Chain::FromRobot(nominal);
-  ModelState& state = result.state;
-  state.chain = nominal_chain;
-  std::vector<Measurement> all = MakeMeasurements(nominal_chain, obs, &state);
-  if (all.empty()) {
-    throw InputError(obs.source, 0, 0,
-                     "no row has a measured tip (x, y, z) or a fixed_point "
-                     "label: nothing to calibrate against");
-  }
-  const int distinct = DistinctPoses(all);
-  if (distinct < 2) {
-    throw InputError(obs.source, 0, 0,
-                     "all " + std::to_string(all.size()) +
-                         " usable rows have the same joint readings: one pose "
-                         "determines no robot parameter");
-  }
-  std::vector<PointDistance> distances;
-  for (const FixedDistance& d : options.distances) {
-    PointDistance pd;
-    pd.a = state.PointIndex(d.a);
-    pd.b = state.PointIndex(d.b);
-    if (pd.a < 0 || pd.b < 0) {
-      throw InputError("--fixed-distance " + d.a + "," + d.b +
-                       ": no fixed_point label '" + (pd.a < 0 ? d.a : d.b) +
-                       "' in " + obs.source);
-    }
-    pd.distance_mm = d.distance_mm;
-    pd.weight = options.distance_weight;
-    distances.push_back(pd);
-  }
+namespace {
 
-  SplitHoldout(all, options.holdout_fraction, options.seed, &result.train_rows,
-               &result.heldout_rows);
-  std::vector<Measurement> train = Pick(all, result.train_rows);
-  std::vector<Measurement> held = Pick(all, result.heldout_rows);
+// Rounds of fit -> flag gross errors -> refit without them.
+constexpr int kMaxOutlierRounds = 6;
+
+// One calibration of `train` from the nominal model (state on entry: the
+// nominal chain and the fixed points' labels): register the frame / points,
+// fit the geometry (FitGeometry) or the seed's objective. `others` get their
+// joint-error inputs from the fitted geometry.
+void CalibrateOn(const Observations& obs, const Chain& nominal_chain,
+                 bool bounds_stated, int distinct,
+                 const std::vector<PointDistance>& distances,
+                 const CalibrateOptions& options,
+                 std::vector<Measurement>* train_rows,
+                 std::vector<Measurement>* others, CalibrateResult* out) {
+  CalibrateResult& result = *out;
+  ModelState& state = result.state;
+  std::vector<Measurement>& train = *train_rows;
+  result.freed.clear();
+  result.held.clear();
   InitializeFrameAndPoints(train, &state);
 
   const bool any_measured = std::any_of(
@@ -455,9 +430,9 @@ CalibrateResult Calibrate(const Robot& nominal, const Observations& obs,
                            " distinct training poses (more for a useful fit)");
     }
   };
-  GeometryFit g = FitGeometry(obs, nominal_chain, nominal.bounds_stated,
-                              candidates, registered.sigma0_mm, distances,
-                              options, check, &train, &held, &state);
+  GeometryFit g = FitGeometry(obs, nominal_chain, bounds_stated, candidates,
+                              registered.sigma0_mm, distances, options, check,
+                              &train, others, &state);
   result.identifiability = g.identifiability;
   result.passes = g.passes;
   result.fit = g.fit;
@@ -492,7 +467,152 @@ CalibrateResult Calibrate(const Robot& nominal, const Observations& obs,
         "the fit ended in a non-finite state (NaN or infinity): the data or "
         "the model carry values out of any physical range");
   }
+}
 
+}  // namespace
+
+CalibrateResult Calibrate(const Robot& nominal, const Observations& obs,
+                          const CalibrateOptions& options) {
+  const auto start = std::chrono::steady_clock::now();
+  Require(options.holdout_fraction >= 0 && options.holdout_fraction < 0.9,
+          "--holdout must be in [0, 0.9)");
+  Require(options.distance_weight > 0 && std::isfinite(options.distance_weight),
+          "--distance-weight must be positive and finite");
+  CalibrateResult result;
+  result.method =
+      options.method == CalibrateOptions::kPaper ? "paper" : "least_squares";
+  const Chain nominal_chain = Chain::FromRobot(nominal);
+  ModelState& state = result.state;
+  state.chain = nominal_chain;
+  std::vector<Measurement> all = MakeMeasurements(nominal_chain, obs, &state);
+  if (all.empty()) {
+    throw InputError(obs.source, 0, 0,
+                     "no row has a measured tip (x, y, z) or a fixed_point "
+                     "label: nothing to calibrate against");
+  }
+  const int distinct = DistinctPoses(all);
+  if (distinct < 2) {
+    throw InputError(obs.source, 0, 0,
+                     "all " + std::to_string(all.size()) +
+                         " usable rows have the same joint readings: one pose "
+                         "determines no robot parameter");
+  }
+  std::vector<PointDistance> distances;
+  for (const FixedDistance& d : options.distances) {
+    PointDistance pd;
+    pd.a = state.PointIndex(d.a);
+    pd.b = state.PointIndex(d.b);
+    if (pd.a < 0 || pd.b < 0) {
+      throw InputError("--fixed-distance " + d.a + "," + d.b +
+                       ": no fixed_point label '" + (pd.a < 0 ? d.a : d.b) +
+                       "' in " + obs.source);
+    }
+    pd.distance_mm = d.distance_mm;
+    pd.weight = options.distance_weight;
+    distances.push_back(pd);
+  }
+
+  SplitHoldout(all, options.holdout_fraction, options.seed, &result.train_rows,
+               &result.heldout_rows);
+  const std::vector<Measurement> all_train = Pick(all, result.train_rows);
+  std::vector<Measurement> train, held;
+  const ModelState initial = state;
+
+  // Gross errors (calib/outliers.h): fit without the rows flagged, flag the
+  // training rows beyond options.outlier_sigmas robust sigmas of the fitted
+  // model, refit from the nominal model, until the flagged set is stable. A
+  // row flagged in one round may come back in the next.
+  // The first set from the nominal model with only the frame / points
+  // registered (robustly: calib/outliers.h FindGrossErrors), at half the
+  // threshold: the nominal model's own error widens the scale (MUKCa Panda:
+  // 8.5 mm median, so a row saved under the socket 50 mm away is only ~9
+  // sigma there; 550 after calibration). The rounds below readmit any row
+  // the calibrated model fits.
+  std::vector<char> excluded(all_train.size(), 0);
+  if (options.outlier_sigmas > 0) {
+    excluded = FindGrossErrors(initial, all_train, 0.5 * options.outlier_sigmas,
+                               nullptr, nullptr);
+  }
+  std::vector<double> train_norms;
+  double axis_sigma = 0.0;
+  for (int round = 1;; ++round) {
+    result.outlier_rounds = round;
+    state = initial;
+    train.clear();
+    // The rows out of the fit ride along with the held-out ones so that
+    // their joint-error inputs follow the fitted geometry too.
+    std::vector<Measurement> others = Pick(all, result.heldout_rows);
+    std::vector<int> out_index;
+    for (size_t i = 0; i < all_train.size(); ++i) {
+      if (excluded[i]) {
+        out_index.push_back(static_cast<int>(i));
+        others.push_back(all_train[i]);
+      } else {
+        train.push_back(all_train[i]);
+      }
+    }
+    CalibrateOn(obs, nominal_chain, nominal.bounds_stated, distinct, distances,
+                options, &train, &others, &result);
+    held.assign(others.begin(),
+                others.begin() + static_cast<long>(result.heldout_rows.size()));
+    // Every training row's error under this round's model.
+    std::vector<Measurement> rows = train;
+    rows.insert(rows.end(), others.begin() + static_cast<long>(held.size()),
+                others.end());
+    std::vector<double> norms = Norms(state, rows);
+    train_norms.assign(all_train.size(), 0.0);
+    {
+      size_t k = 0;
+      for (size_t i = 0; i < all_train.size(); ++i)
+        if (!excluded[i]) train_norms[i] = norms[k++];
+      for (int i : out_index) train_norms[i] = norms[k++];
+    }
+    // The scale from the rows fitted, robust to those left in.
+    std::vector<double> fitted_norms;
+    for (size_t i = 0; i < all_train.size(); ++i)
+      if (!excluded[i]) fitted_norms.push_back(train_norms[i]);
+    axis_sigma = RobustAxisSigmaMm(fitted_norms);
+    const std::vector<char> flags =
+        FlagGross(train_norms, axis_sigma, options.outlier_sigmas);
+    if (flags == excluded) break;
+    if (!CanExclude(all_train, flags)) {
+      result.outliers_too_many = true;
+      break;
+    }
+    if (round >= kMaxOutlierRounds) break;
+    excluded = flags;
+  }
+  result.outlier_axis_sigma_mm = axis_sigma;
+  for (size_t i = 0; i < all_train.size(); ++i) {
+    const bool gross = train_norms[i] > options.outlier_sigmas * axis_sigma;
+    if (!excluded[i] && !(options.outlier_sigmas > 0 && gross)) continue;
+    RowOutlier o =
+        DescribeOutlier(state, all_train[i], obs.rows[all_train[i].row].pose,
+                        train_norms[i], axis_sigma, options.outlier_sigmas);
+    o.excluded = excluded[i] != 0;
+    result.outliers.push_back(o);
+  }
+  // Held-out rows beyond the same threshold are listed and left out of the
+  // held-out figures, as the training ones.
+  {
+    std::vector<Measurement> kept;
+    const std::vector<double> norms = Norms(state, held);
+    const std::vector<char> flags =
+        FlagGross(norms, axis_sigma, options.outlier_sigmas);
+    for (size_t i = 0; i < held.size(); ++i) {
+      if (!flags[i]) {
+        kept.push_back(held[i]);
+        continue;
+      }
+      RowOutlier o =
+          DescribeOutlier(state, held[i], obs.rows[held[i].row].pose, norms[i],
+                          axis_sigma, options.outlier_sigmas);
+      o.heldout = true;
+      o.excluded = true;
+      result.outliers.push_back(o);
+    }
+    held = kept;
+  }
   result.train = ComputeErrorStats(Norms(state, train));
   result.heldout = ComputeErrorStats(Norms(state, held));
   for (size_t i = 0; i < distances.size(); ++i) {

@@ -15,6 +15,7 @@
 #include "calib/fit.h"
 #include "calib/identifiability.h"
 #include "calib/model_state.h"
+#include "calib/outliers.h"
 #include "data/observations.h"
 #include "data/robot.h"
 
@@ -65,6 +66,12 @@ struct CalibrateOptions {
   // after registering the frame, exceeds IdentifiabilityOptions::
   // max_sigma_fraction of their admissible range. 0 = sine test only.
   double first_look_noise_fraction = 0.1;
+  // Training rows whose error exceeds this many robust sigmas (per axis,
+  // from the median error) are gross errors: left out of the fit, which is
+  // repeated from the nominal model until the set is stable, and listed
+  // (calib/outliers.h). Held-out rows beyond it are listed and left out of
+  // the held-out figures. 0 = keep every row.
+  double outlier_sigmas = kDefaultOutlierSigmas;
 };
 
 // One pass of fit -> identifiability: parameters that entered (freed) or
@@ -106,6 +113,14 @@ struct CalibrateResult {
   double seconds = 0.0;
   std::string method;
   double prior_weight = 0.0;  // the ridge weight used
+  // Gross errors (CalibrateOptions::outlier_sigmas): the rows beyond the
+  // threshold, the robust per-axis sigma of the fitted rows (mm), the
+  // rounds of fit -> flag -> refit run, and whether more rows than a fit
+  // can spare were beyond it (then none is left out).
+  std::vector<RowOutlier> outliers;
+  double outlier_axis_sigma_mm = 0.0;
+  int outlier_rounds = 1;
+  bool outliers_too_many = false;
 };
 
 CalibrateResult Calibrate(const Robot& nominal, const Observations& obs,

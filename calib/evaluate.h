@@ -9,19 +9,44 @@
 
 #include "calib/fit.h"
 #include "calib/model_state.h"
+#include "calib/outliers.h"
 #include "data/observations.h"
 #include "data/robot.h"
 
 namespace kincal {
 
+// The frame / points registered on a set of rows, and every row's error.
+struct Registration {
+  ErrorStats stats;               // over the rows registered on
+  std::vector<double> errors_mm;  // per usable row (all of them)
+  ModelState state;               // with the registered frame / points
+};
+
+// Registers the frame / fixed points on the rows not `excluded` (same size
+// as `ms`), from `start`'s chain and point labels, and computes every row's
+// error.
+Registration Register(const ModelState& start,
+                      const std::vector<Measurement>& ms,
+                      const std::vector<char>& excluded);
+
 struct EvaluateResult {
+  // Registered on every usable row: the figures the spec names.
   ErrorStats stats;
   std::vector<double> errors_mm;  // per usable row
   std::vector<int> rows;          // their indices in the observations
   ModelState state;               // with the registered frame
+  // Gross errors (calib/outliers.h FindGrossErrors): rows beyond
+  // `outlier_sigmas` robust sigmas. When there are any (and few enough to
+  // leave out), `robust` is the registration without them, its stats over
+  // the other rows.
+  std::vector<RowOutlier> outliers;
+  bool has_robust = false;
+  Registration robust;
+  std::vector<char> excluded;  // per usable row, in `robust`
 };
 
-EvaluateResult Evaluate(const Robot& robot, const Observations& obs);
+EvaluateResult Evaluate(const Robot& robot, const Observations& obs,
+                        double outlier_sigmas = kDefaultOutlierSigmas);
 
 }  // namespace kincal
 

@@ -88,6 +88,66 @@ TEST_F(CliTest, CalibrateJsonContract) {
             5 * e["rms_mm"].get<double>());
 }
 
+// Gross errors through the command line: three rows' x moved by 15 mm are
+// listed (JSON `outliers`, text "left out") and left out of the fit;
+// evaluate (of the calibrated model) lists them and adds `without_outliers`,
+// keeping the spec's figures over every row.
+TEST_F(CliTest, GrossRowsAreListedAndLeftOut) {
+  std::istringstream in(ReadFile(Obs()));
+  std::ostringstream out;
+  std::string line;
+  int data_row = 0;
+  while (std::getline(in, line)) {
+    if (!line.empty() && line[0] != '#' && line.rfind("pose,", 0) != 0) {
+      if (data_row == 10 || data_row == 50 || data_row == 90) {
+        // pose,j1..j5,x,...: x is the 7th field.
+        std::vector<std::string> f;
+        std::istringstream fields(line);
+        std::string v;
+        while (std::getline(fields, v, ',')) f.push_back(v);
+        f[6] = std::to_string(std::stod(f[6]) + 15.0);
+        line.clear();
+        for (size_t k = 0; k < f.size(); ++k) line += (k ? "," : "") + f[k];
+      }
+      ++data_row;
+    }
+    out << line << "\n";
+  }
+  const std::string bad = Dir() + "/gross.csv";
+  WriteText(bad, out.str());
+  const std::string cal = Dir() + "/gross_cal.yaml";
+  const RunResult r = RunKincal("calibrate --robot " + Robot() + " --obs " +
+                                bad + " --holdout 0 --out " + cal + " --json");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  std::vector<std::string> poses;
+  for (const auto& o : j["outliers"]) {
+    poses.push_back(o["pose"].get<std::string>());
+    EXPECT_TRUE(o["excluded"].get<bool>());
+    EXPECT_GT(o["sigmas"].get<double>(), 10.0);
+  }
+  EXPECT_THAT(poses, ::testing::UnorderedElementsAre("10", "50", "90"));
+  EXPECT_LT(j["train_rms_mm"].get<double>(), 0.07);
+  EXPECT_EQ(j["train"]["n"].get<int>(), 117);
+  const RunResult text =
+      RunKincal("calibrate --robot " + Robot() + " --obs " + bad);
+  EXPECT_THAT(text.out, HasSubstr("3 row(s) beyond 10 robust sigmas"));
+  EXPECT_THAT(text.out, HasSubstr("left out"));
+  const RunResult ev =
+      RunKincal("evaluate --robot " + cal + " --obs " + bad + " --json");
+  ASSERT_EQ(ev.exit_code, 0) << ev.err;
+  const auto e = nlohmann::json::parse(ev.out);
+  EXPECT_EQ(e["n"].get<int>(), 120);
+  EXPECT_EQ(e["outliers"].size(), 3u);
+  EXPECT_EQ(e["without_outliers"]["n"].get<int>(), 117);
+  const RunResult keep =
+      RunKincal("calibrate --robot " + Robot() + " --obs " + bad +
+                " --holdout 0 --outlier-sigma 0 --json");
+  const auto k = nlohmann::json::parse(keep.out);
+  EXPECT_TRUE(k["outliers"].empty());
+  EXPECT_GT(k["train_rms_mm"].get<double>(), 1.0);
+}
+
 // Subcommand names listed under "Subcommands:" in a --help text.
 std::vector<std::string> SubcommandsOf(const std::string& help) {
   std::vector<std::string> names;
