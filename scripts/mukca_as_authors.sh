@@ -14,10 +14,17 @@ W=$(mktemp -d)
 trap 'rm -rf "$W"' EXIT
 . "$(dirname "$0")/mukca_common.sh"
 printf "robot\ttrain\ttest\tkincal_rms\tkincal_h0\tkincal_h1\tkincal_dist_err\tauthors_rms\tauthors_h0\tauthors_h1\tauthors_dist_err\tkincal_train_rms\tfree\tpasses\n"
-# model  training recording  robots whose recordings are tested
-for spec in "panda_2 panda_2_clean/front_center panda_2_clean" \
-  "panda_3 panda_3/frontcenter panda_3 panda_3_bis" \
-  "panda_4 panda_4_clean/front panda_4_clean" "panda_6 panda_6/front panda_6"; do
+# model  training recording  robots whose recordings are tested; SPECS (one
+# spec per line) replaces them, e.g. for a copy of the authors' repository
+# with more robots: SPECS="panda_7 panda_7/front panda_7" (their
+# calibrated_urdf/panda_7/config.yaml names the training recording).
+DEFAULT_SPECS="panda_2 panda_2_clean/front_center panda_2_clean
+panda_3 panda_3/frontcenter panda_3 panda_3_bis
+panda_4 panda_4_clean/front panda_4_clean
+panda_6 panda_6/front panda_6"
+mapfile -t specs <<<"${SPECS:-$DEFAULT_SPECS}"
+for spec in "${specs[@]}"; do
+  [ -z "$spec" ] && continue
   set -- $spec
   model=$1 train=$2
   shift 2
