@@ -330,6 +330,29 @@ ReportResult BuildReport(
       << " others are redundant with them or the frame and stay at nominal "
          "(see Identifiability).";
     verdict.push_back(s.str());
+    if (!calres.outliers.empty()) {
+      // Gross errors (calib/outliers.h): named in words, the poses first.
+      std::ostringstream g;
+      g << calres.outliers.size() << " row(s) are more than "
+        << Fmt(kDefaultOutlierSigmas, 2) << " robust sigmas ("
+        << Fmt(calres.outlier_axis_sigma_mm, 3)
+        << " mm per axis) off the calibrated model";
+      g << (calres.outliers_too_many ? " and were kept (too many to leave out)"
+                                     : " and were left out of the fit");
+      g << ":";
+      for (size_t i = 0; i < calres.outliers.size() && i < 10; ++i) {
+        const RowOutlier& o = calres.outliers[i];
+        g << (i ? ";" : "") << " pose " << o.pose << ": " << Fmt(o.error_mm, 3)
+          << " mm";
+        if (!o.near_point.empty()) {
+          g << " (" << Fmt(o.near_point_mm, 3) << " mm from " << o.near_point
+            << ": saved under the wrong label?)";
+        }
+      }
+      if (calres.outliers.size() > 10) g << "; ...";
+      g << ". Check these rows of the data.";
+      verdict.push_back(g.str());
+    }
   }
   if (has_ext) {
     verdict.push_back("The extended model (" + opt.calibrated + ", " +

@@ -146,6 +146,30 @@ TEST(ReportCliTest, SectionsAppearOnlyWithTheirInputs) {
   EXPECT_EQ(sec, (std::vector<std::string>{"verdict", "provenance"}));
 }
 
+// Gross rows in the data are named in the verdict, in words, with poses.
+TEST(ReportCliTest, VerdictNamesGrossRows) {
+  const std::string dir = testing::MakeTempDir("report_gross");
+  const std::string robot = testing::SourceDir() + "/data/robots/bh7.yaml";
+  ASSERT_EQ(RunKincal("simulate --robot " + robot + " --out " + dir +
+                      "/s --poses 120 --seed 6 --json")
+                .exit_code,
+            0);
+  // x (7th column) of data rows 11 and 51 (poses 10 and 50) moved 20 mm.
+  ASSERT_EQ(RunShell("awk -F, 'BEGIN{OFS=\",\"} /^[0-9]/{n++; if(n==11||"
+                     "n==51) $7=$7+20} {print}' " +
+                     dir + "/s/observations.csv > " + dir + "/gross.csv")
+                .exit_code,
+            0);
+  const auto r = RunKincal("report --robot " + robot + " --obs " + dir +
+                           "/gross.csv --out " + dir + "/r.html --json");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const std::string html = ReadFile(dir + "/r.html");
+  EXPECT_THAT(html, HasSubstr("2 row(s) are more than 10 robust sigmas"));
+  EXPECT_THAT(html, HasSubstr("left out of the fit"));
+  EXPECT_THAT(html, HasSubstr("pose 10: "));
+  EXPECT_THAT(html, HasSubstr("pose 50: "));
+}
+
 TEST(ReportCliTest, BadInputExitsTwoAndWritesNothing) {
   const std::string dir = testing::MakeTempDir("report_bad");
   std::ofstream(dir + "/diag.json") << "{\"verdict\": 3";
