@@ -168,7 +168,8 @@ int RunCalibrate(CalibrateArgs args) {
   if (r.outliers_too_many) {
     std::printf(
         "  warning: more rows are beyond the threshold than a fit can spare "
-        "(a quarter, or a fixed point left with < 3): every row was fitted\n");
+        "(a quarter, or a fixed point left with < 3): those listed as kept "
+        "are in the figures; the model may be wrong rather than the rows\n");
   }
   std::printf("  %zu identifiable parameters, %zu held at nominal; %s\n",
               id.identifiable.size(), id.unidentifiable.size(),

@@ -593,24 +593,27 @@ CalibrateResult Calibrate(const Robot& nominal, const Observations& obs,
     result.outliers.push_back(o);
   }
   // Held-out rows beyond the same threshold are listed and left out of the
-  // held-out figures, as the training ones.
+  // held-out figures, as the training ones; unless more than a quarter are
+  // (a model that predicts badly, not gross rows: all are kept, so the
+  // held-out figures cannot flatter it).
   {
     std::vector<Measurement> kept;
     const std::vector<double> norms = Norms(state, held);
     const std::vector<char> flags =
         FlagGross(norms, axis_sigma, options.outlier_sigmas);
+    const size_t flagged = std::count(flags.begin(), flags.end(), 1);
+    const bool leave_out = 4 * flagged <= held.size();
     for (size_t i = 0; i < held.size(); ++i) {
-      if (!flags[i]) {
-        kept.push_back(held[i]);
-        continue;
-      }
+      if (!flags[i] || !leave_out) kept.push_back(held[i]);
+      if (!flags[i]) continue;
       RowOutlier o =
           DescribeOutlier(state, held[i], obs.rows[held[i].row].pose, norms[i],
                           axis_sigma, options.outlier_sigmas);
       o.heldout = true;
-      o.excluded = true;
+      o.excluded = leave_out;
       result.outliers.push_back(o);
     }
+    if (!leave_out) result.outliers_too_many = true;
     held = kept;
   }
   result.train = ComputeErrorStats(Norms(state, train));

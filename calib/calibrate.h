@@ -116,7 +116,7 @@ struct CalibrateResult {
   // Gross errors (CalibrateOptions::outlier_sigmas): the rows beyond the
   // threshold, the robust per-axis sigma of the fitted rows (mm), the
   // rounds of fit -> flag -> refit run, and whether more rows than a fit
-  // can spare were beyond it (then none is left out).
+  // can spare were beyond it (training or held-out; those are kept).
   std::vector<RowOutlier> outliers;
   double outlier_axis_sigma_mm = 0.0;
   int outlier_rounds = 1;

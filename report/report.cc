@@ -337,13 +337,16 @@ ReportResult BuildReport(
         << Fmt(kDefaultOutlierSigmas, 2) << " robust sigmas ("
         << Fmt(calres.outlier_axis_sigma_mm, 3)
         << " mm per axis) off the calibrated model";
-      g << (calres.outliers_too_many ? " and were kept (too many to leave out)"
-                                     : " and were left out of the fit");
+      g << (calres.outliers_too_many
+                ? " (too many to leave them all out: the model may be wrong "
+                  "rather than the rows)"
+                : " and were left out of the fit");
       g << ":";
       for (size_t i = 0; i < calres.outliers.size() && i < 10; ++i) {
         const RowOutlier& o = calres.outliers[i];
         g << (i ? ";" : "") << " pose " << o.pose << ": " << Fmt(o.error_mm, 3)
-          << " mm";
+          << " mm" << (o.heldout ? ", held out" : "")
+          << (o.excluded ? "" : ", kept");
         if (!o.near_point.empty()) {
           g << " (" << Fmt(o.near_point_mm, 3) << " mm from " << o.near_point
             << ": saved under the wrong label?)";
