@@ -87,6 +87,7 @@ int RunEvaluate(const EvaluateArgs& args) {
     j["outlier_sigmas"] = args.outlier_sigmas;
     j["outliers"] = OutliersJson(r.outliers);
     if (r.has_robust) {
+      j["outlier_axis_sigma_mm"] = Number(r.outlier_axis_sigma_mm);
       nlohmann::json w = StatsJson(r.robust.stats);
       AddPointsJson(r.robust.state, obs, r.rows, r.robust.errors_mm, r.excluded,
                     &w);
@@ -98,11 +99,7 @@ int RunEvaluate(const EvaluateArgs& args) {
   std::printf("kincal evaluate: %d poses, frame registered only\n", r.stats.n);
   std::printf("  RMS %.4f mm, mean %.4f, max %.4f, std %.4f\n", r.stats.rms_mm,
               r.stats.mean_mm, r.stats.max_mm, r.stats.std_mm);
-  if (!r.outliers.empty()) {
-    const double sigma =
-        r.outliers.front().error_mm / r.outliers.front().sigmas;
-    PrintOutliers(r.outliers, sigma, args.outlier_sigmas);
-  }
+  PrintOutliers(r.outliers, r.outlier_axis_sigma_mm, args.outlier_sigmas);
   if (r.has_robust) {
     const ErrorStats& w = r.robust.stats;
     std::printf(

@@ -60,6 +60,7 @@ EvaluateResult Evaluate(const Robot& robot, const Observations& obs,
   for (size_t i = 0; i < ms.size(); ++i)
     if (!excluded[i]) kept.push_back(out.robust.errors_mm[i]);
   const double sigma = RobustAxisSigmaMm(kept);
+  out.outlier_axis_sigma_mm = sigma;
   for (size_t i = 0; i < ms.size(); ++i) {
     if (!excluded[i]) continue;
     RowOutlier o =

@@ -40,6 +40,7 @@ struct EvaluateResult {
   // leave out), `robust` is the registration without them, its stats over
   // the other rows.
   std::vector<RowOutlier> outliers;
+  double outlier_axis_sigma_mm = 0.0;  // of the rows kept in `robust`
   bool has_robust = false;
   Registration robust;
   std::vector<char> excluded;  // per usable row, in `robust`
