@@ -148,6 +148,44 @@ TEST(OutliersTest, RowsSavedUnderAnotherFixedPointAreNamed) {
               0.1 * clean.epsilon.mean_mm);
 }
 
+// Held-out rows beyond the threshold are left out of the held-out figures
+// only while they are at most a quarter of them; more (a model predicting
+// badly looks the same) stay in, listed as kept.
+TEST(OutliersTest, HeldOutRowsLeftOutOnlyWhileFew) {
+  SimulateOptions opt;
+  opt.poses = 200;
+  opt.noise_mm = 0.03;
+  opt.seed = 11;
+  const SimulatedSession s = Simulate(RobotFile("bh7.yaml"), opt);
+  const CalibrateOptions defaults;
+  ModelState state;
+  const std::vector<Measurement> ms =
+      MakeMeasurements(Chain::FromRobot(s.nominal), s.observations, &state);
+  std::vector<int> train, held;
+  SplitHoldout(ms, defaults.holdout_fraction, defaults.seed, &train, &held);
+  ASSERT_EQ(held.size(), 40u);
+  for (const int corrupt : {5, 15}) {
+    Observations bad = s.observations;
+    for (int k = 0; k < corrupt; ++k)
+      bad.rows[ms[held[k]].row].p_in_meas.x() += 5.0;
+    const CalibrateResult r = Calibrate(s.nominal, bad, defaults);
+    int listed = 0;
+    for (const RowOutlier& o : r.outliers) {
+      EXPECT_TRUE(o.heldout) << o.pose;
+      EXPECT_EQ(o.excluded, corrupt == 5) << o.pose;
+      ++listed;
+    }
+    EXPECT_EQ(listed, corrupt);
+    EXPECT_EQ(r.outliers_too_many, corrupt == 15);
+    EXPECT_EQ(r.heldout.n, corrupt == 5 ? 35 : 40);
+    if (corrupt == 15) {
+      EXPECT_GT(r.heldout.rms_mm, 2.0);
+    } else {
+      EXPECT_LT(r.heldout.rms_mm, 0.1);
+    }
+  }
+}
+
 // No false alarms on clean sessions: seeds x robots x noise.
 TEST(OutliersTest, CleanSessionsListNoRow) {
   int sessions = 0;
