@@ -530,8 +530,8 @@ CalibrateResult Calibrate(const Robot& nominal, const Observations& obs,
   // the calibrated model fits.
   std::vector<char> excluded(all_train.size(), 0);
   if (options.outlier_sigmas > 0) {
-    excluded = FindGrossErrors(initial, all_train, 0.5 * options.outlier_sigmas,
-                               nullptr, nullptr);
+    excluded =
+        FindGrossErrors(initial, all_train, 0.5 * options.outlier_sigmas);
   }
   std::vector<double> train_norms;
   double axis_sigma = 0.0;
@@ -542,36 +542,22 @@ CalibrateResult Calibrate(const Robot& nominal, const Observations& obs,
     // The rows out of the fit ride along with the held-out ones so that
     // their joint-error inputs follow the fitted geometry too.
     std::vector<Measurement> others = Pick(all, result.heldout_rows);
-    std::vector<int> out_index;
-    for (size_t i = 0; i < all_train.size(); ++i) {
-      if (excluded[i]) {
-        out_index.push_back(static_cast<int>(i));
-        others.push_back(all_train[i]);
-      } else {
-        train.push_back(all_train[i]);
-      }
-    }
+    for (size_t i = 0; i < all_train.size(); ++i)
+      (excluded[i] ? others : train).push_back(all_train[i]);
     CalibrateOn(obs, nominal_chain, nominal.bounds_stated, distinct, distances,
                 options, &train, &others, &result);
-    held.assign(others.begin(),
-                others.begin() + static_cast<long>(result.heldout_rows.size()));
-    // Every training row's error under this round's model.
-    std::vector<Measurement> rows = train;
-    rows.insert(rows.end(), others.begin() + static_cast<long>(held.size()),
-                others.end());
-    std::vector<double> norms = Norms(state, rows);
-    train_norms.assign(all_train.size(), 0.0);
-    {
-      size_t k = 0;
-      for (size_t i = 0; i < all_train.size(); ++i)
-        if (!excluded[i]) train_norms[i] = norms[k++];
-      for (int i : out_index) train_norms[i] = norms[k++];
+    const size_t num_held = result.heldout_rows.size();
+    held.assign(others.begin(), others.begin() + static_cast<long>(num_held));
+    // Every training row's error under this round's model (the copies whose
+    // inputs followed the fitted geometry: in `train`, or after the
+    // held-out rows in `others`).
+    train_norms.clear();
+    for (size_t i = 0, t = 0, o = num_held; i < all_train.size(); ++i) {
+      const Measurement& m = excluded[i] ? others[o++] : train[t++];
+      train_norms.push_back(Residual(state, m).norm());
     }
     // The scale from the rows fitted, robust to those left in.
-    std::vector<double> fitted_norms;
-    for (size_t i = 0; i < all_train.size(); ++i)
-      if (!excluded[i]) fitted_norms.push_back(train_norms[i]);
-    axis_sigma = RobustAxisSigmaMm(fitted_norms);
+    axis_sigma = RobustAxisSigmaOfKeptMm(train_norms, excluded);
     const std::vector<char> flags =
         FlagGross(train_norms, axis_sigma, options.outlier_sigmas);
     if (flags == excluded) break;
@@ -583,9 +569,10 @@ CalibrateResult Calibrate(const Robot& nominal, const Observations& obs,
     excluded = flags;
   }
   result.outlier_axis_sigma_mm = axis_sigma;
+  const std::vector<char> gross =
+      FlagGross(train_norms, axis_sigma, options.outlier_sigmas);
   for (size_t i = 0; i < all_train.size(); ++i) {
-    const bool gross = train_norms[i] > options.outlier_sigmas * axis_sigma;
-    if (!excluded[i] && !(options.outlier_sigmas > 0 && gross)) continue;
+    if (!excluded[i] && !gross[i]) continue;
     RowOutlier o =
         DescribeOutlier(state, all_train[i], obs.rows[all_train[i].row].pose,
                         train_norms[i], axis_sigma, options.outlier_sigmas);

@@ -43,8 +43,7 @@ EvaluateResult Evaluate(const Robot& robot, const Observations& obs,
                      "label: nothing to evaluate");
   }
   for (const Measurement& m : ms) out.rows.push_back(m.row);
-  const std::vector<char> excluded =
-      FindGrossErrors(start, ms, outlier_sigmas, nullptr, nullptr);
+  const std::vector<char> excluded = FindGrossErrors(start, ms, outlier_sigmas);
   const bool any =
       std::find(excluded.begin(), excluded.end(), 1) != excluded.end();
   // The spec's figures: registered on every row.
@@ -56,10 +55,7 @@ EvaluateResult Evaluate(const Robot& robot, const Observations& obs,
   out.has_robust = true;
   out.robust = Register(start, ms, excluded);
   out.excluded = excluded;
-  std::vector<double> kept;
-  for (size_t i = 0; i < ms.size(); ++i)
-    if (!excluded[i]) kept.push_back(out.robust.errors_mm[i]);
-  const double sigma = RobustAxisSigmaMm(kept);
+  const double sigma = RobustAxisSigmaOfKeptMm(out.robust.errors_mm, excluded);
   out.outlier_axis_sigma_mm = sigma;
   for (size_t i = 0; i < ms.size(); ++i) {
     if (!excluded[i]) continue;

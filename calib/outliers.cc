@@ -19,6 +19,14 @@ double RobustAxisSigmaMm(const std::vector<double>& norms_mm) {
   return median / 1.5382;
 }
 
+double RobustAxisSigmaOfKeptMm(const std::vector<double>& errors_mm,
+                               const std::vector<char>& excluded) {
+  std::vector<double> kept;
+  for (size_t i = 0; i < errors_mm.size(); ++i)
+    if (!excluded[i]) kept.push_back(errors_mm[i]);
+  return RobustAxisSigmaMm(kept);
+}
+
 std::vector<char> FlagGross(const std::vector<double>& norms_mm,
                             double axis_sigma_mm, double sigmas) {
   std::vector<char> flags(norms_mm.size(), 0);
@@ -105,20 +113,11 @@ std::vector<double> RegisterTips(const std::vector<Measurement>& ms,
   return errors;
 }
 
-double RobustSigmaOfKept(const std::vector<double>& errors_mm,
-                         const std::vector<char>& excluded) {
-  std::vector<double> kept;
-  for (size_t i = 0; i < errors_mm.size(); ++i)
-    if (!excluded[i]) kept.push_back(errors_mm[i]);
-  return RobustAxisSigmaMm(kept);
-}
-
 }  // namespace
 
 std::vector<char> FindGrossErrors(const ModelState& state,
                                   const std::vector<Measurement>& ms,
-                                  double sigmas, std::vector<double>* errors_mm,
-                                  double* axis_sigma_mm) {
+                                  double sigmas) {
   std::vector<Eigen::Vector3d> tips;
   tips.reserve(ms.size());
   int num_points = 0;
@@ -129,36 +128,27 @@ std::vector<char> FindGrossErrors(const ModelState& state,
   }
   std::vector<char> excluded(ms.size(), 0);
   std::vector<double> w(ms.size(), 1.0);
-  std::vector<double> errors = RegisterTips(ms, tips, w, num_points);
-  double sigma = RobustAxisSigmaMm(errors);
-  if (sigmas > 0 && sigma > 0) {
-    // Cauchy weights, the scale held: iteratively reweighted.
-    const double scale = sigma;
-    std::vector<double> robust = errors;
-    for (int it = 0; it < 20; ++it) {
-      for (size_t i = 0; i < ms.size(); ++i) {
-        const double r = robust[i] / scale;
-        w[i] = 1.0 / (1.0 + r * r);
-      }
-      robust = RegisterTips(ms, tips, w, num_points);
+  const std::vector<double> plain = RegisterTips(ms, tips, w, num_points);
+  const double scale = RobustAxisSigmaMm(plain);
+  if (!(sigmas > 0) || !(scale > 0)) return excluded;
+  // Cauchy weights, the scale held: iteratively reweighted.
+  std::vector<double> errors = plain;
+  for (int it = 0; it < 20; ++it) {
+    for (size_t i = 0; i < ms.size(); ++i) {
+      const double r = errors[i] / scale;
+      w[i] = 1.0 / (1.0 + r * r);
     }
-    std::vector<double> current = robust;
-    double current_sigma = RobustAxisSigmaMm(robust);
-    for (int round = 0; round < 6; ++round) {
-      const std::vector<char> flags = FlagGross(current, current_sigma, sigmas);
-      if (flags == excluded || !CanExclude(ms, flags)) break;
-      excluded = flags;
-      for (size_t i = 0; i < ms.size(); ++i) w[i] = excluded[i] ? 0.0 : 1.0;
-      current = RegisterTips(ms, tips, w, num_points);
-      current_sigma = RobustSigmaOfKept(current, excluded);
-    }
-    if (std::find(excluded.begin(), excluded.end(), 1) != excluded.end()) {
-      errors = current;
-      sigma = current_sigma;
-    }
+    errors = RegisterTips(ms, tips, w, num_points);
   }
-  if (errors_mm) *errors_mm = errors;
-  if (axis_sigma_mm) *axis_sigma_mm = sigma;
+  double sigma = RobustAxisSigmaMm(errors);
+  for (int round = 0; round < 6; ++round) {
+    const std::vector<char> flags = FlagGross(errors, sigma, sigmas);
+    if (flags == excluded || !CanExclude(ms, flags)) break;
+    excluded = flags;
+    for (size_t i = 0; i < ms.size(); ++i) w[i] = excluded[i] ? 0.0 : 1.0;
+    errors = RegisterTips(ms, tips, w, num_points);
+    sigma = RobustAxisSigmaOfKeptMm(errors, excluded);
+  }
   return excluded;
 }
 

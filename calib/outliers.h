@@ -45,6 +45,10 @@ struct RowOutlier {
   double near_point_mm = 0.0;
 };
 
+// RobustAxisSigmaMm of the rows not `excluded` (same size as errors_mm).
+double RobustAxisSigmaOfKeptMm(const std::vector<double>& errors_mm,
+                               const std::vector<char>& excluded);
+
 // Flags (1 = gross) for `norms_mm` above sigmas x axis_sigma_mm; none when
 // either is not positive.
 std::vector<char> FlagGross(const std::vector<double>& norms_mm,
@@ -62,12 +66,10 @@ bool CanExclude(const std::vector<Measurement>& ms,
 // of the unweighted fit) so that gross rows cannot pull the frame or a
 // point towards them, then unweighted without the rows beyond `sigmas`
 // robust sigmas, until that set is stable. Returns the flags (none when
-// more than CanExclude allows); every row's error and the kept rows' robust
-// axis sigma in `errors_mm` / `axis_sigma_mm` (may be null).
+// more than CanExclude allows).
 std::vector<char> FindGrossErrors(const ModelState& state,
                                   const std::vector<Measurement>& ms,
-                                  double sigmas, std::vector<double>* errors_mm,
-                                  double* axis_sigma_mm);
+                                  double sigmas);
 
 RowOutlier DescribeOutlier(const ModelState& state, const Measurement& m,
                            const std::string& pose, double error_mm,
