@@ -33,4 +33,15 @@ build_quietly() {
     return "$rc"
   fi
   echo "   build: done in $((SECONDS - start)) s (log: $log)"
+  report_warnings "$log"
+}
+
+# report_warnings LOG: the count of compiler warnings in a build log (of the
+# files compiled in that build: all of them on a clean checkout, as in CI),
+# and the warnings themselves when there are any.
+report_warnings() {
+  local n
+  n=$(grep -c 'warning:' "$1" || true)
+  echo "   compiler warnings: $n"
+  [ "$n" -eq 0 ] || grep -A3 'warning:' "$1" | head -n 200
 }
