@@ -318,7 +318,9 @@ void DrawColorBar(const Plot& plot, const Frame& f, int y0,
   for (const auto& s : plot.series) {
     if (!s.color.empty()) label = s.color_label;
   }
-  const double bx = f.left + f.w + 20, by = y0 + f.top, bh = f.h, steps = 20;
+  // At least 200 px tall (an equal-axes frame may be flat), within the plot.
+  const double bh = std::max(f.h, std::min(200.0, plot.height - f.top - 52));
+  const double bx = f.left + f.w + 20, by = y0 + f.top, steps = 20;
   for (int i = 0; i < steps; ++i) {
     os << "<rect x='" << Px(bx) << "' y='" << Px(by + bh * i / steps)
        << "' width='14' height='" << Px(bh / steps + 0.5) << "' fill='"

@@ -32,6 +32,31 @@ std::string JointUnit(const Robot& r, int j) {
 // Parameter unit shown in tables.
 std::string Unit(const ParamInfo& p) { return p.angle ? "deg" : "mm"; }
 
+// Equal-count bins of the trend lines: 12, fewer so that each holds 8 poses
+// or more, none (0) below 3 bins: a mean of one or two poses is no trend.
+int TrendBins(size_t poses) {
+  const int bins = std::min<int>(12, static_cast<int>(poses / 8));
+  return bins >= 3 ? bins : 0;
+}
+
+std::string TrendWords(size_t poses) {
+  const int bins = TrendBins(poses);
+  return bins > 0
+             ? "; lines: means of " + std::to_string(bins) + " equal-count bins"
+             : "; no trend lines: too few poses (" + std::to_string(poses) +
+                   ") for means of 8 or more";
+}
+
+// The enlargement of the workspace arrows: 0.12 x the workspace over the
+// longest error, rounded down to 1, 2 or 5 x 10^k so the legend reads it.
+double RoundScale(double scale) {
+  if (!(scale > 0) || !std::isfinite(scale)) return 1.0;
+  const double decade = std::pow(10.0, std::floor(std::log10(scale)));
+  return scale >= 5 * decade   ? 5 * decade
+         : scale >= 2 * decade ? 2 * decade
+                               : decade;
+}
+
 std::vector<const ResidualSet*> Sets(const ReportAnalysis& an) {
   std::vector<const ResidualSet*> sets = {&an.res_geo};
   if (an.has_ext) sets.push_back(&an.res_ext);
@@ -62,12 +87,13 @@ Plot Scatter(const ReportAnalysis& an, const ReportOptions& opt,
     }
     p.series.push_back(pts);
   }
-  for (size_t k = 0; k < sets.size(); ++k) {
+  const int bins = TrendBins(an.res_geo.rows.size());
+  for (size_t k = 0; k < sets.size() && bins > 0; ++k) {
     PlotSeries trend;
     trend.color_index = static_cast<int>(k);
     std::vector<double> xs;
     for (int row : sets[k]->rows) xs.push_back(x_of(row));
-    BinnedMeans(xs, sets[k]->norm_mm, 12, &trend.x, &trend.y);
+    BinnedMeans(xs, sets[k]->norm_mm, bins, &trend.x, &trend.y);
     p.series.push_back(trend);
   }
   return p;
@@ -78,8 +104,9 @@ Plot Scatter(const ReportAnalysis& an, const ReportOptions& opt,
 void AddDiagnosisSection(const ReportInputs& in, const ReportOptions& opt,
                          HtmlReport* page) {
   if (!in.has_diag) return;
-  page->Section("diagnosis", "Diagnosis: causes found");
   const nlohmann::json& findings = in.diag["findings"];
+  page->Section("diagnosis",
+                findings.empty() ? "Diagnosis" : "Diagnosis: causes found");
   if (findings.empty()) {
     page->Paragraph(
         "No significant effect: no cause diagnose model tested lowered the "
@@ -129,8 +156,9 @@ void AddResidualsSection(const ReportInputs& in, const ReportAnalysis& an,
       "|error| of each pose against each joint reading: the geometric "
       "model (blue)" +
           std::string(an.has_ext ? ", with the extensions (red)" : "") +
-          "; lines: means of 12 equal-count bins. A trend means the "
-          "geometric model misses something that depends on that joint." +
+          TrendWords(an.res_geo.rows.size()) +
+          ". A trend means the geometric model misses something that "
+          "depends on that joint." +
           ThinNote(an.res_geo.rows.size(), opt.max_points / 2));
   std::vector<Plot> tplots;
   if (in.obs.AnyTime()) {
@@ -228,7 +256,7 @@ void AddWorkspaceSection(const ReportAnalysis& an, const ReportOptions& opt,
     extent = std::max(extent, g.tip_in_base[i].cwiseAbs().maxCoeff());
     emax = std::max(emax, g.norm_mm[i]);
   }
-  const double scale = emax > 0 ? 0.12 * extent / emax : 1.0;
+  const double scale = RoundScale(emax > 0 ? 0.12 * extent / emax : 1.0);
   const int max_markers = std::min(opt.max_points, 800);
   std::vector<Plot> views;
   for (int view = 0; view < 2; ++view) {
@@ -242,7 +270,7 @@ void AddWorkspaceSection(const ReportAnalysis& an, const ReportOptions& opt,
     p.height = 460;
     p.equal_axes = true;
     PlotSeries arrows;
-    arrows.label = "error x " + Fmt(scale, 3);
+    arrows.label = "error x " + Fmt(scale, 6);
     arrows.points = true;
     arrows.color_label = "|error| (mm)";
     for (int i : Thin(g.rows.size(), max_markers)) {
@@ -258,7 +286,7 @@ void AddWorkspaceSection(const ReportAnalysis& an, const ReportOptions& opt,
   page->FigureRow(views,
                   "Model tip positions in the robot base frame with the error "
                   "vector (model - measured) drawn " +
-                      Fmt(scale, 3) +
+                      Fmt(scale, 6) +
                       " times enlarged. Regions of long, aligned arrows are "
                       "where the geometric model fails." +
                       ThinNote(g.rows.size(), max_markers));

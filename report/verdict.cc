@@ -269,10 +269,18 @@ ToleranceCheck CheckTolerance(const ReportInputs& in, const ReportAnalysis& an,
               "observations, a diagnosis or a bundle result).";
     return t;
   }
+  if (t.heldout.n < kMinHeldOutPoses) {
+    t.words = "NOT DECIDED: tolerance " + Fmt(t.tolerance_mm, 3) +
+              " mm, held-out RMS " + Fmt(t.heldout.rms_mm, 3) + " mm (" +
+              t.heldout.source + "): too few held-out poses (" +
+              std::to_string(t.heldout.n) + "; at least " +
+              std::to_string(kMinHeldOutPoses) + " are needed to decide).";
+  }
   const double dof = 3.0 * t.heldout.n;  // 3 components per held-out pose
   const double ss = t.heldout.rms_mm * t.heldout.rms_mm * dof;
   t.lo_mm = std::sqrt(ss / ChiSquareQuantile(0.975, dof));
   t.hi_mm = std::sqrt(ss / ChiSquareQuantile(0.025, dof));
+  if (t.heldout.n < kMinHeldOutPoses) return t;  // words set above
   t.pass = t.hi_mm <= t.tolerance_mm;
   const std::string figure =
       "held-out RMS " + Fmt(t.heldout.rms_mm, 3) + " mm, 95 % interval [" +

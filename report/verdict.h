@@ -48,7 +48,8 @@ double ChiSquareQuantile(double p, double dof);
 // `report --tolerance`: the final held-out RMS against the tolerance with
 // its 95 % interval from the chi-square distribution of the 3 n residual
 // components of n held-out poses. Passes when the whole interval is at or
-// below the tolerance.
+// below the tolerance; with fewer than kMinHeldOutPoses held-out poses it is
+// not decided (no pass), and says so.
 struct ToleranceCheck {
   bool given = false, available = false, pass = false;
   double tolerance_mm = 0.0;

@@ -174,6 +174,13 @@ TEST(VerdictTest, ToleranceUsesTheIntervalOfTheFinalHeldOutError) {
   EXPECT_THAT(t.words, HasSubstr("not shown to pass"));
   // The line leads the verdict.
   EXPECT_EQ(WriteVerdict(in, an, opt)[0], t.words);
+  // Few held-out poses: not decided, whatever the interval.
+  in.diag["heldout_poses"] = 4;
+  opt.tolerance_mm = 10.0;
+  t = CheckTolerance(in, an, opt);
+  EXPECT_FALSE(t.pass);
+  EXPECT_THAT(t.words, HasSubstr("NOT DECIDED"));
+  EXPECT_THAT(t.words, HasSubstr("too few held-out poses (4"));
   // Nothing held out: said, and no pass.
   ReportInputs none;
   t = CheckTolerance(none, an, opt);
