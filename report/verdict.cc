@@ -207,6 +207,36 @@ std::string ClearanceWords(const ReportAnalysis& an, const ReportOptions& opt) {
                          : "no joint removes the error of the worst poses.");
 }
 
+// camcal's figures per camera and its worst view, in one sentence.
+std::string CameraWords(const nlohmann::json& camcal) {
+  std::ostringstream s;
+  s << "Cameras (kincal camcal):";
+  int worst_view = 0;
+  double worst = -1;
+  std::string worst_camera;
+  bool first = true;
+  for (const auto& c : camcal["cameras"]) {
+    s << (first ? " " : "; ") << c.value("name", "?") << " RMS "
+      << Fmt(Num(c, "rms_px"), 3) << " px (held out "
+      << Fmt(Num(c, "holdout_rms_px"), 3) << " px)";
+    first = false;
+    if (!c.contains("view_rms_px") || !c["view_rms_px"].is_array()) continue;
+    for (size_t v = 0; v < c["view_rms_px"].size(); ++v) {
+      const double e = At(c["view_rms_px"], v);
+      if (e > worst) {
+        worst = e, worst_view = static_cast<int>(v) + 1;
+        worst_camera = c.value("name", "?");
+      }
+    }
+  }
+  s << ".";
+  if (worst >= 0) {
+    s << " Worst view: " << worst_view << " (" << worst_camera << ", "
+      << Fmt(worst, 3) << " px).";
+  }
+  return s.str();
+}
+
 }  // namespace
 
 HeldOutFigure GeometricHeldOut(const ReportInputs& in, const ReportAnalysis& an,
@@ -366,6 +396,10 @@ std::vector<std::string> WriteVerdict(const ReportInputs& in,
   const std::string structure = StructureSentence(in, an);
   if (!structure.empty()) v.push_back(structure);
   if (an.has_clear) v.push_back(ClearanceWords(an, opt));
+  if (in.camcal.is_object() && in.camcal.contains("cameras") &&
+      in.camcal["cameras"].is_array()) {
+    v.push_back(CameraWords(in.camcal));
+  }
   if (v.empty()) {
     v.push_back(
         "No robot data given: the sections below show what the inputs hold.");

@@ -143,6 +143,20 @@ TEST(VerdictTest, BundleResultShowsItsOwnFigures) {
   EXPECT_EQ(h.n, 6);
 }
 
+TEST(VerdictTest, CamcalResultNamesTheWorstView) {
+  ReportInputs in;
+  in.camcal = {{"cameras",
+                {{{"name", "left"},
+                  {"rms_px", 0.419},
+                  {"holdout_rms_px", 0.441},
+                  {"view_rms_px", {0.2, 1.22, 0.3}}}}}};
+  const std::string v =
+      Joined(WriteVerdict(in, ReportAnalysis(), ReportOptions()));
+  EXPECT_THAT(v, HasSubstr("left RMS 0.419 px (held out 0.441 px)"));
+  EXPECT_THAT(v, HasSubstr("Worst view: 2 (left, 1.22 px)"));
+  EXPECT_THAT(v, Not(HasSubstr("No robot data")));
+}
+
 TEST(VerdictTest, ChiSquareQuantileMatchesTables) {
   EXPECT_NEAR(ChiSquareQuantile(0.975, 10), 20.483, 0.1);
   EXPECT_NEAR(ChiSquareQuantile(0.025, 10), 3.247, 0.05);
