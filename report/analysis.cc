@@ -3,10 +3,12 @@
 #include <sys/stat.h>
 
 #include <fstream>
+#include <regex>
 
 #include "data/atomic_file.h"
 #include "data/error.h"
 #include "data/urdf.h"
+#include "report/html.h"
 
 namespace kincal {
 namespace {
@@ -195,8 +197,20 @@ BundleHeader ReadBundleHeader(const std::string& robot_path) {
     if (line.find("calibrated by kincal bundle") != std::string::npos) {
       out.found = true;
     }
-    if (line.rfind("# reprojection RMS", 0) == 0)
-      out.reprojection = line.substr(2);
+    if (line.rfind("# reprojection RMS", 0) == 0) {
+      // Numbers to 3 significant digits, as everywhere in the verdict.
+      const std::string text = line.substr(2);
+      const std::regex number("[0-9]+\\.[0-9]+(e-?[0-9]+)?");
+      size_t last = 0;
+      for (auto it = std::sregex_iterator(text.begin(), text.end(), number);
+           it != std::sregex_iterator(); ++it) {
+        out.reprojection +=
+            text.substr(last, static_cast<size_t>(it->position()) - last) +
+            Fmt(std::stod(it->str()), 3);
+        last = static_cast<size_t>(it->position() + it->length());
+      }
+      out.reprojection += text.substr(last);
+    }
   }
   return out;
 }

@@ -28,14 +28,15 @@ TEST(AnalysisTest, ObservationsNeedARobotAndRigJsonIsFoundBeside) {
 
 TEST(AnalysisTest, BundleHeaderIsRead) {
   const std::string path = ::testing::TempDir() + "kincal_bundle_header.yaml";
-  std::ofstream(path) << "# written by kincal 0.1.0: kincal bundle ...\n"
-                         "# calibrated by kincal bundle from the images of S\n"
-                         "# reprojection RMS 0.05 px (training), 0.03 px "
-                         "(held out)\nkincal_robot: 1\n";
+  std::ofstream(path)
+      << "# written by kincal 0.1.0: kincal bundle ...\n"
+         "# calibrated by kincal bundle from the images of S\n"
+         "# reprojection RMS 0.0503906984888 px (training), 0.03 px "
+         "(held out)\nkincal_robot: 1\n";
   const BundleHeader h = ReadBundleHeader(path);
   EXPECT_TRUE(h.found);
   EXPECT_EQ(h.reprojection,
-            "reprojection RMS 0.05 px (training), 0.03 px (held out)");
+            "reprojection RMS 0.0504 px (training), 0.03 px (held out)");
   std::ofstream(path) << "# written by kincal 0.1.0: kincal calibrate\n"
                          "kincal_robot: 1\n";
   EXPECT_FALSE(ReadBundleHeader(path).found);
