@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cstdio>
 #include <memory>
+#include <nlohmann/json.hpp>
 
 #include "app/command.h"
 #include "data/atomic_file.h"
@@ -24,9 +25,9 @@ int RunReport(const ReportArgs& args) {
   const auto start = std::chrono::steady_clock::now();
   const ReportOptions& o = args.options;
   Require(!o.robot.empty() || !o.calibrated.empty() || !o.diagnosis.empty() ||
-              !o.session.empty() || !o.rig.empty(),
+              !o.session.empty() || !o.rig.empty() || !o.bundle.empty(),
           "kincal report: give at least one input (--robot, --calibrated, "
-          "--diagnosis, --session or --rig)");
+          "--diagnosis, --bundle, --session or --rig)");
   Progress progress("kincal report", args.json);
   const ReportResult r =
       BuildReport(o, [&](const std::string& what) { progress.Stage(what); });
@@ -36,16 +37,30 @@ int RunReport(const ReportArgs& args) {
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start)
           .count();
   if (args.json) {
-    PrintJson({{"out", args.out},
-               {"sections", r.sections},
-               {"figures", r.figures},
-               {"notes", r.notes},
-               {"bytes", r.html.size()},
-               {"seconds", seconds}});
+    nlohmann::json j = {{"out", args.out},        {"sections", r.sections},
+                        {"figures", r.figures},   {"notes", r.notes},
+                        {"bytes", r.html.size()}, {"seconds", seconds}};
+    if (r.tolerance_given) {
+      j["tolerance_mm"] = r.tolerance_mm;
+      j["pass"] = r.pass;
+      if (r.tolerance_available) {
+        j["heldout_rms_mm"] = r.heldout_rms_mm;
+        j["heldout_ci95_mm"] = {r.heldout_lo_mm, r.heldout_hi_mm};
+        j["heldout_n"] = r.heldout_n;
+      }
+    }
+    PrintJson(j);
     return 0;
   }
   std::printf("kincal report: %zu sections, %d figures, %.1f s\n",
               r.sections.size(), r.figures, seconds);
+  if (r.tolerance_given) {
+    std::printf(
+        "  %s: held-out RMS %.4g mm [%.4g, %.4g] (95 %%, %d poses), "
+        "tolerance %.4g mm\n",
+        r.pass ? "PASS" : "FAIL", r.heldout_rms_mm, r.heldout_lo_mm,
+        r.heldout_hi_mm, r.heldout_n, r.tolerance_mm);
+  }
   for (const auto& n : r.notes) std::printf("  note: %s\n", n.c_str());
   std::printf("%s\n", args.out.c_str());
   return 0;
@@ -82,6 +97,13 @@ void AddReportCommand(CLI::App& app, Runner* run) {
                   "rig.yaml from camcal (its camcal --json output is read "
                   "from RIG.json beside it when present)");
   sub->add_option("--camcal", o.camcal_json, "camcal --json output");
+  sub->add_option("--bundle", o.bundle,
+                  "what `kincal bundle --json` printed: the report shows the "
+                  "bundle's own held-out tip error, reprojection RMS, sigma "
+                  "and parameters instead of calibrating the points again");
+  sub->add_option("--tolerance", o.tolerance_mm,
+                  "mm: adds a pass/fail line, the final held-out RMS with its "
+                  "95 % interval against this (exit code stays 0)");
   sub->add_option("--root", o.root, "URDF root link");
   sub->add_option("--tip", o.tip, "URDF tip link");
   sub->add_option("--seed", o.seed,

@@ -4,7 +4,12 @@
 // A small line/scatter plot written as SVG (a self-contained image format that
 // needs no library): axes with ticks, several series with a legend, optional
 // horizontal reference lines (e.g. the seed's eta = 1 mm). Used for the
-// sensitivity curves (Fig. 2/3) and the clearance test (Fig. 4/5/6).
+// sensitivity curves (Fig. 2/3), the clearance test (Fig. 4/5/6) and every
+// figure of the report. One style for all: one type scale (title 15, axis
+// labels 13, ticks and legend 12 px at 1:1), the legend below the plot
+// (outside the data; its rows add to the plot's height), the data ranges
+// padded so markers at the extremes are drawn whole, colour-bar ticks at
+// round values.
 
 #include <limits>
 #include <string>

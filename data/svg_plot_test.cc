@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
+#include <string>
 
 #include "data/provenance.h"
 
@@ -93,6 +94,84 @@ TEST(SvgPlotTest, FixedRangeClipsAndInlineSvgIsWellFormed) {
   // Tick labels follow the fixed range, not the data's 25.
   EXPECT_EQ(svg.find(">25<"), std::string::npos);
   EXPECT_NE(svg.find(">0.2<"), std::string::npos);
+}
+
+// The frame (the data area): the first unfilled rectangle.
+struct Box {
+  double x = 0, y = 0, w = 0, h = 0;
+};
+Box FrameOf(tinyxml2::XMLElement* svg) {
+  for (auto* e = svg->FirstChildElement("rect"); e;
+       e = e->NextSiblingElement("rect")) {
+    if (std::string(e->Attribute("fill") ? e->Attribute("fill") : "") ==
+        "none") {
+      return {e->DoubleAttribute("x"), e->DoubleAttribute("y"),
+              e->DoubleAttribute("width"), e->DoubleAttribute("height")};
+    }
+  }
+  return {};
+}
+
+TEST(SvgPlotTest, LegendSitsBelowTheDataAndAddsHeight) {
+  Plot p;
+  p.width = 500;
+  p.height = 300;
+  p.series.push_back({"first series", {0, 1, 2}, {1, 2, 3}, true});
+  p.series.push_back({"second series", {0, 1, 2}, {3, 2, 1}, true});
+  p.lines.push_back({2.5, "limit"});
+  const std::string svg = FormatInlineSvg(p, "f");
+  tinyxml2::XMLDocument doc;
+  ASSERT_EQ(doc.Parse(svg.c_str()), tinyxml2::XML_SUCCESS);
+  tinyxml2::XMLElement* root = doc.RootElement();
+  EXPECT_GT(root->IntAttribute("height"), 300);
+  const Box frame = FrameOf(root);
+  ASSERT_GT(frame.h, 0);
+  int found = 0;
+  for (auto* t = root->FirstChildElement("text"); t;
+       t = t->NextSiblingElement("text")) {
+    const std::string text = t->GetText() ? t->GetText() : "";
+    if (text == "first series" || text == "second series" || text == "limit") {
+      ++found;
+      EXPECT_GT(t->DoubleAttribute("y"), frame.y + frame.h + 30) << text;
+    }
+  }
+  EXPECT_EQ(found, 3);
+}
+
+TEST(SvgPlotTest, MarkersAtTheEdgesAreInsideTheFrame) {
+  Plot p;
+  p.series.push_back({"", {0, 10}, {0, 5}, true});
+  const std::string svg = FormatInlineSvg(p, "f");
+  tinyxml2::XMLDocument doc;
+  ASSERT_EQ(doc.Parse(svg.c_str()), tinyxml2::XML_SUCCESS);
+  const Box frame = FrameOf(doc.RootElement());
+  auto* g = doc.RootElement()->FirstChildElement("g");
+  ASSERT_NE(g, nullptr);
+  int circles = 0;
+  for (auto* c = g->FirstChildElement("circle"); c;
+       c = c->NextSiblingElement("circle")) {
+    ++circles;
+    const double cx = c->DoubleAttribute("cx"), cy = c->DoubleAttribute("cy");
+    const double r = c->DoubleAttribute("r");
+    EXPECT_GE(cx - r, frame.x);
+    EXPECT_LE(cx + r, frame.x + frame.w);
+    EXPECT_GE(cy - r, frame.y);
+    EXPECT_LE(cy + r, frame.y + frame.h);
+  }
+  EXPECT_EQ(circles, 2);
+}
+
+TEST(SvgPlotTest, ColourBarLabelsAreRound) {
+  Plot p;
+  PlotSeries s{"", {0, 1, 2}, {0, 1, 2}, true};
+  s.color = {0.1234567, 1.5, 2.9876543};
+  s.color_label = "|e| (mm)";
+  p.series.push_back(s);
+  const std::string svg = FormatInlineSvg(p, "f");
+  EXPECT_EQ(svg.find("2.98765"), std::string::npos);
+  EXPECT_EQ(svg.find("0.123457"), std::string::npos);
+  EXPECT_NE(svg.find(">0.5<"), std::string::npos);
+  EXPECT_NE(svg.find(">2.5<"), std::string::npos);
 }
 
 }  // namespace

@@ -39,7 +39,7 @@ std::vector<Plot> ImageGridPlots(const nlohmann::json& cameras,
     p.title = c.value("name", "?") + ": residual over the image";
     p.x_label = "image column (px)";
     p.y_label = "image row (px, downwards)";
-    p.width = 520;
+    p.width = 500;
     p.height = 420;
     p.y_down = true;
     p.equal_axes = true;
@@ -132,7 +132,8 @@ void AddCameraSection(const Rig& rig, const nlohmann::json& camcal,
     views.title = "Reprojection error per view";
     views.x_label = "view";
     views.y_label = "RMS (px)";
-    views.height = 320;
+    views.width = 1000;
+    views.height = 340;
     for (const auto& c : camcal["cameras"]) {
       auto g = [&](const nlohmann::json& o, const char* k) {
         return o.contains(k) && o[k].is_number() ? Fmt(o[k].get<double>(), 3)
@@ -237,13 +238,15 @@ void AddTrackingSection(const std::string& points_path, bool exists,
     p.x_label = "frame";
     p.y_label = "reprojection RMS (px)";
     p.series = {reproj, lost};
+    p.width = 500;
     p.height = 320;
     Plot t;
     t.title = "Tag observations used per frame";
     t.x_label = "frame";
     t.y_label = "tags";
     t.series = {tags};
-    t.height = 260;
+    t.width = 500;
+    t.height = 320;
     page->FigureRow({p, t}, "From " + points_path + ": tip found in " +
                                 std::to_string(found) + " of " +
                                 std::to_string(total) +

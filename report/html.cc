@@ -15,12 +15,13 @@ nav{font-size:.9em;color:#555} nav a{margin-right:.8em}
 .verdict{font-size:1.15em;background:#f4f8fb;border-left:5px solid #1f77b4;padding:.6em 1em}
 table{border-collapse:collapse;font-size:.88em;margin:.6em 0} th,td{border:1px solid #ccc;padding:2px 8px;text-align:left} td.num{text-align:right}
 th{background:#f0f0f0}
-figure{margin:1em 0;page-break-inside:avoid;break-inside:avoid} figure svg{width:100%;height:auto;border:1px solid #eee}
-figure.row{display:grid;grid-template-columns:repeat(auto-fill,minmax(330px,1fr));gap:6px}
-figure.row figcaption{grid-column:1/-1}
+figure{margin:1em 0;page-break-inside:avoid;break-inside:avoid} figure svg{max-width:100%;height:auto;border:1px solid #eee}
+figure.row{display:flex;flex-wrap:wrap;gap:6px;align-items:flex-start}
+figure.row figcaption{flex-basis:100%}
 figcaption{font-size:.9em;color:#444}
 code,pre{font-size:.85em;background:#f6f6f6} pre{padding:.5em;white-space:pre-wrap;word-break:break-all}
 .note{color:#8a5a00}
+.verdict p.pass{font-weight:bold;color:#1a6b1a} .verdict p.fail{font-weight:bold;color:#a01010}
 @media print{nav{display:none} body{max-width:none;padding:0} h2{page-break-after:avoid}}
 )CSS";
 
@@ -89,7 +90,8 @@ void HtmlReport::Figure(const Plot& plot, const std::string& caption) {
 
 void HtmlReport::FigureRow(const std::vector<Plot>& plots,
                            const std::string& caption) {
-  // Small plots go in a grid (side by side, or alone at their own size).
+  // Plots are shown at their own width when the page has room (one type
+  // scale for every figure), side by side while they fit.
   const bool grid = plots.size() > 1 || plots[0].width < 600;
   body_ += grid ? "<figure class='row'>\n" : "<figure>\n";
   for (const Plot& p : plots) {

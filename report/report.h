@@ -21,7 +21,12 @@
 //   provenance       the command and version that made every input
 //
 // Residuals and parameters are computed here through the calib library
-// (Calibrate, Evaluate: the same defaults as `kincal calibrate`).
+// (Calibrate, Evaluate: the same defaults as `kincal calibrate`), unless a
+// bundle result is given (its own parameters and held-out figures).
+//
+// The steps: read the inputs (report/analysis.h ReadReportInputs), compute
+// (AnalyseReport), write the verdict (report/verdict.h), one function per
+// section (report/robot_sections.h, report/camera_sections.h), provenance.
 
 #include <cstdint>
 #include <functional>
@@ -32,11 +37,14 @@ namespace kincal {
 
 struct ReportOptions {
   std::string robot, obs, calibrated, diagnosis, session, rig, camcal_json;
+  std::string bundle;  // what `kincal bundle --json` printed (its own figures)
   std::string root, tip;  // URDF chain ends, when a robot is a .urdf
   uint64_t seed = 1;      // held-out split of the calibration run here
   double gamma = 3.0;     // clearance sweep half-range (deg | mm)
   // Markers per scatter series at most (evenly thinned above; said so).
   int max_points = 2000;
+  // > 0: a pass/fail line, the final held-out RMS against this (mm).
+  double tolerance_mm = 0.0;
 };
 
 struct ReportResult {
@@ -44,6 +52,12 @@ struct ReportResult {
   std::vector<std::string> sections;  // ids, in page order
   int figures = 0;
   std::vector<std::string> notes;  // sections skipped and why
+  // --tolerance: whether given, whether a held-out figure was there, and
+  // the check (report/verdict.h ToleranceCheck).
+  bool tolerance_given = false, tolerance_available = false, pass = false;
+  double tolerance_mm = 0.0, heldout_rms_mm = 0.0;
+  double heldout_lo_mm = 0.0, heldout_hi_mm = 0.0;
+  int heldout_n = 0;
 };
 
 // Reads the inputs (InputError with file:line:column on bad ones) and builds

@@ -190,6 +190,73 @@ TEST(ReportCliTest, BadInputExitsTwoAndWritesNothing) {
   EXPECT_FALSE(Exists(dir + "/r.html"));
 }
 
+// --tolerance: a pass/fail line in the page and tolerance_mm / pass in the
+// JSON, exit code 0 either way.
+TEST(ReportCliTest, ToleranceAddsPassFailAndKeepsExitZero) {
+  const std::string dir = testing::MakeTempDir("report_tol");
+  const std::string s = testing::SourceDir() + "/data/sessions/bh7_demo";
+  const std::string base = "report --robot " + s + "/robot.yaml --obs " + s +
+                           "/observations.csv --out " + dir + "/r.html --json";
+  auto r = RunKincal(base + " --tolerance 1");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  auto j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["tolerance_mm"], 1.0);
+  EXPECT_EQ(j["pass"], true);
+  ASSERT_EQ(j["heldout_ci95_mm"].size(), 2u);
+  EXPECT_LT(j["heldout_ci95_mm"][0].get<double>(),
+            j["heldout_rms_mm"].get<double>());
+  EXPECT_THAT(ReadFile(dir + "/r.html"), HasSubstr("PASS: held-out RMS"));
+  r = RunKincal(base + " --tolerance 0.01");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["pass"], false);
+  EXPECT_THAT(ReadFile(dir + "/r.html"), HasSubstr("FAIL: held-out RMS"));
+  // Without --tolerance the JSON has no such fields.
+  r = RunKincal(base);
+  EXPECT_FALSE(nlohmann::json::parse(r.out).contains("pass"));
+}
+
+// 16 poses: no percentages of explained variance, "too few poses" instead.
+TEST(ReportCliTest, FewPosesSayTooFewInsteadOfPercentages) {
+  const std::string dir = testing::MakeTempDir("report_few");
+  const std::string robot = testing::SourceDir() + "/data/robots/bh7.yaml";
+  ASSERT_EQ(RunKincal("simulate --robot " + robot + " --out " + dir +
+                      "/s --poses 16 --seed 3 --json")
+                .exit_code,
+            0);
+  const auto r = RunKincal("report --robot " + robot + " --obs " + dir +
+                           "/s/observations.csv --out " + dir + "/r.html");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const std::string html = ReadFile(dir + "/r.html");
+  EXPECT_THAT(html, HasSubstr("too few poses (16)"));
+  EXPECT_THAT(html, Not(HasSubstr("grid explains")));
+  EXPECT_THAT(html, HasSubstr("a rough figure"));  // 3 held-out poses
+}
+
+// --bundle: the bundle's own figures, no calibration run by the report.
+TEST(ReportCliTest, BundleResultIsShownNotRecalibrated) {
+  const std::string dir = testing::MakeTempDir("report_bundle");
+  const std::string s = testing::SourceDir() + "/data/sessions/bh7_demo";
+  std::ofstream(dir + "/bundle.json")
+      << R"({"command": "kincal bundle ...", "reproj_rms_px": 0.0504,
+             "heldout_reproj_rms_px": 0.0295, "sigma0_px": 0.036,
+             "heldout_tip_rms_mm": 0.449, "heldout_tips": 6,
+             "heldout_frames": 6, "identifiable": ["j2.a"],
+             "unidentifiable": ["j1.d"],
+             "params": [{"name": "j2.a", "value": 200.161, "sigma": 0.0086}]})";
+  const auto r = RunKincal("report --robot " + s + "/robot.yaml --obs " + s +
+                           "/observations.csv --bundle " + dir +
+                           "/bundle.json --out " + dir + "/r.html --json");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto sec = Sections(nlohmann::json::parse(r.out));
+  EXPECT_THAT(sec, Contains("parameters"));
+  const std::string html = ReadFile(dir + "/r.html");
+  EXPECT_THAT(html, HasSubstr("held-out tip error 0.449 mm"));
+  EXPECT_THAT(html, HasSubstr("sigma0 0.036 px"));
+  EXPECT_THAT(html, Not(HasSubstr("Geometric calibration (run here")));
+  EXPECT_THAT(html, HasSubstr("bundle result"));  // provenance row
+}
+
 // The camera section from a real camera calibration (OpenCV's stereo
 // chessboard images): camcal's JSON saved beside the rig is found, and the
 // per-view and over-the-image figures draw (screenshot in the build folder).
