@@ -8,13 +8,13 @@
 #include <map>
 #include <random>
 
-#include "diagnose/exact_jacobian.h"
+#include "calib/exact_jacobian.h"
 
 namespace kincal {
 namespace {
 
 // The +-delta box of the free row entries (calib/fit.h's RowBound, as
-// diagnose/free_fit.cc); no box for the other parameters.
+// calib/free_fit.cc); no box for the other parameters.
 void Box(const FreeFitOptions& o, Eigen::VectorXd* lower,
          Eigen::VectorXd* upper) {
   const int k = static_cast<int>(o.free.size());

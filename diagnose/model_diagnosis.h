@@ -63,14 +63,6 @@ struct DiagnoseOptions {
   // Residual scatter above this multiple of the noise counts as systematic.
   double unexplained_ratio = 1.5;
   int num_threads = 2;
-  // Candidate refits differentiate only the free parameters
-  // (diagnose/free_fit.h); false = calib/fit.h's Fit (the speed reference
-  // of bench/diagnose_bench --only ur10).
-  bool free_parameter_fit = true;
-  // With free_parameter_fit: Levenberg-Marquardt on the exact Jacobian
-  // (diagnose/exact_jacobian.h); false = Ceres with autodiff in the free
-  // parameters (the path before, bench/diagnose_bench --only ur10).
-  bool exact_jacobian = true;
   // Restrict candidates to these causes (empty = all of the catalogue).
   std::vector<std::string> causes;
   // Cross-series validation: other measured series of the same robot that
