@@ -36,13 +36,6 @@ std::vector<double> CentroidDistances(const ModelState& state,
 
 namespace {
 
-std::vector<Measurement> Pick(const std::vector<Measurement>& ms,
-                              const std::vector<int>& idx) {
-  std::vector<Measurement> out;
-  for (int i : idx) out.push_back(ms[i]);
-  return out;
-}
-
 // --free NAME: a parameter (j2.beta), or a joint-error family without a
 // joint (compliance, gain, ...): that entry of every joint.
 std::vector<ParamInfo> ExtraParams(const ModelState& state,
@@ -576,7 +569,7 @@ CalibrateResult Calibrate(const Robot& nominal, const Observations& obs,
       SplitHoldout(all, options.holdout_fraction, options.seed);
   result.train_rows = std::move(split.train);
   result.heldout_rows = std::move(split.heldout);
-  const std::vector<Measurement> all_train = Pick(all, result.train_rows);
+  const std::vector<Measurement> all_train = PickRows(all, result.train_rows);
   std::vector<Measurement> train, held;
   const ModelState initial = state;
 
@@ -603,7 +596,7 @@ CalibrateResult Calibrate(const Robot& nominal, const Observations& obs,
     train.clear();
     // The rows out of the fit ride along with the held-out ones so that
     // their joint-error inputs follow the fitted geometry too.
-    std::vector<Measurement> others = Pick(all, result.heldout_rows);
+    std::vector<Measurement> others = PickRows(all, result.heldout_rows);
     for (size_t i = 0; i < all_train.size(); ++i)
       (excluded[i] ? others : train).push_back(all_train[i]);
     CalibrateOn(obs, nominal_chain, nominal.bounds_stated, distinct, distances,

@@ -64,4 +64,12 @@ HoldoutSplit SplitHoldout(const std::vector<Measurement>& measurements,
   return split;
 }
 
+std::vector<Measurement> PickRows(const std::vector<Measurement>& measurements,
+                                  const std::vector<int>& indices) {
+  std::vector<Measurement> out;
+  out.reserve(indices.size());
+  for (int i : indices) out.push_back(measurements[i]);
+  return out;
+}
+
 }  // namespace kincal

@@ -41,6 +41,10 @@ HoldoutSplit HoldOutFold(const std::vector<int>& indices, int folds, int fold,
 HoldoutSplit SplitHoldout(const std::vector<Measurement>& measurements,
                           double fraction, uint64_t seed);
 
+// The measurements at `indices` (e.g. a split's training rows), in order.
+std::vector<Measurement> PickRows(const std::vector<Measurement>& measurements,
+                                  const std::vector<int>& indices);
+
 }  // namespace kincal
 
 #endif  // KINCAL_CALIB_HOLDOUT_H_

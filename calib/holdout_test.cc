@@ -75,6 +75,16 @@ TEST(HoldoutTest, MeasurementSplitIsSeededAndKeepsGroups) {
   EXPECT_EQ(SplitHoldout(ms, 0.89, 1).train.size(), 10u);
 }
 
+TEST(HoldoutTest, PickRowsKeepsTheOrder) {
+  std::vector<Measurement> ms(4);
+  for (int i = 0; i < 4; ++i) ms[i].row = 10 + i;
+  const std::vector<Measurement> picked = PickRows(ms, {3, 0, 3});
+  ASSERT_EQ(picked.size(), 3u);
+  EXPECT_EQ(picked[0].row, 13);
+  EXPECT_EQ(picked[1].row, 10);
+  EXPECT_EQ(picked[2].row, 13);
+}
+
 TEST(HoldoutTest, FixedPointGroupsKeepThreeTrainingPoses) {
   std::vector<Measurement> ms;
   for (int g = 0; g < 2; ++g) {

@@ -32,14 +32,6 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 constexpr double kZ95 = 1.959963984540054;
 constexpr double kChi2One95 = 3.841458820694124;
 
-std::vector<Measurement> Pick(const std::vector<Measurement>& ms,
-                              const std::vector<int>& idx) {
-  std::vector<Measurement> out;
-  out.reserve(idx.size());
-  for (int i : idx) out.push_back(ms[i]);
-  return out;
-}
-
 double Rss(const ModelState& state, const std::vector<Measurement>& ms) {
   double sum = 0.0;
   for (const Measurement& m : ms) sum += Residual(state, m).squaredNorm();
@@ -318,8 +310,8 @@ Problem SplitPoses(const Robot& nominal, const Observations& obs,
   problem.all = Measurements(problem.nominal, obs, &problem.base_state);
   const HoldoutSplit split =
       SplitHoldout(problem.all, options.holdout_fraction, options.seed);
-  problem.train = Pick(problem.all, split.train);
-  problem.held = Pick(problem.all, split.heldout);
+  problem.train = PickRows(problem.all, split.train);
+  problem.held = PickRows(problem.all, split.heldout);
   SetTransmissionTravel(problem.train, &problem.nominal);
   SetTransmissionTravel(problem.train, &problem.base_state.chain);
   for (auto* set : {&problem.all, &problem.train, &problem.held})
