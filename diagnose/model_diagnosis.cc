@@ -1,26 +1,20 @@
 #include "diagnose/model_diagnosis.h"
 
-#include <Eigen/QR>
+#include <Eigen/Cholesky>
 #include <algorithm>
 #include <array>
-#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <limits>
 #include <map>
 #include <set>
-#include <sstream>
-#include <thread>
 
 #include "calib/calibrate.h"
 #include "calib/exact_jacobian.h"
 #include "calib/free_fit.h"
 #include "calib/holdout.h"
 #include "calib/identifiability.h"
-#include "data/csv.h"
 #include "data/error.h"
-#include "data/provenance.h"
-#include "data/yaml_util.h"
 #include "diagnose/cross_validation.h"
 #include "diagnose/nonparametric.h"
 
