@@ -27,8 +27,8 @@
 #include <vector>
 
 #include "calib/fit.h"
-#include "calib/model_state.h"
 #include "calib/free_fit.h"
+#include "calib/model_state.h"
 
 namespace kincal {
 
