@@ -11,8 +11,9 @@
 //      lie in the span of the base's is equivalent to geometry and skipped):
 //      backlash (s), compliance (gravity torque), cyclic (cos q, sin q), gain
 //      (q), axis_tilt (Hayati beta on nominally parallel axes), drift (t).
-//   4. Each candidate is refitted JOINTLY with geometry and frame (Ceres, one
-//      Fit with the candidate's parameters freed). Nested-model F-test,
+//   4. Each candidate is refitted JOINTLY with geometry and frame
+//      (Levenberg-Marquardt on the exact Jacobian, calib/free_fit.h, with the
+//      candidate's parameters freed). Nested-model F-test,
 //      F = ((RSS0 - RSS1) / k) / (RSS1 / (n - p - k)), Bonferroni-corrected
 //      over the candidates of the step (family-wise false-alarm rate
 //      `false_alarm` per step), and the candidate must predict the left-out
