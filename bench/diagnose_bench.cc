@@ -5,12 +5,10 @@
 //   3. the false-alarm rate of `diagnose model` on null data;
 //   4. the seed's Section 4 clearance test: false-positive rate without
 //      clearance and hit rate with clearance in j3.
-//   5. (--only ur10) the UR10 series C timing at 240 and 2773 poses, the
-//      path before the exact-Jacobian refits and now, in one run, with the
-//      comparison of their results (--repeat R runs each, median; default 3);
-//      (--only ur10-240: the 240 poses only);
-//   6. (--only compare) the diagnose tests' simulated cases, before and now.
-//   7. (--only cv) k-fold cross-validation of the selection on UR10 series
+//   5. (--only ur10) the UR10 series C timing at 240 and 2773 poses
+//      (--repeat R runs each, median; default 3); (--only ur10-240: the 240
+//      poses only);
+//   6. (--only cv) k-fold cross-validation of the selection on UR10 series
 //      C (240 and 2773 poses): time and findings with the single held-out
 //      split (--folds 0), 5 and 10 folds (linearised fold fits) and 5 folds
 //      with full refits per fold, and how far the linearised
@@ -96,45 +94,6 @@ double CpuSeconds() {
   return ts.tv_sec + 1e-9 * ts.tv_nsec;
 }
 
-// Compares a diagnosis with the one of the path before (the speed-up must
-// not change results in substance): same findings (cause, joint), each
-// magnitude within sigma/10 of its 95 % interval, held-out and final figures
-// within 1 %. Returns a one-line verdict.
-std::string Compare(const DiagnosisResult& before,
-                    const DiagnosisResult& after) {
-  auto rel = [](double a, double b) {
-    return std::isfinite(a) && std::isfinite(b) && a != 0
-               ? std::abs(a - b) / std::abs(a)
-               : (a == b || (!std::isfinite(a) && !std::isfinite(b)) ? 0.0
-                                                                     : 1.0);
-  };
-  bool same = before.findings.size() == after.findings.size() &&
-              before.verdict == after.verdict;
-  double worst_sigma = 0.0,
-         worst_rel = std::max(
-             rel(before.final_heldout_rms_mm, after.final_heldout_rms_mm),
-             rel(before.final_validation_rms_mm,
-                 after.final_validation_rms_mm));
-  for (size_t i = 0; same && i < before.findings.size(); ++i) {
-    const Finding &a = before.findings[i], &b = after.findings[i];
-    same = a.cause == b.cause && a.joint == b.joint;
-    const double sigma = (a.ci_high - a.ci_low) / (2 * 1.959963984540054);
-    if (std::isfinite(sigma) && sigma > 0)
-      worst_sigma =
-          std::max(worst_sigma, std::abs(a.magnitude - b.magnitude) / sigma);
-    worst_rel = std::max(worst_rel,
-                         rel(a.heldout_rms_after_mm, b.heldout_rms_after_mm));
-  }
-  same = same && worst_sigma <= 0.1 && worst_rel <= 0.01;
-  char line[200];
-  std::snprintf(line, sizeof(line),
-                "%s (%zu findings; max |d magnitude| %.1e sigma, max held-out "
-                "change %.1e)",
-                same ? "same result" : "RESULT CHANGED", after.findings.size(),
-                worst_sigma, worst_rel);
-  return line;
-}
-
 // One diagnosis timed: wall and process CPU seconds.
 DiagnosisResult Timed(const Robot& robot, const Observations& obs,
                       const DiagnoseOptions& o, double* wall, double* cpu) {
@@ -146,11 +105,6 @@ DiagnosisResult Timed(const Robot& robot, const Observations& obs,
   return r;
 }
 
-// UR10 series C (../shared/data), if present: wall and CPU seconds of the
-// full diagnosis (default options, full catalogue) at 240 and 2773 poses,
-// the path before (DiagnoseOptions::exact_jacobian = false: Ceres autodiff
-// refits, as on main before the speed-up) and now, in one run; medians of
-// `repeat` runs each, and the comparison of the results.
 // UR10 series C from ../shared/data and its every 11th pose (240); false
 // (with a line saying so) when the data are absent.
 bool LoadUr10SeriesC(const char* tag, Robot* ur10, Observations* all,
@@ -171,6 +125,9 @@ bool LoadUr10SeriesC(const char* tag, Robot* ur10, Observations* all,
   return true;
 }
 
+// UR10 series C (../shared/data), if present: wall and CPU seconds of the
+// full diagnosis (default options, full catalogue) at 240 and 2773 poses,
+// medians of `repeat` runs.
 void Ur10Timing(int repeat, bool small_only) {
   Robot ur10;
   Observations all, small;
@@ -181,79 +138,20 @@ void Ur10Timing(int repeat, bool small_only) {
       repeat);
   for (const Observations* obs : {&small, &all}) {
     if (small_only && obs == &all) break;
-    DiagnosisResult results[2];
-    for (int fast = 0; fast < 2; ++fast) {
-      DiagnoseOptions o;
-      o.exact_jacobian = fast == 1;
-      std::vector<double> walls, cpus;
-      for (int run = 0; run < repeat; ++run) {
-        double wall = 0, cpu = 0;
-        results[fast] = Timed(ur10, *obs, o, &wall, &cpu);
-        walls.push_back(wall);
-        cpus.push_back(cpu);
-      }
-      std::sort(walls.begin(), walls.end());
-      std::sort(cpus.begin(), cpus.end());
-      std::printf(
-          "  %4zu poses, %-26s: %6.2f s wall, %6.2f s CPU, held-out %.4f -> "
-          "%.4f mm\n",
-          obs->rows.size(),
-          fast ? "now (exact Jacobian)" : "before (Ceres autodiff)",
-          walls[repeat / 2], cpus[repeat / 2],
-          results[fast].nominal_heldout_rms_mm,
-          results[fast].final_heldout_rms_mm);
+    DiagnosisResult result;
+    std::vector<double> walls, cpus;
+    for (int run = 0; run < repeat; ++run) {
+      double wall = 0, cpu = 0;
+      result = Timed(ur10, *obs, DiagnoseOptions{}, &wall, &cpu);
+      walls.push_back(wall);
+      cpus.push_back(cpu);
     }
-    std::printf("  %4zu poses: %s\n", obs->rows.size(),
-                Compare(results[0], results[1]).c_str());
-  }
-}
-
-// The diagnose tests' simulated cases (diagnose/model_diagnosis_test.cc,
-// diagnose/families_test.cc), before and now: timing and comparison.
-void CompareTestCases() {
-  const Robot bh7 = Bh7();
-  const Robot ur10 =
-      ReadRobotYaml(std::string(KINCAL_SOURCE_DIR) + "/data/robots/ur10.yaml");
-  struct Case {
-    const Robot* robot;
-    std::vector<std::string> effects;
-    uint64_t seed;
-    int poses;
-    double noise;
-  };
-  const std::vector<Case> cases = {
-      {&bh7, {"backlash:j3:0.1"}, 11, 240, 0.03},
-      {&bh7, {}, 12, 240, 0.03},
-      {&bh7, {"axis_tilt:j3:0.1"}, 13, 240, 0.03},
-      {&bh7, {"cyclic:j2:0.05"}, 14, 240, 0.03},
-      {&bh7, {"compliance:j5:0.2"}, 15, 240, 0.03},
-      {&bh7, {"cyclic2:j3:0.05"}, 16, 240, 0.03},
-      {&bh7, {"gain:j1:0.004"}, 17, 200, 0.03},
-      {&ur10, {"elastostatic:shoulder_lift_joint:0.05"}, 31, 240, 0.03},
-      {&ur10, {"mount_compliance:0.03"}, 32, 240, 0.03},
-      {&ur10,
-       {"thermal:shoulder_lift_joint:0.3", "thermal:elbow_joint:0.3"},
-       33,
-       240,
-       0.03},
-      {&ur10, {}, 34, 240, 0.03},
-  };
-  std::printf("== the diagnose tests' cases: before / now (CPU seconds)\n");
-  for (const Case& c : cases) {
-    const SimulatedSession s =
-        Sim(*c.robot, c.effects, c.seed, c.poses, c.noise);
-    DiagnosisResult r[2];
-    double cpu[2], wall[2];
-    for (int fast = 0; fast < 2; ++fast) {
-      DiagnoseOptions o;
-      o.exact_jacobian = fast == 1;
-      r[fast] = Timed(s.nominal, s.observations, o, &wall[fast], &cpu[fast]);
-    }
-    std::string label = c.robot->name;
-    for (const std::string& e : c.effects) label += " " + e;
-    if (c.effects.empty()) label += " null";
-    std::printf("  %-60s %5.2f / %5.2f s: %s\n", label.c_str(), cpu[0], cpu[1],
-                Compare(r[0], r[1]).c_str());
+    std::sort(walls.begin(), walls.end());
+    std::sort(cpus.begin(), cpus.end());
+    std::printf(
+        "  %4zu poses: %6.2f s wall, %6.2f s CPU, held-out %.4f -> %.4f mm\n",
+        obs->rows.size(), walls[repeat / 2], cpus[repeat / 2],
+        result.nominal_heldout_rms_mm, result.final_heldout_rms_mm);
   }
 }
 
@@ -528,7 +426,6 @@ int main(int argc, char** argv) {
   if (only.empty() || only == "timing") kincal::Timing(bh7);
   if (only == "ur10") kincal::Ur10Timing(repeat, false);
   if (only == "ur10-240") kincal::Ur10Timing(repeat, true);
-  if (only == "compare") kincal::CompareTestCases();
   if (only == "cv") kincal::CvUr10(repeat);
   if (only == "cv-sim") kincal::CvSimulated(runs);
   if (only.empty() || only == "backlash") kincal::SmallestBacklash(bh7, runs);

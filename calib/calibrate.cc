@@ -5,38 +5,16 @@
 #include <cmath>
 #include <functional>
 #include <map>
-#include <random>
 #include <set>
 #include <stdexcept>
+#include <utility>
 
+#include "calib/free_fit.h"
+#include "calib/holdout.h"
 #include "calib/paper_method.h"
 #include "data/error.h"
 
 namespace kincal {
-
-void SplitHoldout(const std::vector<Measurement>& ms, double fraction,
-                  uint64_t seed, std::vector<int>* train,
-                  std::vector<int>* heldout) {
-  train->clear();
-  heldout->clear();
-  std::map<int, std::vector<int>> groups;  // -1 = measured points
-  for (size_t i = 0; i < ms.size(); ++i) {
-    groups[ms[i].kind == Measurement::kMeasured ? -1 : ms[i].point].push_back(
-        static_cast<int>(i));
-  }
-  std::mt19937_64 rng(seed);
-  for (auto& kv : groups) {
-    std::vector<int>& idx = kv.second;
-    std::shuffle(idx.begin(), idx.end(), rng);
-    const int n = static_cast<int>(idx.size());
-    const int min_train = kv.first < 0 ? 10 : 3;
-    int hold = static_cast<int>(std::lround(fraction * n));
-    hold = std::max(0, std::min(hold, n - min_train));
-    for (int k = 0; k < n; ++k) (k < hold ? heldout : train)->push_back(idx[k]);
-  }
-  std::sort(train->begin(), train->end());
-  std::sort(heldout->begin(), heldout->end());
-}
 
 std::vector<double> CentroidDistances(const ModelState& state,
                                       const std::vector<Measurement>& ms) {
@@ -57,13 +35,6 @@ std::vector<double> CentroidDistances(const ModelState& state,
 }
 
 namespace {
-
-std::vector<Measurement> Pick(const std::vector<Measurement>& ms,
-                              const std::vector<int>& idx) {
-  std::vector<Measurement> out;
-  for (int i : idx) out.push_back(ms[i]);
-  return out;
-}
 
 // --free NAME: a parameter (j2.beta), or a joint-error family without a
 // joint (compliance, gain, ...): that entry of every joint.
@@ -160,79 +131,113 @@ std::vector<double> Norms(const ModelState& state,
   return out;
 }
 
-}  // namespace
+// Calibrate's geometry fit in its steps (FitGeometry): the first look, the
+// passes of fit -> identifiability at the solution, the bounds widened
+// where the data press against them, the final refit.
+class GeometryFitRun {
+ public:
+  GeometryFitRun(const GeometryProblem& problem,
+                 const CalibrateOptions& options, ModelState* state)
+      : problem_(problem),
+        options_(options),
+        state_(state),
+        train_(*problem.train),
+        nominal_(*problem.nominal) {
+    joint_errors_ = std::any_of(
+        problem.candidates.begin(), problem.candidates.end(),
+        [](const ParamInfo& p) { return p.kind == ParamKind::kJointError; });
+  }
 
-GeometryFit FitGeometry(
-    const Observations& obs, const Chain& nominal_chain, bool bounds_stated,
-    const std::vector<ParamInfo>& candidates, double registered_sigma0_mm,
-    const std::vector<PointDistance>& distances,
-    const CalibrateOptions& options,
-    const std::function<void(const Identifiability&)>& check,
-    std::vector<Measurement>* train, std::vector<Measurement>* held,
-    ModelState* state, const GeometryFitter& fitter) {
-  GeometryFit g;
+  GeometryFit Run() {
+    FirstLook();
+    InitFitOptions();
+    g_.fit = LeastSquares(g_.identifiability.identifiable);
+    IdentifiabilityPass pass;
+    pass.num_free = static_cast<int>(g_.identifiability.identifiable.size());
+    pass.train_rms_mm = g_.fit.final_rms_mm;
+    g_.passes.push_back(pass);
+    g_.first_set = NamesOf(g_.identifiability.identifiable);
+    seen_ = {g_.first_set};
+    if (options_.fit_geometry) RunPasses();
+    if (options_.fit_geometry && options_.method != CalibrateOptions::kPaper &&
+        !problem_.bounds_stated && WidenPressedBounds()) {
+      RunPasses();  // the free set where the widened fit ended
+    }
+    // The inputs of the final fit from the geometry it starts at, so that
+    // the calibrated model (whose `evaluate` computes them from its own
+    // geometry) predicts what was fitted.
+    if (joint_errors_ && options_.method != CalibrateOptions::kPaper) {
+      RefreshInputs();
+      g_.fit = LeastSquares(g_.identifiability.identifiable);
+    }
+    for (const ParamInfo& p : Pressed()) g_.at_bound.push_back(p.name);
+    g_.fit_options = fit_;
+    g_.fit_options.bounds_center = nullptr;  // the caller's nominal chain
+    return g_;
+  }
+
+ private:
+  static std::set<std::string> NamesOf(const std::vector<ParamInfo>& ps) {
+    std::set<std::string> out;
+    for (const ParamInfo& p : ps) out.insert(p.name);
+    return out;
+  }
+
   // First look, at the start values: structural redundancy (the sine test)
   // and, with a noise level of a fraction of the registered misfit, the
   // parameters so weakly determined that a first fit would send them
   // across the admissible range (a Panda's joint-7 tilt with single-point
   // data) and into another minimum.
-  IdentifiabilityOptions first_look = options.identifiability;
-  if (options.fit_geometry && options.first_look_noise_fraction > 0 &&
-      first_look.noise_sigma_mm <= 0) {
-    first_look.noise_sigma_mm =
-        options.first_look_noise_fraction * registered_sigma0_mm;
+  void FirstLook() {
+    IdentifiabilityOptions first_look = options_.identifiability;
+    if (options_.fit_geometry && options_.first_look_noise_fraction > 0 &&
+        first_look.noise_sigma_mm <= 0) {
+      first_look.noise_sigma_mm =
+          options_.first_look_noise_fraction * problem_.registered_sigma0_mm;
+    }
+    g_.identifiability = AnalyzeIdentifiability(
+        train_, *state_, problem_.candidates, first_look, problem_.distances);
+    HoldWeakJointErrors(train_, *state_, first_look, &g_.identifiability);
+    if (problem_.check) problem_.check(g_.identifiability);
   }
-  g.identifiability =
-      AnalyzeIdentifiability(*train, *state, candidates, first_look, distances);
-  HoldWeakJointErrors(*train, *state, first_look, &g.identifiability);
-  check(g.identifiability);
-  const int num_free = static_cast<int>(g.identifiability.identifiable.size());
-  FitOptions fit;
-  fit.bounds_center = &nominal_chain;
-  fit.loss = options.loss;
-  fit.loss_scale_mm = options.loss_scale_mm;
-  fit.distances = distances;
-  // The automatic ridge: on for single-point data only.
-  const bool measured = std::any_of(
-      train->begin(), train->end(),
-      [](const Measurement& m) { return m.kind == Measurement::kMeasured; });
-  fit.prior_weight = options.prior_weight >= 0 ? options.prior_weight
-                     : measured                ? 0.0
-                                               : 1.0;
-  g.prior_weight = fit.prior_weight;
+
+  void InitFitOptions() {
+    fit_.bounds_center = &nominal_;
+    fit_.loss = options_.loss;
+    fit_.loss_scale_mm = options_.loss_scale_mm;
+    fit_.distances = problem_.distances;
+    // The automatic ridge: on for single-point data only.
+    const bool measured = std::any_of(
+        train_.begin(), train_.end(),
+        [](const Measurement& m) { return m.kind == Measurement::kMeasured; });
+    fit_.prior_weight = options_.prior_weight >= 0 ? options_.prior_weight
+                        : measured                 ? 0.0
+                                                   : 1.0;
+    g_.prior_weight = fit_.prior_weight;
+  }
+
   // Least squares for the passes (the seed's eq. (9), --method paper, runs
-  // once on the final set, in Calibrate).
-  auto lsq_fit = [&](const std::vector<ParamInfo>& free) {
-    fit.free = free;
-    return fitter ? fitter(*train, fit, state) : Fit(*train, fit, state);
-  };
+  // once on the final set, in Calibrate), by the problem's solver.
+  FitSummary LeastSquares(const std::vector<ParamInfo>& free) {
+    fit_.free = free;
+    if (problem_.solver == GeometrySolver::kExactJacobian)
+      return FreeFitWithCovariance(train_, FreeFitOptionsFrom(fit_), state_);
+    return Fit(train_, fit_, state_);
+  }
+
   // Joint-error families multiply inputs computed from the geometry (the
   // gravity torque of compliance and elastostatic): computed from the
   // nominal model at first, they are recomputed from the fitted one before
   // each pass. A tool offset the nominal model lacks (the MUKCa ball sits
   // 7 mm off the flange axis, the nominal one on it) otherwise leaves joint
-  // 7's torque ~0 in the fit and ~5 mm in every prediction: measured 1.24 mm
-  // held-out RMS instead of 0.25 on panda_4 with --free compliance.
-  const bool joint_errors = std::any_of(
-      candidates.begin(), candidates.end(),
-      [](const ParamInfo& p) { return p.kind == ParamKind::kJointError; });
-  auto refresh_inputs = [&]() {
-    const std::vector<PoseInput> inputs = MakePoseInputs(state->chain, obs);
-    for (Measurement& m : *train) m.input = inputs[m.row];
-    if (held != nullptr)
-      for (Measurement& m : *held) m.input = inputs[m.row];
-  };
-  auto names_of = [](const std::vector<ParamInfo>& ps) {
-    std::set<std::string> out;
-    for (const ParamInfo& p : ps) out.insert(p.name);
-    return out;
-  };
-  g.fit = lsq_fit(g.identifiability.identifiable);
-  {
-    IdentifiabilityPass pass;
-    pass.num_free = num_free;
-    pass.train_rms_mm = g.fit.final_rms_mm;
-    g.passes.push_back(pass);
+  // 7's torque ~0 in the fit and ~5 mm in every prediction (docs/
+  // CALIBRATION.md).
+  void RefreshInputs() {
+    const std::vector<PoseInput> inputs =
+        MakePoseInputs(state_->chain, *problem_.obs);
+    for (Measurement& m : train_) m.input = inputs[m.row];
+    if (problem_.held != nullptr)
+      for (Measurement& m : *problem_.held) m.input = inputs[m.row];
   }
 
   // Identifiability at the solution, not at the guess: a nominal model with
@@ -243,53 +248,62 @@ GeometryFit FitGeometry(
   // set keeps its value (a jump back to nominal would throw away the fit
   // and can land LM in another minimum) and may come back in a later pass.
   // A pass whose fit ends worse than the one before is undone.
-  const std::set<std::string> first_set =
-      names_of(g.identifiability.identifiable);
-  std::vector<std::set<std::string>> seen = {first_set};
-  auto run_passes = [&]() {
-    for (int k = 1; k < options.max_identifiability_passes; ++k) {
-      if (!(g.fit.sigma0_mm > 0)) break;
-      if (joint_errors) refresh_inputs();
-      IdentifiabilityOptions at = options.identifiability;
-      at.noise_sigma_mm = g.fit.sigma0_mm;
-      Identifiability next =
-          AnalyzeIdentifiability(*train, *state, candidates, at, distances);
-      HoldWeakJointErrors(*train, *state, at, &next);
+  void RunPasses() {
+    for (int k = 1; k < options_.max_identifiability_passes; ++k) {
+      if (!(g_.fit.sigma0_mm > 0)) break;
+      if (joint_errors_) RefreshInputs();
+      IdentifiabilityOptions at = options_.identifiability;
+      at.noise_sigma_mm = g_.fit.sigma0_mm;
+      Identifiability next = AnalyzeIdentifiability(
+          train_, *state_, problem_.candidates, at, problem_.distances);
+      HoldWeakJointErrors(train_, *state_, at, &next);
       const std::set<std::string> now =
-          names_of(g.identifiability.identifiable);
-      const std::set<std::string> then = names_of(next.identifiable);
+          NamesOf(g_.identifiability.identifiable);
+      const std::set<std::string> then = NamesOf(next.identifiable);
       if (then == now) {
-        g.identifiability = next;
+        g_.identifiability = next;
         break;
       }
       IdentifiabilityPass pass;
       for (const ParamInfo& p : next.identifiable)
         if (!now.count(p.name)) pass.freed.push_back(p.name);
-      for (const ParamInfo& p : g.identifiability.identifiable)
+      for (const ParamInfo& p : g_.identifiability.identifiable)
         if (!then.count(p.name)) pass.held.push_back(p.name);
       const bool cycle =
-          std::find(seen.begin(), seen.end(), then) != seen.end();
-      seen.push_back(then);
-      const ModelState before_state = *state;
-      const FitSummary before_fit = g.fit;
-      FitSummary refit = lsq_fit(next.identifiable);
+          std::find(seen_.begin(), seen_.end(), then) != seen_.end();
+      seen_.push_back(then);
+      const ModelState before_state = *state_;
+      const FitSummary before_fit = g_.fit;
+      FitSummary refit = LeastSquares(next.identifiable);
       pass.num_free = static_cast<int>(next.identifiable.size());
       pass.train_rms_mm = refit.final_rms_mm;
       if (!(refit.final_rms_mm <=
             before_fit.final_rms_mm * (1 + 1e-6) + 1e-9)) {
         pass.undone = true;
-        g.passes.push_back(pass);
-        *state = before_state;
-        g.fit = before_fit;
+        g_.passes.push_back(pass);
+        *state_ = before_state;
+        g_.fit = before_fit;
         break;
       }
-      g.passes.push_back(pass);
-      g.identifiability = next;
-      g.fit = refit;
+      g_.passes.push_back(pass);
+      g_.identifiability = next;
+      g_.fit = refit;
       if (cycle) break;  // a set seen before: stop on this fit
     }
-  };
-  if (options.fit_geometry) run_passes();
+  }
+
+  // Free row parameters that end on their bound.
+  std::vector<ParamInfo> Pressed() const {
+    std::vector<ParamInfo> out;
+    for (const ParamInfo& p : g_.fit.params) {
+      if (p.kind != ParamKind::kRow) continue;
+      const double bound = RowBound(nominal_, p, fit_);
+      const double center = nominal_.rows.at(p.block).p.at(p.index);
+      const double deviation = std::abs(ParamValue(*state_, p) - center);
+      if (deviation >= bound * (1 - 1e-6)) out.push_back(p);
+    }
+    return out;
+  }
 
   // Bounds the data press against. Bounds the robot file does not state
   // (a URDF's 20 mm / 10 deg, a robot.yaml without `bounds:`) are a guess
@@ -303,63 +317,54 @@ GeometryFit FitGeometry(
   // the fit repeated, kept when it fits better by more than 1 %; at most
   // kMaxWidenings doublings, angles up to 180 deg. Stated bounds (the
   // seed's |x - t0| <= delta) are kept; parameters on them are reported.
-  auto pressed = [&]() {
-    std::vector<ParamInfo> out;
-    for (size_t i = 0; i < g.fit.params.size(); ++i) {
-      const ParamInfo& p = g.fit.params[i];
-      if (p.kind != ParamKind::kRow) continue;
-      const double bound = RowBound(nominal_chain, p, fit);
-      const double center = nominal_chain.rows.at(p.block).p.at(p.index);
-      const double deviation = std::abs(ParamValue(*state, p) - center);
-      if (deviation >= bound * (1 - 1e-6)) out.push_back(p);
-    }
-    return out;
-  };
-  if (options.fit_geometry && options.method != CalibrateOptions::kPaper &&
-      !bounds_stated) {
+  // True when a widened fit was kept.
+  bool WidenPressedBounds() {
     constexpr int kMaxWidenings = 4;
     bool widened_any = false;
     for (int round = 0; round < kMaxWidenings; ++round) {
-      const ModelState before_state = *state;
-      const FitSummary before_fit = g.fit;
-      const std::map<std::string, double> before_bounds = fit.bound_override;
+      const ModelState before_state = *state_;
+      const FitSummary before_fit = g_.fit;
+      const std::map<std::string, double> before_bounds = fit_.bound_override;
       std::vector<WidenedBound> widened;
-      for (const ParamInfo& p : pressed()) {
-        const double from = RowBound(nominal_chain, p, fit);
+      for (const ParamInfo& p : Pressed()) {
+        const double from = RowBound(nominal_, p, fit_);
         const double to = p.angle ? std::min(2 * from, M_PI) : 2 * from;
         if (!(to > from)) continue;
-        fit.bound_override[p.name] = to;
+        fit_.bound_override[p.name] = to;
         widened.push_back({p.name, p.ToInterface(from), p.ToInterface(to)});
       }
       if (widened.empty()) break;
-      FitSummary refit = lsq_fit(g.identifiability.identifiable);
+      FitSummary refit = LeastSquares(g_.identifiability.identifiable);
       if (!(refit.final_rms_mm < 0.99 * before_fit.final_rms_mm)) {
-        *state = before_state;
-        g.fit = before_fit;
-        fit.bound_override = before_bounds;
+        *state_ = before_state;
+        g_.fit = before_fit;
+        fit_.bound_override = before_bounds;
         break;
       }
-      g.fit = refit;
-      g.widened_bounds.insert(g.widened_bounds.end(), widened.begin(),
-                              widened.end());
+      g_.fit = refit;
+      g_.widened_bounds.insert(g_.widened_bounds.end(), widened.begin(),
+                               widened.end());
       widened_any = true;
     }
-    // The free set where the widened fit ended.
-    if (widened_any) run_passes();
+    return widened_any;
   }
 
-  // The inputs of the final fit from the geometry it starts at, so that the
-  // calibrated model (whose `evaluate` computes them from its own geometry)
-  // predicts what was fitted.
-  if (joint_errors && options.method != CalibrateOptions::kPaper) {
-    refresh_inputs();
-    g.fit = lsq_fit(g.identifiability.identifiable);
-  }
-  for (const ParamInfo& p : pressed()) g.at_bound.push_back(p.name);
-  g.first_set = first_set;
-  g.fit_options = fit;
-  g.fit_options.bounds_center = nullptr;  // the caller's nominal chain
-  return g;
+  const GeometryProblem& problem_;
+  const CalibrateOptions& options_;
+  ModelState* state_;
+  std::vector<Measurement>& train_;
+  const Chain& nominal_;
+  bool joint_errors_ = false;
+  FitOptions fit_;
+  GeometryFit g_;
+  std::vector<std::set<std::string>> seen_;
+};
+
+}  // namespace
+
+GeometryFit FitGeometry(const GeometryProblem& problem,
+                        const CalibrateOptions& options, ModelState* state) {
+  return GeometryFitRun(problem, options, state).Run();
 }
 
 namespace {
@@ -430,9 +435,17 @@ void CalibrateOn(const Observations& obs, const Chain& nominal_chain,
                            " distinct training poses (more for a useful fit)");
     }
   };
-  GeometryFit g = FitGeometry(obs, nominal_chain, bounds_stated, candidates,
-                              registered.sigma0_mm, distances, options, check,
-                              &train, others, &state);
+  GeometryProblem problem;
+  problem.obs = &obs;
+  problem.nominal = &nominal_chain;
+  problem.bounds_stated = bounds_stated;
+  problem.candidates = candidates;
+  problem.registered_sigma0_mm = registered.sigma0_mm;
+  problem.distances = distances;
+  problem.train = &train;
+  problem.held = others;
+  problem.check = check;
+  GeometryFit g = FitGeometry(problem, options, &state);
   result.identifiability = g.identifiability;
   result.passes = g.passes;
   result.fit = g.fit;
@@ -469,6 +482,58 @@ void CalibrateOn(const Observations& obs, const Chain& nominal_chain,
   }
 }
 
+// The known distances of options.distances between fixed points of `state`
+// (InputError for a label the data lack).
+std::vector<PointDistance> PointDistances(const CalibrateOptions& options,
+                                          const ModelState& state,
+                                          const Observations& obs) {
+  std::vector<PointDistance> distances;
+  for (const FixedDistance& d : options.distances) {
+    PointDistance pd;
+    pd.a = state.PointIndex(d.a);
+    pd.b = state.PointIndex(d.b);
+    if (pd.a < 0 || pd.b < 0) {
+      throw InputError("--fixed-distance " + d.a + "," + d.b +
+                       ": no fixed_point label '" + (pd.a < 0 ? d.a : d.b) +
+                       "' in " + obs.source);
+    }
+    pd.distance_mm = d.distance_mm;
+    pd.weight = options.distance_weight;
+    distances.push_back(pd);
+  }
+  return distances;
+}
+
+// Held-out rows beyond the gross-error threshold (axis_sigma x options.
+// outlier_sigmas under result->state) are listed in result->outliers and
+// left out of the held-out figures, as the training ones; unless more than
+// a quarter are (a model that predicts badly, not gross rows: all are kept,
+// so the held-out figures cannot flatter it). Returns the rows kept.
+std::vector<Measurement> HeldOutWithoutGross(
+    const Observations& obs, const std::vector<Measurement>& held,
+    double axis_sigma, const CalibrateOptions& options,
+    CalibrateResult* result) {
+  const ModelState& state = result->state;
+  std::vector<Measurement> kept;
+  const std::vector<double> norms = Norms(state, held);
+  const std::vector<char> flags =
+      FlagGross(norms, axis_sigma, options.outlier_sigmas);
+  const size_t flagged = std::count(flags.begin(), flags.end(), 1);
+  const bool leave_out = 4 * flagged <= held.size();
+  for (size_t i = 0; i < held.size(); ++i) {
+    if (!flags[i] || !leave_out) kept.push_back(held[i]);
+    if (!flags[i]) continue;
+    RowOutlier o =
+        DescribeOutlier(state, held[i], obs.rows[held[i].row].pose, norms[i],
+                        axis_sigma, options.outlier_sigmas);
+    o.heldout = true;
+    o.excluded = leave_out;
+    result->outliers.push_back(o);
+  }
+  if (!leave_out) result->outliers_too_many = true;
+  return kept;
+}
+
 }  // namespace
 
 CalibrateResult Calibrate(const Robot& nominal, const Observations& obs,
@@ -497,24 +562,14 @@ CalibrateResult Calibrate(const Robot& nominal, const Observations& obs,
                          " usable rows have the same joint readings: one pose "
                          "determines no robot parameter");
   }
-  std::vector<PointDistance> distances;
-  for (const FixedDistance& d : options.distances) {
-    PointDistance pd;
-    pd.a = state.PointIndex(d.a);
-    pd.b = state.PointIndex(d.b);
-    if (pd.a < 0 || pd.b < 0) {
-      throw InputError("--fixed-distance " + d.a + "," + d.b +
-                       ": no fixed_point label '" + (pd.a < 0 ? d.a : d.b) +
-                       "' in " + obs.source);
-    }
-    pd.distance_mm = d.distance_mm;
-    pd.weight = options.distance_weight;
-    distances.push_back(pd);
-  }
+  const std::vector<PointDistance> distances =
+      PointDistances(options, state, obs);
 
-  SplitHoldout(all, options.holdout_fraction, options.seed, &result.train_rows,
-               &result.heldout_rows);
-  const std::vector<Measurement> all_train = Pick(all, result.train_rows);
+  HoldoutSplit split =
+      SplitHoldout(all, options.holdout_fraction, options.seed);
+  result.train_rows = std::move(split.train);
+  result.heldout_rows = std::move(split.heldout);
+  const std::vector<Measurement> all_train = PickRows(all, result.train_rows);
   std::vector<Measurement> train, held;
   const ModelState initial = state;
 
@@ -541,7 +596,7 @@ CalibrateResult Calibrate(const Robot& nominal, const Observations& obs,
     train.clear();
     // The rows out of the fit ride along with the held-out ones so that
     // their joint-error inputs follow the fitted geometry too.
-    std::vector<Measurement> others = Pick(all, result.heldout_rows);
+    std::vector<Measurement> others = PickRows(all, result.heldout_rows);
     for (size_t i = 0; i < all_train.size(); ++i)
       (excluded[i] ? others : train).push_back(all_train[i]);
     CalibrateOn(obs, nominal_chain, nominal.bounds_stated, distinct, distances,
@@ -579,30 +634,7 @@ CalibrateResult Calibrate(const Robot& nominal, const Observations& obs,
     o.excluded = excluded[i] != 0;
     result.outliers.push_back(o);
   }
-  // Held-out rows beyond the same threshold are listed and left out of the
-  // held-out figures, as the training ones; unless more than a quarter are
-  // (a model that predicts badly, not gross rows: all are kept, so the
-  // held-out figures cannot flatter it).
-  {
-    std::vector<Measurement> kept;
-    const std::vector<double> norms = Norms(state, held);
-    const std::vector<char> flags =
-        FlagGross(norms, axis_sigma, options.outlier_sigmas);
-    const size_t flagged = std::count(flags.begin(), flags.end(), 1);
-    const bool leave_out = 4 * flagged <= held.size();
-    for (size_t i = 0; i < held.size(); ++i) {
-      if (!flags[i] || !leave_out) kept.push_back(held[i]);
-      if (!flags[i]) continue;
-      RowOutlier o =
-          DescribeOutlier(state, held[i], obs.rows[held[i].row].pose, norms[i],
-                          axis_sigma, options.outlier_sigmas);
-      o.heldout = true;
-      o.excluded = leave_out;
-      result.outliers.push_back(o);
-    }
-    if (!leave_out) result.outliers_too_many = true;
-    held = kept;
-  }
+  held = HeldOutWithoutGross(obs, held, axis_sigma, options, &result);
   result.train = ComputeErrorStats(Norms(state, train));
   result.heldout = ComputeErrorStats(Norms(state, held));
   for (size_t i = 0; i < distances.size(); ++i) {

@@ -126,21 +126,32 @@ struct CalibrateResult {
 CalibrateResult Calibrate(const Robot& nominal, const Observations& obs,
                           const CalibrateOptions& options);
 
-// The geometry from the nominal model, as `calibrate` fits it, for callers
-// with measurements of their own (diagnose's base model):
-//   1. the first look at the start values: the sine test and, with a noise
-//      level of options.first_look_noise_fraction x `registered_sigma0_mm`
-//      (the misfit after registering the frame / points), the parameters
-//      too weak to free;
-//   2. `check` on that set (callers throw their InputError there);
-//   3. fit, identifiability at the solution, refit, until the free set is
-//      stable (at most options.max_identifiability_passes);
-//   4. bounds the robot does not state (`bounds_stated` false) widened where
-//      a free parameter ends on them (CalibrateResult::widened_bounds).
-// `state` holds the registered frame / points on entry, the fitted model on
-// return. Joint-error candidates' inputs are recomputed from the fitted
-// geometry (from `obs`) in `train` and `held` (may be null). Least squares
-// only: options.method is not used.
+// The least-squares solver of the geometry's fits: calib/fit.h's Fit
+// (Ceres, autodiff through the chain; `calibrate`) or Levenberg-Marquardt on
+// the exact Jacobian (calib/free_fit.h FreeFitWithCovariance; the base model
+// of `diagnose`). Same problem and bounds.
+enum class GeometrySolver { kCeres, kExactJacobian };
+
+// What FitGeometry fits: the training rows of `obs` from the nominal model.
+struct GeometryProblem {
+  const Observations* obs = nullptr;  // the rows' source
+  const Chain* nominal = nullptr;     // start and centre of the bounds
+  bool bounds_stated = false;         // Robot::bounds_stated
+  // The parameters the fit may free: frame / points, geometry, extras.
+  std::vector<ParamInfo> candidates;
+  // The misfit after registering the frame / points, per axis (mm).
+  double registered_sigma0_mm = 0.0;
+  std::vector<PointDistance> distances;
+  // Training rows, and held-out rows (may be null): their joint-error
+  // inputs are recomputed from the fitted geometry.
+  std::vector<Measurement>* train = nullptr;
+  std::vector<Measurement>* held = nullptr;
+  // Called with the first look's free set (callers throw their InputError
+  // there); may be empty.
+  std::function<void(const Identifiability&)> check;
+  GeometrySolver solver = GeometrySolver::kCeres;
+};
+
 struct GeometryFit {
   Identifiability identifiability;  // of the final pass
   std::vector<IdentifiabilityPass> passes;
@@ -153,23 +164,21 @@ struct GeometryFit {
   std::vector<WidenedBound> widened_bounds;
   std::vector<std::string> at_bound;
 };
-// The least-squares fit FitGeometry runs: calib/fit.h's Fit when empty.
-using GeometryFitter = std::function<FitSummary(
-    const std::vector<Measurement>&, const FitOptions&, ModelState*)>;
-GeometryFit FitGeometry(
-    const Observations& obs, const Chain& nominal_chain, bool bounds_stated,
-    const std::vector<ParamInfo>& candidates, double registered_sigma0_mm,
-    const std::vector<PointDistance>& distances,
-    const CalibrateOptions& options,
-    const std::function<void(const Identifiability&)>& check,
-    std::vector<Measurement>* train, std::vector<Measurement>* held,
-    ModelState* state, const GeometryFitter& fitter = nullptr);
 
-// Splits measurement indices into train / held-out, seeded; fixed-point
-// groups are split per group so that each keeps at least 3 training poses.
-void SplitHoldout(const std::vector<Measurement>& measurements, double fraction,
-                  uint64_t seed, std::vector<int>* train,
-                  std::vector<int>* heldout);
+// The geometry from the nominal model, as `calibrate` fits it, for callers
+// with measurements of their own (diagnose's base model):
+//   1. the first look at the start values: the sine test and, with a noise
+//      level of options.first_look_noise_fraction x
+//      problem.registered_sigma0_mm, the parameters too weak to free;
+//   2. problem.check on that set;
+//   3. fit, identifiability at the solution, refit, until the free set is
+//      stable (at most options.max_identifiability_passes);
+//   4. bounds the robot does not state widened where a free parameter ends
+//      on them (CalibrateResult::widened_bounds).
+// `state` holds the registered frame / points on entry, the fitted model on
+// return. Least squares only: options.method is not used.
+GeometryFit FitGeometry(const GeometryProblem& problem,
+                        const CalibrateOptions& options, ModelState* state);
 
 // The seed's epsilon for fixed-point measurements: for each group, distances
 // of the model tips to the group's centroid.

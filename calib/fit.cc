@@ -244,12 +244,13 @@ Eigen::Vector3d Residual(const ModelState& state, const Measurement& m) {
   return tip - Eigen::Vector3d(p[0], p[1], p[2]);
 }
 
-FitSummary Fit(const std::vector<Measurement>& measurements,
-               const FitOptions& options, ModelState* state) {
-  const auto start = std::chrono::steady_clock::now();
-  KINCAL_CHECK(!measurements.empty(), "no measurements to fit");
-  FitSummary summary;
-  ceres::Problem problem;
+namespace {
+
+// The tip residual of every measurement (with the robust loss) and the
+// known distances' residuals.
+void AddResiduals(const std::vector<Measurement>& measurements,
+                  const FitOptions& options, ModelState* state,
+                  ceres::Problem* problem) {
   // The free entries of each block: the only columns the tip residuals
   // differentiate.
   std::map<const double*, std::vector<int>> free_entries;
@@ -271,32 +272,38 @@ FitSummary Fit(const std::vector<Measurement>& measurements,
       auto it = free_entries.find(blocks[b]);
       if (it != free_entries.end()) entries[b] = it->second;
     }
-    problem.AddResidualBlock(new TipCost(state->chain, m, std::move(entries)),
-                             loss, blocks);
+    problem->AddResidualBlock(new TipCost(state->chain, m, std::move(entries)),
+                              loss, blocks);
   }
   for (const PointDistance& d : options.distances) {
-    problem.AddResidualBlock(DistanceResidual::Create(d.distance_mm, d.weight),
-                             nullptr, state->points_in_base.at(d.a).data(),
-                             state->points_in_base.at(d.b).data());
+    problem->AddResidualBlock(DistanceResidual::Create(d.distance_mm, d.weight),
+                              nullptr, state->points_in_base.at(d.a).data(),
+                              state->points_in_base.at(d.b).data());
   }
+}
 
-  // Which entries of each block are free.
+// Holds every entry that is not free (whole blocks constant, or a subset
+// manifold); `params` gets the free parameters the data reach. Returns the
+// free entries of each block.
+std::map<double*, std::vector<bool>> HoldFrozenEntries(
+    const FitOptions& options, ModelState* state, ceres::Problem* problem,
+    std::vector<ParamInfo>* params) {
   std::map<double*, std::vector<bool>> free_mask;
   for (const ParamInfo& p : options.free) {
     double* address = ParamAddress(state, p);
     double* block = address - p.index;
-    if (!problem.HasParameterBlock(block)) continue;  // not in this data
+    if (!problem->HasParameterBlock(block)) continue;  // not in this data
     auto& mask = free_mask[block];
-    mask.resize(problem.ParameterBlockSize(block), false);
+    mask.resize(problem->ParameterBlockSize(block), false);
     mask[p.index] = true;
-    summary.params.push_back(p);
+    params->push_back(p);
   }
   std::vector<double*> blocks;
-  problem.GetParameterBlocks(&blocks);
+  problem->GetParameterBlocks(&blocks);
   for (double* block : blocks) {
     auto it = free_mask.find(block);
     if (it == free_mask.end()) {
-      problem.SetParameterBlockConstant(block);
+      problem->SetParameterBlockConstant(block);
       continue;
     }
     std::vector<int> constant;
@@ -304,39 +311,127 @@ FitSummary Fit(const std::vector<Measurement>& measurements,
       if (!it->second[k]) constant.push_back(static_cast<int>(k));
     }
     if (!constant.empty()) {
-      problem.SetManifold(
+      problem->SetManifold(
           block, new ceres::SubsetManifold(static_cast<int>(it->second.size()),
                                            constant));
     }
   }
-  if (options.bounds_center != nullptr) {
-    const Chain& c = *options.bounds_center;
-    for (const ParamInfo& p : summary.params) {
-      if (p.kind != ParamKind::kRow) continue;
-      double* address = ParamAddress(state, p);
-      const double center = c.rows.at(p.block).p.at(p.index);
-      const double bound = RowBound(c, p, options);
-      problem.SetParameterLowerBound(address - p.index, p.index,
-                                     center - bound);
-      problem.SetParameterUpperBound(address - p.index, p.index,
-                                     center + bound);
-      // Start inside the box.
-      *address = std::min(std::max(*address, center - bound), center + bound);
-    }
-  }
+  return free_mask;
+}
 
-  if (options.bounds_center != nullptr && options.prior_weight > 0) {
-    const Chain& c = *options.bounds_center;
-    for (const ParamInfo& p : summary.params) {
-      if (p.kind != ParamKind::kRow) continue;
-      double* block = ParamAddress(state, p) - p.index;
-      problem.AddResidualBlock(
-          new PriorResidual(problem.ParameterBlockSize(block), p.index,
-                            c.rows.at(p.block).p.at(p.index),
-                            RowBound(c, p, options), options.prior_weight),
-          nullptr, block);
+// With options.bounds_center: the free row entries boxed (and started
+// inside the box) and, with a prior weight, pulled towards the centre.
+void BoxAndPrior(const FitOptions& options,
+                 const std::vector<ParamInfo>& params, ModelState* state,
+                 ceres::Problem* problem) {
+  if (options.bounds_center == nullptr) return;
+  const Chain& c = *options.bounds_center;
+  for (const ParamInfo& p : params) {
+    if (p.kind != ParamKind::kRow) continue;
+    double* address = ParamAddress(state, p);
+    const double center = c.rows.at(p.block).p.at(p.index);
+    const double bound = RowBound(c, p, options);
+    problem->SetParameterLowerBound(address - p.index, p.index, center - bound);
+    problem->SetParameterUpperBound(address - p.index, p.index, center + bound);
+    // Start inside the box.
+    *address = std::min(std::max(*address, center - bound), center + bound);
+  }
+  if (!(options.prior_weight > 0)) return;
+  for (const ParamInfo& p : params) {
+    if (p.kind != ParamKind::kRow) continue;
+    double* block = ParamAddress(state, p) - p.index;
+    problem->AddResidualBlock(
+        new PriorResidual(problem->ParameterBlockSize(block), p.index,
+                          c.rows.at(p.block).p.at(p.index),
+                          RowBound(c, p, options), options.prior_weight),
+        nullptr, block);
+  }
+}
+
+// Levenberg-Marquardt (dense QR) to the options' tolerances.
+void SolveProblem(const FitOptions& options, ceres::Problem* problem,
+                  FitSummary* summary) {
+  if (summary->params.empty()) {
+    summary->converged = true;
+    summary->termination = "nothing to fit";
+    return;
+  }
+  ceres::Solver::Options solver;
+  solver.linear_solver_type = ceres::DENSE_QR;
+  solver.trust_region_strategy_type = ceres::LEVENBERG_MARQUARDT;
+  solver.max_num_iterations = options.max_iterations;
+  solver.function_tolerance = options.function_tolerance;
+  solver.parameter_tolerance = options.parameter_tolerance;
+  solver.gradient_tolerance = 1e-14;
+  solver.num_threads = options.num_threads;
+  solver.logging_type = ceres::SILENT;
+  ceres::Solver::Summary ceres_summary;
+  ceres::Solve(solver, problem, &ceres_summary);
+  summary->converged = ceres_summary.IsSolutionUsable() &&
+                       ceres_summary.termination_type == ceres::CONVERGENCE;
+  summary->termination = ceres_summary.message;
+  summary->iterations = static_cast<int>(ceres_summary.iterations.size());
+}
+
+// The free parameters' covariance sigma0^2 (J^T J)^+ (ceres::Covariance,
+// dense SVD) and their 1-sigma in interface units; left empty (sigmas NaN)
+// when it cannot be computed.
+void ComputeCovariance(const std::map<double*, std::vector<bool>>& free_mask,
+                       ModelState* state, ceres::Problem* problem,
+                       FitSummary* summary) {
+  const int num_params = static_cast<int>(summary->params.size());
+  ceres::Covariance::Options cov_options;
+  cov_options.algorithm_type = ceres::DENSE_SVD;
+  cov_options.null_space_rank = -1;
+  cov_options.min_reciprocal_condition_number = 1e-14;
+  ceres::Covariance covariance(cov_options);
+  std::vector<double*> free_blocks;
+  for (const auto& kv : free_mask) free_blocks.push_back(kv.first);
+  std::vector<std::pair<const double*, const double*>> pairs;
+  for (size_t a = 0; a < free_blocks.size(); ++a) {
+    for (size_t b = a; b < free_blocks.size(); ++b) {
+      pairs.emplace_back(free_blocks[a], free_blocks[b]);
     }
   }
+  if (!covariance.Compute(pairs, problem)) return;
+  summary->covariance.setZero(num_params, num_params);
+  const double scale = summary->sigma0_mm * summary->sigma0_mm;
+  for (int i = 0; i < num_params; ++i) {
+    const ParamInfo& pi = summary->params[i];
+    double* bi = ParamAddress(state, pi) - pi.index;
+    const int si = problem->ParameterBlockSize(bi);
+    for (int j = 0; j < num_params; ++j) {
+      const ParamInfo& pj = summary->params[j];
+      double* bj = ParamAddress(state, pj) - pj.index;
+      const int sj = problem->ParameterBlockSize(bj);
+      std::vector<double> block(si * sj);
+      const bool ok = covariance.GetCovarianceBlock(bi, bj, block.data());
+      if (ok) {
+        summary->covariance(i, j) = scale * block[pi.index * sj + pj.index];
+      }
+    }
+  }
+  for (int i = 0; i < num_params; ++i) {
+    const double var = summary->covariance(i, i);
+    const double sigma_internal = var >= 0 ? std::sqrt(var) : NAN;
+    summary->sigmas[i] = summary->params[i].angle
+                             ? summary->params[i].ToInterface(sigma_internal)
+                             : sigma_internal;
+  }
+}
+
+}  // namespace
+
+FitSummary Fit(const std::vector<Measurement>& measurements,
+               const FitOptions& options, ModelState* state) {
+  const auto start = std::chrono::steady_clock::now();
+  KINCAL_CHECK(!measurements.empty(), "no measurements to fit");
+  FitSummary summary;
+  ceres::Problem problem;
+  AddResiduals(measurements, options, state, &problem);
+  const std::map<double*, std::vector<bool>> free_mask =
+      HoldFrozenEntries(options, state, &problem, &summary.params);
+  BoxAndPrior(options, summary.params, state, &problem);
 
   auto rms = [&]() {
     double sum = 0.0;
@@ -349,27 +444,7 @@ FitSummary Fit(const std::vector<Measurement>& measurements,
     return std::sqrt(sum / measurements.size());
   };
   summary.initial_rms_mm = rms();
-
-  if (!summary.params.empty()) {
-    ceres::Solver::Options solver;
-    solver.linear_solver_type = ceres::DENSE_QR;
-    solver.trust_region_strategy_type = ceres::LEVENBERG_MARQUARDT;
-    solver.max_num_iterations = options.max_iterations;
-    solver.function_tolerance = options.function_tolerance;
-    solver.parameter_tolerance = options.parameter_tolerance;
-    solver.gradient_tolerance = 1e-14;
-    solver.num_threads = options.num_threads;
-    solver.logging_type = ceres::SILENT;
-    ceres::Solver::Summary ceres_summary;
-    ceres::Solve(solver, &problem, &ceres_summary);
-    summary.converged = ceres_summary.IsSolutionUsable() &&
-                        ceres_summary.termination_type == ceres::CONVERGENCE;
-    summary.termination = ceres_summary.message;
-    summary.iterations = static_cast<int>(ceres_summary.iterations.size());
-  } else {
-    summary.converged = true;
-    summary.termination = "nothing to fit";
-  }
+  SolveProblem(options, &problem, &summary);
   summary.final_rms_mm = rms();
 
   const int num_params = static_cast<int>(summary.params.size());
@@ -384,47 +459,8 @@ FitSummary Fit(const std::vector<Measurement>& measurements,
     summary.values[i] =
         summary.params[i].ToInterface(ParamValue(*state, summary.params[i]));
   }
-  if (options.compute_covariance && num_params > 0 && dof > 0) {
-    ceres::Covariance::Options cov_options;
-    cov_options.algorithm_type = ceres::DENSE_SVD;
-    cov_options.null_space_rank = -1;
-    cov_options.min_reciprocal_condition_number = 1e-14;
-    ceres::Covariance covariance(cov_options);
-    std::vector<double*> free_blocks;
-    for (const auto& kv : free_mask) free_blocks.push_back(kv.first);
-    std::vector<std::pair<const double*, const double*>> pairs;
-    for (size_t a = 0; a < free_blocks.size(); ++a) {
-      for (size_t b = a; b < free_blocks.size(); ++b) {
-        pairs.emplace_back(free_blocks[a], free_blocks[b]);
-      }
-    }
-    if (covariance.Compute(pairs, &problem)) {
-      summary.covariance.setZero(num_params, num_params);
-      const double scale = summary.sigma0_mm * summary.sigma0_mm;
-      for (int i = 0; i < num_params; ++i) {
-        const ParamInfo& pi = summary.params[i];
-        double* bi = ParamAddress(state, pi) - pi.index;
-        const int si = problem.ParameterBlockSize(bi);
-        for (int j = 0; j < num_params; ++j) {
-          const ParamInfo& pj = summary.params[j];
-          double* bj = ParamAddress(state, pj) - pj.index;
-          const int sj = problem.ParameterBlockSize(bj);
-          std::vector<double> block(si * sj);
-          const bool ok = covariance.GetCovarianceBlock(bi, bj, block.data());
-          if (ok) {
-            summary.covariance(i, j) = scale * block[pi.index * sj + pj.index];
-          }
-        }
-      }
-      for (int i = 0; i < num_params; ++i) {
-        const double var = summary.covariance(i, i);
-        const double sigma_internal = var >= 0 ? std::sqrt(var) : NAN;
-        summary.sigmas[i] = summary.params[i].angle
-                                ? summary.params[i].ToInterface(sigma_internal)
-                                : sigma_internal;
-      }
-    }
-  }
+  if (options.compute_covariance && num_params > 0 && dof > 0)
+    ComputeCovariance(free_mask, state, &problem, &summary);
   summary.seconds = Seconds(start);
   return summary;
 }

@@ -8,13 +8,14 @@
 #include <map>
 #include <random>
 
-#include "diagnose/exact_jacobian.h"
+#include "calib/exact_jacobian.h"
+#include "calib/holdout.h"
 
 namespace kincal {
 namespace {
 
 // The +-delta box of the free row entries (calib/fit.h's RowBound, as
-// diagnose/free_fit.cc); no box for the other parameters.
+// calib/free_fit.cc); no box for the other parameters.
 void Box(const FreeFitOptions& o, Eigen::VectorXd* lower,
          Eigen::VectorXd* upper) {
   const int k = static_cast<int>(o.free.size());
@@ -68,12 +69,13 @@ FoldPlan MakeFolds(const std::vector<Measurement>& ms, int folds,
     }
     groups[it->second].push_back(static_cast<int>(i));
   }
-  std::vector<int> order(groups.size());
-  for (size_t g = 0; g < order.size(); ++g) order[g] = static_cast<int>(g);
+  std::vector<int> groups_in_order(groups.size());
+  for (size_t g = 0; g < groups.size(); ++g)
+    groups_in_order[g] = static_cast<int>(g);
   // A stream of its own, so that the folds do not repeat the held-out
-  // split's shuffle (calib/calibrate.h SplitHoldout uses `seed`).
+  // split's shuffle (calib/holdout.h SplitHoldout uses `seed`).
   std::mt19937_64 rng(seed ^ 0x9e3779b97f4a7c15ULL);
-  std::shuffle(order.begin(), order.end(), rng);
+  const std::vector<int> order = ShuffledIndices(groups_in_order, &rng);
   // Each group to the fold with the fewest poses so far (lowest index on
   // ties): round robin when every pose is distinct.
   std::vector<int> size(folds, 0);

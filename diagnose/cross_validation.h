@@ -15,10 +15,10 @@
 //   - linearised (default): one Gauss-Newton step of the fold's fit from x*,
 //     x_{-k} = x* + d, (J_{-k}^T J_{-k}) d = -J_{-k}^T r_{-k}, Jacobi-scaled,
 //     projected onto the +-delta box; the held-out fold is predicted as
-//     r_k + J_k d. One exact Jacobian (diagnose/exact_jacobian.h) of the
+//     r_k + J_k d. One exact Jacobian (calib/exact_jacobian.h) of the
 //     fitted model serves all K folds: J^T J and J^T r are summed per fold
 //     once, each fold's normal equations are the total minus its own.
-//   - refit: Levenberg-Marquardt (diagnose/free_fit.h) on the K - 1 folds
+//   - refit: Levenberg-Marquardt (calib/free_fit.h) on the K - 1 folds
 //     from x*, to convergence; K fits per model (the reference that the
 //     bench compares the linearised figure with).
 
@@ -27,8 +27,8 @@
 #include <vector>
 
 #include "calib/fit.h"
+#include "calib/free_fit.h"
 #include "calib/model_state.h"
-#include "diagnose/free_fit.h"
 
 namespace kincal {
 

@@ -1,26 +1,21 @@
 #include "diagnose/model_diagnosis.h"
 
-#include <Eigen/QR>
+#include <Eigen/Cholesky>
 #include <algorithm>
 #include <array>
-#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <limits>
 #include <map>
 #include <set>
-#include <sstream>
-#include <thread>
 
 #include "calib/calibrate.h"
+#include "calib/exact_jacobian.h"
+#include "calib/free_fit.h"
+#include "calib/holdout.h"
 #include "calib/identifiability.h"
-#include "data/csv.h"
 #include "data/error.h"
-#include "data/provenance.h"
-#include "data/yaml_util.h"
 #include "diagnose/cross_validation.h"
-#include "diagnose/exact_jacobian.h"
-#include "diagnose/free_fit.h"
 #include "diagnose/nonparametric.h"
 
 namespace kincal {
@@ -30,14 +25,6 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 // 97.5 % point of the standard normal and 95 % point of chi-square(1).
 constexpr double kZ95 = 1.959963984540054;
 constexpr double kChi2One95 = 3.841458820694124;
-
-std::vector<Measurement> Pick(const std::vector<Measurement>& ms,
-                              const std::vector<int>& idx) {
-  std::vector<Measurement> out;
-  out.reserve(idx.size());
-  for (int i : idx) out.push_back(ms[i]);
-  return out;
-}
 
 double Rss(const ModelState& state, const std::vector<Measurement>& ms) {
   double sum = 0.0;
@@ -82,20 +69,20 @@ struct Problem {
   // A fit of `free` in the geometry's box: nominal +- its bounds, the
   // widened ones included.
   FitOptions Boxed(const std::vector<ParamInfo>& free) const {
-    FitOptions fo;
-    fo.free = free;
-    fo.bounds_center = &nominal;
-    fo.bound_override = bound_override;
-    return fo;
+    FitOptions fit_options;
+    fit_options.free = free;
+    fit_options.bounds_center = &nominal;
+    fit_options.bound_override = bound_override;
+    return fit_options;
   }
   // A candidate's refit: the box, no covariance, the refits' tolerances.
   FitOptions CandidateRefit(const std::vector<ParamInfo>& free) const {
-    FitOptions fo = Boxed(free);
-    fo.compute_covariance = false;
-    fo.max_iterations = 100;
-    fo.function_tolerance = 1e-10;
-    fo.parameter_tolerance = 1e-10;
-    return fo;
+    FitOptions fit_options = Boxed(free);
+    fit_options.compute_covariance = false;
+    fit_options.max_iterations = 100;
+    fit_options.function_tolerance = 1e-10;
+    fit_options.parameter_tolerance = 1e-10;
+    return fit_options;
   }
 };
 
@@ -106,11 +93,11 @@ struct Problem {
 // alone a 7-joint URDF arm 10 mm / 3 deg from its nominal model stopped at
 // 1.88 mm RMS (another minimum, 0.14 after the passes) and the catalogue
 // found nothing; with bounds pressed it named `thermal` for a backlash.
-// exact: the fits by diagnose/free_fit.h's exact-Jacobian path (same
-// problem, calib/fit.h's tolerances).
+// `solver`: the least-squares solver of every fit (same problem,
+// calib/fit.h's tolerances).
 void FitBase(const std::vector<Measurement>& fit_on, const Observations& obs,
-             bool bounds_stated, Problem* pb, bool exact = false) {
-  ModelState& state = pb->base_state;
+             bool bounds_stated, GeometrySolver solver, Problem* problem) {
+  ModelState& state = problem->base_state;
   InitializeFrameAndPoints(fit_on, &state);
   std::vector<ParamInfo> nuisance;
   bool any_measured = false;
@@ -124,7 +111,7 @@ void FitBase(const std::vector<Measurement>& fit_on, const Observations& obs,
   frame_only.compute_covariance = false;
   // The misfit after registering, per axis (calib/fit.h's sigma0).
   double registered_sigma0 = 0.0;
-  if (exact) {
+  if (solver == GeometrySolver::kExactJacobian) {
     const double rss = FreeFit(fit_on, FreeFitOptionsFrom(frame_only), &state);
     registered_sigma0 = std::sqrt(
         rss / std::max(1.0, 3.0 * fit_on.size() -
@@ -160,21 +147,19 @@ void FitBase(const std::vector<Measurement>& fit_on, const Observations& obs,
                            "diagnosis)");
     }
   };
-  // The geometry's fits by the exact-Jacobian path when asked (same
-  // problem and bounds, calib/fit.h's tolerances).
-  GeometryFitter fitter;
-  if (exact) {
-    fitter = [](const std::vector<Measurement>& ms, const FitOptions& fo,
-                ModelState* s) {
-      return FreeFitWithCovariance(ms, FreeFitOptionsFrom(fo), s);
-    };
-  }
   std::vector<Measurement> train = fit_on;
-  const GeometryFit g = FitGeometry(obs, pb->nominal, bounds_stated, candidates,
-                                    registered_sigma0, {}, CalibrateOptions{},
-                                    check, &train, nullptr, &state, fitter);
-  pb->base_free = g.identifiability.identifiable;
-  pb->bound_override = g.fit_options.bound_override;
+  GeometryProblem geometry;
+  geometry.obs = &obs;
+  geometry.nominal = &problem->nominal;
+  geometry.bounds_stated = bounds_stated;
+  geometry.candidates = candidates;
+  geometry.registered_sigma0_mm = registered_sigma0;
+  geometry.train = &train;
+  geometry.check = check;
+  geometry.solver = solver;
+  const GeometryFit g = FitGeometry(geometry, CalibrateOptions{}, &state);
+  problem->base_free = g.identifiability.identifiable;
+  problem->bound_override = g.fit_options.bound_override;
 }
 
 // Measurements of `obs` with the validity checks of the spec.
@@ -236,12 +221,13 @@ SmoothInputs MakeSmoothInputs(const Observations& obs,
   return in;
 }
 
-SmoothCorrection SmoothRest(const Observations& obs, const Problem& pb,
+SmoothCorrection SmoothRest(const Observations& obs, const Problem& problem,
                             const ModelState& state) {
   std::vector<Eigen::Vector3d> rt, rh;
-  for (const Measurement& m : pb.train) rt.push_back(Residual(state, m));
-  for (const Measurement& m : pb.held) rh.push_back(Residual(state, m));
-  return FitSmoothCorrection(MakeSmoothInputs(obs, pb.train, pb.held), rt, rh);
+  for (const Measurement& m : problem.train) rt.push_back(Residual(state, m));
+  for (const Measurement& m : problem.held) rh.push_back(Residual(state, m));
+  return FitSmoothCorrection(MakeSmoothInputs(obs, problem.train, problem.held),
+                             rt, rh);
 }
 
 // RMS on the validation series with the model held fixed and only the
@@ -254,7 +240,7 @@ double ValidationRms(const ModelState& state,
   return Rms(s, validation);
 }
 
-// The same with the exact-Jacobian fit (diagnose/free_fit.h) of the frame,
+// The same with the exact-Jacobian fit (calib/free_fit.h) of the frame,
 // started from `frame` (the current model's registered frame on the
 // validation series) instead of Umeyama: same problem, calib/fit.h's
 // tolerances.
@@ -305,547 +291,656 @@ void DiagnoseOptions::Check() const {
   }
 }
 
+namespace {
+
+// Step 1: the measured poses of `obs`, split into training and held-out
+// (seeded); the transmission family lives on the joints' travel in the
+// training data.
+Problem SplitPoses(const Robot& nominal, const Observations& obs,
+                   const DiagnoseOptions& options) {
+  Problem problem;
+  problem.nominal = Chain::FromRobot(nominal);
+  problem.base_state = StateWithChain(problem.nominal);
+  problem.all = Measurements(problem.nominal, obs, &problem.base_state);
+  const HoldoutSplit split =
+      SplitHoldout(problem.all, options.holdout_fraction, options.seed);
+  problem.train = PickRows(problem.all, split.train);
+  problem.held = PickRows(problem.all, split.heldout);
+  SetTransmissionTravel(problem.train, &problem.nominal);
+  SetTransmissionTravel(problem.train, &problem.base_state.chain);
+  for (auto* set : {&problem.all, &problem.train, &problem.held})
+    for (Measurement& m : *set)
+      FillTransmissionSines(problem.nominal, &m.input);
+  return problem;
+}
+
+// Folds of the cross-validation (training poses only: the held-out poses
+// stay out of the selection and are reported); 0 = the single held-out
+// split.
+int FoldCount(const Problem& problem, const Observations& obs,
+              const DiagnoseOptions& options) {
+  const int distinct = DistinctPoses(problem.train);
+  int k = options.folds <= 1 ? 0 : options.folds;
+  if (options.folds_given && k > distinct) {
+    throw InputError(obs.source, 0, 0,
+                     "--folds " + std::to_string(options.folds) + ": only " +
+                         std::to_string(distinct) +
+                         " distinct training poses (" +
+                         std::to_string(problem.train.size()) + " of " +
+                         std::to_string(problem.all.size()) +
+                         " poses, the rest held out); use at most " +
+                         std::to_string(distinct) +
+                         " folds, or 0 for the single held-out split");
+  }
+  if (!options.folds_given) {
+    k = std::min(k, distinct / DiagnoseOptions::kMinPosesPerFold);
+  }
+  return k >= 2 ? k : 0;
+}
+
+// The poses of the validation series (options.validation).
+std::vector<Measurement> ValidationMeasurements(
+    const Chain& nominal, const DiagnoseOptions& options) {
+  std::vector<Measurement> validation;
+  for (const Observations& v : options.validation) {
+    ModelState scratch = StateWithChain(nominal);
+    for (const Measurement& m : Measurements(nominal, v, &scratch))
+      validation.push_back(m);
+  }
+  return validation;
+}
+
+// What every step of the selection reads.
+struct Selection {
+  Selection(const Problem& problem_in, const Observations& obs_in,
+            const DiagnoseOptions& options_in)
+      : problem(problem_in), obs(obs_in), options(options_in) {}
+
+  const Problem& problem;
+  const Observations& obs;
+  const DiagnoseOptions& options;
+  FoldPlan folds;
+  std::vector<Measurement> validation;  // poses of the validation series
+  int num_residuals = 0;                // 3 x training poses
+  bool thermal_kelvin = false;          // thermal per kelvin, not per second
+
+  // The cross-validation's refits of `free` in the geometry's box.
+  FreeFitOptions CvOptions(const std::vector<ParamInfo>& free) const {
+    FreeFitOptions o;
+    o.free = free;
+    o.bounds_center = &problem.nominal;
+    o.bound_override = problem.bound_override;
+    return o;
+  }
+  double Scale(const Candidate& c) const {
+    return MagnitudeScale(c.cause, c.joint, problem.nominal, problem.all);
+  }
+  std::string Unit(const Candidate& c, const std::string& unit) const {
+    return c.cause == "thermal" && thermal_kelvin ? std::string("mm/K") : unit;
+  }
+  bool WithFolds() const { return folds.folds >= 2; }
+};
+
+// The model the selection has reached and its figures.
+struct CurrentModel {
+  ModelState state;
+  std::vector<ParamInfo> free;
+  double rss = 0.0;  // training, mm^2
+  double heldout_rms_mm = kNaN, validation_rms_mm = kNaN, cv_rms_mm = kNaN;
+  std::vector<double> cv_err;  // out-of-fold squared error per training pose
+};
+
+// Step 2's figures: the base model (frame + identifiable geometry) on the
+// training, held-out, folded and validation poses.
+CurrentModel BaseModel(const Selection& selection, DiagnosisResult* out) {
+  const Problem& problem = selection.problem;
+  CurrentModel current;
+  current.state = problem.base_state;
+  current.free = problem.base_free;
+  out->nominal_train_rms_mm = Rms(current.state, problem.train);
+  out->nominal_heldout_rms_mm = Rms(current.state, problem.held);
+  current.rss = Rss(current.state, problem.train);
+  current.heldout_rms_mm = out->nominal_heldout_rms_mm;
+  out->nominal_cv_rms_mm =
+      CrossValidatedRms(problem.train, selection.folds, current.state,
+                        selection.CvOptions(current.free),
+                        selection.options.cv_refit, &current.cv_err);
+  current.cv_rms_mm = out->nominal_cv_rms_mm;
+  out->nominal_validation_rms_mm =
+      ValidationRms(current.state, selection.validation);
+  current.validation_rms_mm = out->nominal_validation_rms_mm;
+  return current;
+}
+
+// One step's linearisation at the current model: residuals, the Jacobian
+// of the current free parameters and of every candidate's (calib/
+// exact_jacobian.h), and the normal equations the candidates' Gauss-Newton
+// starts share.
+struct StepLinearization {
+  // The current model's measuring frame on the validation series: the
+  // start of every candidate's re-registration.
+  std::array<double, kFrameBlockSize> validation_frame{};
+  Eigen::VectorXd r0;                    // training residuals
+  Eigen::MatrixXd cand_jac;              // columns of every candidate parameter
+  std::map<std::string, int> column_of;  // a parameter's column, by name
+  // Screening: each candidate is refitted with the geometry and the frame
+  // free and the extensions accepted in earlier steps held at their fitted
+  // values (a transmission series carries up to 24 of them). Holding them
+  // can only raise a candidate's RSS, so its F-test is conservative; the
+  // winner is refitted jointly with everything (RefitWinnerJointly).
+  std::vector<ParamInfo> screen_free;
+  Eigen::MatrixXd screen_jac;       // their columns
+  Eigen::MatrixXd screen_normal;    // screen_jac^T screen_jac
+  Eigen::VectorXd screen_gradient;  // screen_jac^T r0
+  std::vector<bool> usable;         // identifiable against the current model
+
+  Eigen::MatrixXd CandidateColumns(const Eigen::MatrixXd& jac,
+                                   const Candidate& cand) const {
+    Eigen::MatrixXd cols(jac.rows(), cand.params.size());
+    for (size_t q = 0; q < cand.params.size(); ++q)
+      cols.col(q) = jac.col(column_of.at(cand.params[q].name));
+    return cols;
+  }
+};
+
+// Linearises the step and reduces each candidate of `pool` (rebuilt from
+// the catalogue) to what the data can determine against the current model.
+StepLinearization Linearize(const Selection& selection,
+                            const CurrentModel& current,
+                            std::vector<Candidate>* pool) {
+  const Problem& problem = selection.problem;
+  StepLinearization lin;
+  if (!selection.validation.empty()) {
+    ModelState v = current.state;
+    InitializeFrameAndPoints(selection.validation, &v);
+    lin.validation_frame = v.meas_from_base;
+  }
+  Eigen::MatrixXd base_jac;
+  ResidualsAndJacobian(problem.train, current.state, current.free, &lin.r0,
+                       &base_jac);
+  const Eigen::MatrixXd basis = Basis(Normalized(base_jac));
+  for (Candidate& c : *pool)
+    c = MakeCandidate(problem.nominal, c.cause, c.joint);
+  // Each parameter once (nested candidates share theirs: transmission8 is
+  // the start of transmission16 and 24).
+  std::vector<ParamInfo> all_params;
+  for (const Candidate& cand : *pool) {
+    for (const ParamInfo& q : cand.params) {
+      if (lin.column_of.emplace(q.name, static_cast<int>(all_params.size()))
+              .second)
+        all_params.push_back(q);
+    }
+  }
+  Eigen::VectorXd unused;
+  ResidualsAndJacobian(problem.train, current.state, all_params, &unused,
+                       &lin.cand_jac);
+  std::vector<int> screen_cols;
+  for (size_t q = 0; q < current.free.size(); ++q) {
+    if (current.free[q].kind == ParamKind::kJointError ||
+        current.free[q].kind == ParamKind::kDrift)
+      continue;
+    lin.screen_free.push_back(current.free[q]);
+    screen_cols.push_back(static_cast<int>(q));
+  }
+  lin.screen_jac.resize(base_jac.rows(), screen_cols.size());
+  for (size_t q = 0; q < screen_cols.size(); ++q)
+    lin.screen_jac.col(q) = base_jac.col(screen_cols[q]);
+  lin.screen_normal = lin.screen_jac.transpose() * lin.screen_jac;
+  lin.screen_gradient = lin.screen_jac.transpose() * lin.r0;
+  // Every candidate column off the current model's span, in one product.
+  const Eigen::MatrixXd projected = ProjectedOffBasis(basis, lin.cand_jac);
+  lin.usable.resize(pool->size());
+  for (size_t c = 0; c < pool->size(); ++c) {
+    lin.usable[c] = ReduceToIdentifiable(
+        lin.CandidateColumns(projected, (*pool)[c]), &(*pool)[c]);
+  }
+  return lin;
+}
+
+// One candidate's screening refit and its score.
+struct CandidateFit {
+  CandidateScore score;
+  ModelState state;            // the refitted model
+  double log_p = 0.0;          // log of the F-test's p-value
+  std::vector<double> cv_err;  // out-of-fold squared error per training pose
+};
+
+// The Gauss-Newton step of the linearised joint model [screened, candidate
+// columns] (normal equations, Jacobi-scaled), so that the refit needs few
+// iterations; `gradient` gets the normal equations' right-hand side.
+Eigen::VectorXd GaussNewtonStart(const StepLinearization& lin,
+                                 const Eigen::MatrixXd& cand_cols,
+                                 Eigen::VectorXd* gradient) {
+  const int n_screen = static_cast<int>(lin.screen_jac.cols());
+  const int k = static_cast<int>(cand_cols.cols());
+  Eigen::MatrixXd normal(n_screen + k, n_screen + k);
+  normal.topLeftCorner(n_screen, n_screen) = lin.screen_normal;
+  normal.topRightCorner(n_screen, k) = lin.screen_jac.transpose() * cand_cols;
+  normal.bottomLeftCorner(k, n_screen) =
+      normal.topRightCorner(n_screen, k).transpose();
+  normal.bottomRightCorner(k, k) = cand_cols.transpose() * cand_cols;
+  gradient->resize(n_screen + k);
+  gradient->head(n_screen) = lin.screen_gradient;
+  gradient->tail(k) = cand_cols.transpose() * lin.r0;
+  Eigen::VectorXd scale(normal.cols());
+  for (int q = 0; q < normal.cols(); ++q) {
+    scale[q] = normal(q, q) > 0 ? 1.0 / std::sqrt(normal(q, q)) : 1.0;
+  }
+  return scale.asDiagonal() * (scale.asDiagonal() * normal * scale.asDiagonal())
+                                  .ldlt()
+                                  .solve(-(scale.asDiagonal() * *gradient));
+}
+
+// Step 3: screens one candidate: refit (from the Gauss-Newton start), the
+// F-test against the current model at the step's level `alpha`, the
+// cross-validated / held-out and validation checks, its magnitude.
+CandidateFit ScreenCandidate(const Selection& selection,
+                             const StepLinearization& lin,
+                             const CurrentModel& current, const Candidate& cand,
+                             bool usable, double alpha) {
+  const Problem& problem = selection.problem;
+  const DiagnoseOptions& options = selection.options;
+  CandidateFit fit;
+  fit.state = current.state;
+  CandidateScore& s = fit.score;
+  s.cause = cand.cause;
+  s.joint = cand.joint >= 0 ? problem.nominal.rows[cand.joint].name : "";
+  s.k = static_cast<int>(cand.params.size());
+  s.identifiable = usable;
+  const int p = static_cast<int>(current.free.size());
+  const double d2 = selection.num_residuals - p - s.k;
+  if (!usable || d2 <= 0) {
+    s.identifiable = false;
+    s.train_rms_mm = s.heldout_rms_mm = kNaN;
+    return fit;
+  }
+  std::vector<ParamInfo> refit_free = lin.screen_free;
+  for (const ParamInfo& q : cand.params) refit_free.push_back(q);
+  const FitOptions refit_options = problem.CandidateRefit(refit_free);
+  Eigen::VectorXd gradient;
+  const Eigen::VectorXd step = GaussNewtonStart(
+      lin, lin.CandidateColumns(lin.cand_jac, cand), &gradient);
+  for (int q = 0; q < static_cast<int>(refit_options.free.size()); ++q) {
+    if (std::isfinite(step[q]))
+      *ParamAddress(&fit.state, refit_options.free[q]) += step[q];
+  }
+  // A candidate whose linearised gain (the Gauss-Newton start's) is far
+  // from significant (p above 100x the step's alpha) keeps the start: its
+  // RSS there is that of a feasible model, an upper bound of the refit's,
+  // so its F-test can only be conservative.
+  const double lin_drop = std::max(0.0, -gradient.dot(step));
+  const double lin_rss = std::max(current.rss - lin_drop, 1e-300);
+  const bool hopeless = LogFUpperTail((lin_drop / s.k) / (lin_rss / d2), s.k,
+                                      d2) > std::log(100.0 * alpha);
+  if (!hopeless)
+    FreeFit(problem.train, FreeFitOptionsFrom(refit_options), &fit.state);
+  Eigen::VectorXd rt, rh;
+  ResidualsAndJacobian(problem.train, fit.state, {}, &rt, nullptr);
+  ResidualsAndJacobian(problem.held, fit.state, {}, &rh, nullptr);
+  s.rss = rt.squaredNorm();
+  s.train_rms_mm = std::sqrt(s.rss / static_cast<double>(problem.train.size()));
+  s.heldout_rms_mm = problem.held.empty()
+                         ? kNaN
+                         : std::sqrt(rh.squaredNorm() /
+                                     static_cast<double>(problem.held.size()));
+  // RSS changes at the solver's precision are no evidence.
+  double drop = current.rss - s.rss;
+  if (drop < 1e-10 * current.rss) drop = 0.0;
+  s.f = s.rss > 0 ? (drop / s.k) / (s.rss / d2)
+                  : std::numeric_limits<double>::infinity();
+  fit.log_p = LogFUpperTail(s.f, s.k, d2);
+  s.p_value = std::exp(fit.log_p);
+  const double explained_mm =
+      std::sqrt(drop / static_cast<double>(problem.train.size()));
+  // With folds the cross-validated RMS must drop (computed only for the
+  // candidates that pass the F-test: the few that can win); without, the
+  // single held-out split's.
+  const bool f_passes = std::log(alpha) > fit.log_p && drop > 0 &&
+                        explained_mm >= options.min_effect_mm;
+  if (selection.WithFolds() && f_passes) {
+    s.cv_rms_mm = CrossValidatedRms(problem.train, selection.folds, fit.state,
+                                    selection.CvOptions(refit_options.free),
+                                    options.cv_refit, &fit.cv_err);
+    s.cv_z = PairedZ(current.cv_err, fit.cv_err);
+  }
+  const bool held_better =
+      selection.WithFolds()
+          ? s.cv_rms_mm < current.cv_rms_mm && s.cv_z > options.cv_min_z
+          : problem.held.empty() || s.heldout_rms_mm < current.heldout_rms_mm;
+  s.validation_rms_mm =
+      ValidationRmsFrom(fit.state, lin.validation_frame, selection.validation);
+  const bool validation_better =
+      selection.validation.empty() ||
+      s.validation_rms_mm < current.validation_rms_mm;
+  s.significant = std::log(alpha) > fit.log_p && held_better &&
+                  validation_better && explained_mm >= options.min_effect_mm;
+  const Magnitude mag =
+      CandidateMagnitude(cand, fit.state, FitSummary{}, selection.Scale(cand));
+  s.magnitude = mag.value;
+  s.unit = selection.Unit(cand, mag.unit);
+  return fit;
+}
+
+// Step 4a: the step's winner among the significant candidates, -1 when
+// none. With validation series the one that predicts them best (the F-test
+// only admits); else with folds the lowest cross-validated RMS, ties
+// (within `cv_tie_z` standard errors, paired over the training poses) to
+// the most significant: the F-test's ranking prefers fewer parameters, and
+// without the tie rule a candidate that nests the true one wins by its
+// extra parameter's fit to the noise (docs/DIAGNOSE.md); else the most
+// significant.
+int SelectWinner(const Selection& selection,
+                 const std::vector<CandidateFit>& fits) {
+  const bool validation = !selection.validation.empty();
+  int best = -1;
+  for (size_t c = 0; c < fits.size(); ++c) {
+    const CandidateScore& s = fits[c].score;
+    if (!s.significant) continue;
+    if (best < 0) {
+      best = static_cast<int>(c);
+      continue;
+    }
+    const CandidateScore& b = fits[best].score;
+    const bool better =
+        validation ? s.validation_rms_mm < b.validation_rms_mm
+        : selection.WithFolds()
+            ? s.cv_rms_mm < b.cv_rms_mm
+            : (fits[c].log_p < fits[best].log_p ||
+               (fits[c].log_p == fits[best].log_p && s.rss < b.rss));
+    if (better) best = static_cast<int>(c);
+  }
+  if (best < 0 || validation || !selection.WithFolds() ||
+      !(selection.options.cv_tie_z > 0))
+    return best;
+  const int cv_best = best;
+  for (size_t c = 0; c < fits.size(); ++c) {
+    if (!fits[c].score.significant || static_cast<int>(c) == cv_best) continue;
+    if (PairedZ(fits[c].cv_err, fits[cv_best].cv_err) <
+            selection.options.cv_tie_z &&
+        fits[c].log_p < fits[best].log_p) {
+      best = static_cast<int>(c);
+    }
+  }
+  return best;
+}
+
+// Step 4b: the winner refitted jointly with the extensions held in
+// screening, kept only when it fits the training poses better without
+// predicting the validation series worse.
+void RefitWinnerJointly(const Selection& selection, const CurrentModel& current,
+                        const Candidate& winner, CandidateFit* fit) {
+  const Problem& problem = selection.problem;
+  const CandidateFit screened = *fit;
+  std::vector<ParamInfo> refit_free = current.free;
+  for (const ParamInfo& q : winner.params) refit_free.push_back(q);
+  const FitOptions refit_options = problem.CandidateRefit(refit_free);
+  FreeFit(problem.train, FreeFitOptionsFrom(refit_options), &fit->state);
+  CandidateScore& w = fit->score;
+  w.rss = Rss(fit->state, problem.train);
+  w.train_rms_mm = Rms(fit->state, problem.train);
+  if (!problem.held.empty()) w.heldout_rms_mm = Rms(fit->state, problem.held);
+  if (!selection.validation.empty())
+    w.validation_rms_mm = ValidationRms(fit->state, selection.validation);
+  w.magnitude = CandidateMagnitude(winner, fit->state, FitSummary{},
+                                   selection.Scale(winner))
+                    .value;
+  if (selection.WithFolds()) {
+    w.cv_rms_mm = CrossValidatedRms(problem.train, selection.folds, fit->state,
+                                    selection.CvOptions(refit_options.free),
+                                    selection.options.cv_refit, &fit->cv_err);
+  }
+  if (!(w.rss <= screened.score.rss) ||
+      (!selection.validation.empty() &&
+       !(w.validation_rms_mm <= screened.score.validation_rms_mm))) {
+    *fit = screened;
+  }
+}
+
+// Step 4c: the finding of the winner `best`, with the candidates that
+// predict the same errors on this data (RSS within the chi-square(1) 95 %
+// point of the noise, and significant themselves).
+Finding MakeFinding(const Selection& selection, const CurrentModel& current,
+                    const std::vector<CandidateFit>& fits, int best,
+                    double alpha) {
+  const CandidateScore& b = fits[best].score;
+  Finding f;
+  f.cause = b.cause;
+  f.joint = b.joint;
+  f.heldout_rms_before_mm = current.heldout_rms_mm;
+  f.heldout_rms_after_mm = b.heldout_rms_mm;
+  f.validation_rms_before_mm = current.validation_rms_mm;
+  f.validation_rms_after_mm = b.validation_rms_mm;
+  f.cv_rms_before_mm = current.cv_rms_mm;
+  f.cv_rms_after_mm = b.cv_rms_mm;
+  f.train_rms_after_mm = b.train_rms_mm;
+  f.f = b.f;
+  f.p_value = b.p_value;
+  const int p = static_cast<int>(current.free.size());
+  const double sigma2 = b.rss / (selection.num_residuals - p - b.k);
+  for (size_t c = 0; c < fits.size(); ++c) {
+    const CandidateScore& s = fits[c].score;
+    if (static_cast<int>(c) == best || !s.identifiable) continue;
+    if (s.rss - b.rss < kChi2One95 * sigma2 &&
+        std::log(alpha) > fits[c].log_p) {
+      f.equivalent.push_back({s.cause, s.joint, s.magnitude, s.unit,
+                              s.train_rms_mm, s.heldout_rms_mm});
+    }
+  }
+  return f;
+}
+
+// Step 4d: a joint's error along the travel (transmission) and its low
+// harmonics and gain describe nearly the same function inside the travel
+// and differ outside it: once one kind is in the model, the other leaves
+// the pool (together they drift apart along that near-degenerate direction
+// and extrapolate wildly, docs/DIAGNOSE.md).
+void ExcludeAlongTravel(const Candidate& won, std::vector<Candidate>* pool) {
+  auto along_travel = [](const std::string& cause) {
+    return TransmissionTerms(cause) > 0                     ? 1
+           : (CyclicHarmonic(cause) > 0 || cause == "gain") ? 2
+                                                            : 0;
+  };
+  const int won_kind = along_travel(won.cause);
+  if (won_kind == 0) return;
+  pool->erase(std::remove_if(pool->begin(), pool->end(),
+                             [&](const Candidate& c) {
+                               const int kind = along_travel(c.cause);
+                               return c.joint == won.joint && kind > 0 &&
+                                      kind != won_kind;
+                             }),
+              pool->end());
+}
+
+// Steps 3-4, repeated: greedy forward selection from the catalogue while a
+// candidate stays significant; returns the accepted candidates in order
+// (their findings in out->findings).
+std::vector<Candidate> SelectCandidates(const Selection& selection,
+                                        CurrentModel* current,
+                                        DiagnosisResult* out) {
+  const Problem& problem = selection.problem;
+  const DiagnoseOptions& options = selection.options;
+  std::vector<Candidate> pool =
+      CatalogueCandidates(problem.nominal, problem.all, options.causes);
+  std::vector<Candidate> accepted;
+  // Residuals below this (mm per axis) are numerically exact data: nothing
+  // measurable is left to explain.
+  constexpr double kExactMm = 1e-7;
+  for (int step = 0;
+       step < options.max_findings && !pool.empty() &&
+       current->rss > kExactMm * kExactMm * selection.num_residuals;
+       ++step) {
+    const StepLinearization lin = Linearize(selection, *current, &pool);
+    const int tested = static_cast<int>(
+        std::count(lin.usable.begin(), lin.usable.end(), true));
+    if (tested == 0) break;
+    const double alpha = options.false_alarm / tested;
+    if (step == 0) out->bonferroni_alpha = alpha;
+    std::vector<CandidateFit> fits(pool.size());
+    ParallelFor(static_cast<int>(pool.size()), options.num_threads, [&](int c) {
+      fits[c] = ScreenCandidate(selection, lin, *current, pool[c],
+                                lin.usable[c], alpha);
+    });
+    std::vector<CandidateScore> scores;
+    for (const CandidateFit& fit : fits) scores.push_back(fit.score);
+    out->steps.push_back(scores);
+    if (step == 0) {
+      for (size_t c = 0; c < pool.size(); ++c) {
+        if (!lin.usable[c])
+          out->not_identifiable.push_back(pool[c].Label(problem.nominal));
+      }
+    }
+    const int best = SelectWinner(selection, fits);
+    if (best < 0) break;
+    if (lin.screen_free.size() < current->free.size())
+      RefitWinnerJointly(selection, *current, pool[best], &fits[best]);
+    out->findings.push_back(
+        MakeFinding(selection, *current, fits, best, alpha));
+    accepted.push_back(pool[best]);
+    const CandidateFit& won = fits[best];
+    current->state = won.state;
+    for (const ParamInfo& q : pool[best].params) current->free.push_back(q);
+    current->rss = won.score.rss;
+    current->heldout_rms_mm = won.score.heldout_rms_mm;
+    current->validation_rms_mm = won.score.validation_rms_mm;
+    current->cv_rms_mm = won.score.cv_rms_mm;
+    current->cv_err = won.cv_err;
+    pool.erase(pool.begin() + best);
+    ExcludeAlongTravel(accepted.back(), &pool);
+  }
+  return accepted;
+}
+
+// Step 5: the selected model refitted on all poses; the findings' magnitudes
+// and 95 % intervals from its covariance. Returns the refitted model.
+ModelState FinalRefit(const Selection& selection, const CurrentModel& current,
+                      const std::vector<Candidate>& accepted,
+                      DiagnosisResult* out) {
+  ModelState final_state = current.state;
+  FitOptions fit_options = selection.problem.Boxed(current.free);
+  fit_options.compute_covariance = true;
+  const FitSummary final_fit = FreeFitWithCovariance(
+      selection.problem.all, FreeFitOptionsFrom(fit_options), &final_state);
+  for (size_t i = 0; i < accepted.size(); ++i) {
+    const Candidate& c = accepted[i];
+    const Magnitude m =
+        CandidateMagnitude(c, final_state, final_fit, selection.Scale(c));
+    out->findings[i].magnitude = m.value;
+    out->findings[i].unit = selection.Unit(c, m.unit);
+    out->findings[i].ci_low = m.ci_low;
+    out->findings[i].ci_high = m.ci_high;
+  }
+  return final_state;
+}
+
+// Step 6: the measurement noise per axis: stated, from repeated poses, or an
+// upper bound from the nearest pose pairs.
+void EstimateNoise(const DiagnoseOptions& options, const Problem& problem,
+                   const ModelState& current, DiagnosisResult* out) {
+  if (options.noise_mm > 0) {
+    out->noise_mm = options.noise_mm;
+    out->noise_source = "stated";
+  } else if (const double rep = RepeatedPoseNoise(problem.all); rep > 0) {
+    out->noise_mm = rep;
+    out->noise_source = "repeated poses";
+  } else if (const double nn = NearestPoseNoise(current, problem.train);
+             nn > 0) {
+    out->noise_mm = nn;
+    out->noise_source = "nearest poses (upper bound)";
+  } else {
+    out->noise_source = "none";
+  }
+}
+
+// Step 7: the systematic rest above the noise and, when it is clearly above
+// (options.unexplained_ratio), the `unexplained` finding with what it
+// depends on (a smooth correction over the pose inputs, chosen by
+// cross-validation, tested on the held-out poses).
+void UnexplainedRest(const Selection& selection, const CurrentModel& current,
+                     DiagnosisResult* out) {
+  const DiagnoseOptions& options = selection.options;
+  const Problem& problem = selection.problem;
+  const int dof =
+      selection.num_residuals - static_cast<int>(current.free.size());
+  if (!(out->noise_mm > 0 && dof >= 10)) return;
+  const double s2 = out->residual_sigma_mm * out->residual_sigma_mm;
+  const double n2 = out->noise_mm * out->noise_mm;
+  out->systematic_rms_mm = std::sqrt(std::max(0.0, 3.0 * (s2 - n2)));
+  if (!(out->residual_sigma_mm > options.unexplained_ratio * out->noise_mm &&
+        out->systematic_rms_mm > options.min_effect_mm))
+    return;
+  Finding u;
+  u.cause = "unexplained";
+  u.magnitude = out->systematic_rms_mm;
+  u.unit = "mm";
+  // Chi-square interval of the residual variance (normal approximation).
+  const double rel = kZ95 * std::sqrt(2.0 / dof);
+  u.ci_low = std::sqrt(std::max(0.0, 3.0 * (s2 * (1 - rel) - n2)));
+  u.ci_high = std::sqrt(std::max(0.0, 3.0 * (s2 * (1 + rel) - n2)));
+  u.heldout_rms_before_mm = u.heldout_rms_after_mm = current.heldout_rms_mm;
+  u.validation_rms_before_mm = u.validation_rms_after_mm =
+      current.validation_rms_mm;
+  u.cv_rms_before_mm = u.cv_rms_after_mm = current.cv_rms_mm;
+  u.train_rms_after_mm = out->final_train_rms_mm;
+  u.p_value = kNaN;
+  u.f = s2 / n2;
+  const SmoothCorrection sc = SmoothRest(selection.obs, problem, current.state);
+  u.depends_on = sc.depends_on;
+  u.cv_explained = sc.cv_explained;
+  u.smooth_k = sc.k;
+  u.single_inputs = sc.single;
+  u.point_cv_explained = sc.point_cv_explained;
+  if (!problem.held.empty()) u.heldout_rms_after_mm = sc.heldout_rms_after_mm;
+  out->findings.push_back(u);
+}
+
+// Per measured pose: its row, whether it was held out, the final residual.
+void PerPoseResiduals(const Problem& problem, const ModelState& final_state,
+                      DiagnosisResult* out) {
+  std::set<int> held_rows;
+  for (const Measurement& m : problem.held) held_rows.insert(m.row);
+  for (const Measurement& m : problem.all) {
+    out->rows.push_back(m.row);
+    out->heldout.push_back(held_rows.count(m.row) > 0);
+    out->residuals.push_back(Residual(final_state, m));
+  }
+}
+
+}  // namespace
+
 DiagnosisResult DiagnoseModel(const Robot& nominal, const Observations& obs,
                               const DiagnoseOptions& options) {
   const auto start = std::chrono::steady_clock::now();
   options.Check();
   DiagnosisResult out;
-  Problem pb;
-  pb.nominal = Chain::FromRobot(nominal);
-  pb.base_state = StateWithChain(pb.nominal);
-  pb.all = Measurements(pb.nominal, obs, &pb.base_state);
-  std::vector<int> train_idx, held_idx;
-  SplitHoldout(pb.all, options.holdout_fraction, options.seed, &train_idx,
-               &held_idx);
-  pb.train = Pick(pb.all, train_idx);
-  pb.held = Pick(pb.all, held_idx);
-  // The transmission family lives on the joints' travel in the training data.
-  SetTransmissionTravel(pb.train, &pb.nominal);
-  SetTransmissionTravel(pb.train, &pb.base_state.chain);
-  for (auto* set : {&pb.all, &pb.train, &pb.held})
-    for (Measurement& m : *set) FillTransmissionSines(pb.nominal, &m.input);
-  out.train_poses = static_cast<int>(pb.train.size());
-  out.heldout_poses = static_cast<int>(pb.held.size());
-  // Folds of the cross-validation (training poses only: the held-out poses
-  // stay out of the selection and are reported).
-  {
-    const int distinct = DistinctPoses(pb.train);
-    int k = options.folds <= 1 ? 0 : options.folds;
-    if (options.folds_given && k > distinct) {
-      throw InputError(obs.source, 0, 0,
-                       "--folds " + std::to_string(options.folds) + ": only " +
-                           std::to_string(distinct) +
-                           " distinct training poses (" +
-                           std::to_string(pb.train.size()) + " of " +
-                           std::to_string(pb.all.size()) +
-                           " poses, the rest held out); use at most " +
-                           std::to_string(distinct) +
-                           " folds, or 0 for the single held-out split");
-    }
-    if (!options.folds_given) {
-      k = std::min(k, distinct / DiagnoseOptions::kMinPosesPerFold);
-    }
-    out.folds = k >= 2 ? k : 0;
-  }
-  FitBase(pb.train, obs, nominal.bounds_stated, &pb, options.exact_jacobian);
-  const FoldPlan folds = out.folds >= 2
-                             ? MakeFolds(pb.train, out.folds, options.seed)
-                             : FoldPlan{};
+  Problem problem = SplitPoses(nominal, obs, options);
+  out.train_poses = static_cast<int>(problem.train.size());
+  out.heldout_poses = static_cast<int>(problem.held.size());
+  out.folds = FoldCount(problem, obs, options);
+  FitBase(problem.train, obs, nominal.bounds_stated,
+          GeometrySolver::kExactJacobian, &problem);
 
-  ModelState current = pb.base_state;
-  std::vector<ParamInfo> current_free = pb.base_free;
-  out.nominal_train_rms_mm = Rms(current, pb.train);
-  out.nominal_heldout_rms_mm = Rms(current, pb.held);
-  double current_rss = Rss(current, pb.train);
-  double current_held = out.nominal_heldout_rms_mm;
-  auto cv_options = [&](const std::vector<ParamInfo>& free) {
-    FreeFitOptions o;
-    o.free = free;
-    o.bounds_center = &pb.nominal;
-    o.bound_override = pb.bound_override;
-    o.exact_jacobian = options.exact_jacobian;
-    return o;
-  };
-  // Out-of-fold squared error per training pose of the current model.
-  std::vector<double> current_cv_err;
-  out.nominal_cv_rms_mm =
-      CrossValidatedRms(pb.train, folds, current, cv_options(current_free),
-                        options.cv_refit, &current_cv_err);
-  double current_cv = out.nominal_cv_rms_mm;
-  std::vector<Measurement> validation;
-  for (const Observations& v : options.validation) {
-    ModelState scratch = StateWithChain(pb.nominal);
-    for (const Measurement& m : Measurements(pb.nominal, v, &scratch))
-      validation.push_back(m);
-  }
-  out.nominal_validation_rms_mm = ValidationRms(current, validation);
-  double current_validation = out.nominal_validation_rms_mm;
-  const int n_res = 3 * static_cast<int>(pb.train.size());
-
-  std::vector<Candidate> pool =
-      CatalogueCandidates(pb.nominal, pb.all, options.causes);
-  std::vector<Candidate> accepted;
-  const bool thermal_kelvin = ThermalUsesTemperature(obs);
-  auto scale_of = [&](const Candidate& c) {
-    return MagnitudeScale(c.cause, c.joint, pb.nominal, pb.all);
-  };
-  auto unit_of = [&](const Candidate& c, const std::string& unit) {
-    return c.cause == "thermal" && thermal_kelvin ? std::string("mm/K") : unit;
-  };
-
-  // Residuals below this (mm per axis) are numerically exact data: nothing
-  // measurable is left to explain.
-  constexpr double kExactMm = 1e-7;
-  for (int step = 0; step < options.max_findings && !pool.empty() &&
-                     current_rss > kExactMm * kExactMm * n_res;
-       ++step) {
-    // The current model's measuring frame on the validation series: the
-    // start of every candidate's re-registration.
-    std::array<double, kFrameBlockSize> validation_frame{};
-    if (!validation.empty()) {
-      ModelState v = current;
-      InitializeFrameAndPoints(validation, &v);
-      validation_frame = v.meas_from_base;
-    }
-    // Identifiability of each candidate against the current model
-    // (residuals and Jacobians: diagnose/exact_jacobian.h).
-    // exact_jacobian = false: calib/fit.h's autodiff, as before.
-    Eigen::VectorXd r0;
-    Eigen::MatrixXd base_raw;
-    if (options.exact_jacobian) {
-      ResidualsAndJacobian(pb.train, current, current_free, &r0, &base_raw);
-    } else {
-      base_raw = ResidualJacobian(pb.train, current, current_free);
-      r0.resize(3 * pb.train.size());
-      for (size_t i = 0; i < pb.train.size(); ++i)
-        r0.segment<3>(3 * i) = Residual(current, pb.train[i]);
-    }
-    const Eigen::MatrixXd basis = Basis(Normalized(base_raw));
-    // One Jacobian for all candidates' parameters, sliced per candidate.
-    std::vector<ParamInfo> all_params;
-    for (size_t c = 0; c < pool.size(); ++c) {
-      pool[c] = MakeCandidate(pb.nominal, pool[c].cause, pool[c].joint);
-    }
-    // Each parameter once (nested candidates share theirs: transmission8 is
-    // the start of transmission16 and 24), its column by name.
-    std::map<std::string, int> column_of;
-    for (const Candidate& cand : pool) {
-      for (const ParamInfo& q : cand.params) {
-        if (column_of.emplace(q.name, static_cast<int>(all_params.size()))
-                .second)
-          all_params.push_back(q);
-      }
-    }
-    auto candidate_columns = [&](const Eigen::MatrixXd& jac,
-                                 const Candidate& cand) {
-      Eigen::MatrixXd cols(jac.rows(), cand.params.size());
-      for (size_t q = 0; q < cand.params.size(); ++q)
-        cols.col(q) = jac.col(column_of.at(cand.params[q].name));
-      return cols;
-    };
-    Eigen::MatrixXd cand_jac;
-    if (options.exact_jacobian) {
-      Eigen::VectorXd unused;
-      ResidualsAndJacobian(pb.train, current, all_params, &unused, &cand_jac);
-    } else {
-      cand_jac = ResidualJacobian(pb.train, current, all_params);
-    }
-    // Normal equations of the base model, shared by every candidate's
-    // Gauss-Newton start.
-    // Screening: each candidate is refitted with the geometry and the frame
-    // free and the extensions accepted in earlier steps held at their fitted
-    // values (a transmission series carries up to 24 of them; freeing them
-    // all in every candidate's refit made series C 10x slower). Holding them
-    // can only raise a candidate's RSS, so its F-test is conservative; the
-    // winner is refitted jointly with everything below.
-    std::vector<ParamInfo> screen_free;
-    std::vector<int> screen_cols;
-    for (size_t q = 0; q < current_free.size(); ++q) {
-      if (current_free[q].kind == ParamKind::kJointError ||
-          current_free[q].kind == ParamKind::kDrift)
-        continue;
-      screen_free.push_back(current_free[q]);
-      screen_cols.push_back(static_cast<int>(q));
-    }
-    Eigen::MatrixXd screen_raw(base_raw.rows(), screen_cols.size());
-    for (size_t q = 0; q < screen_cols.size(); ++q)
-      screen_raw.col(q) = base_raw.col(screen_cols[q]);
-    const Eigen::MatrixXd base_ntn = screen_raw.transpose() * screen_raw;
-    const Eigen::VectorXd base_ntr = screen_raw.transpose() * r0;
-    // Every candidate column off the current model's span, in one product.
-    const Eigen::MatrixXd projected = ProjectedOffBasis(basis, cand_jac);
-    std::vector<bool> usable(pool.size());
-    for (size_t c = 0; c < pool.size(); ++c) {
-      usable[c] =
-          ReduceToIdentifiable(candidate_columns(projected, pool[c]), &pool[c]);
-    }
-    const int p = static_cast<int>(current_free.size());
-    int tested = 0;
-    for (size_t c = 0; c < pool.size(); ++c) tested += usable[c] ? 1 : 0;
-    if (tested == 0) break;
-    const double alpha = options.false_alarm / tested;
-    if (step == 0) out.bonferroni_alpha = alpha;
-
-    std::vector<CandidateScore> scores(pool.size());
-    std::vector<ModelState> states(pool.size(), current);
-    std::vector<FitSummary> fits(pool.size());
-    std::vector<double> log_p(pool.size(), 0.0);
-    std::vector<std::vector<double>> cv_err(pool.size());
-    ParallelFor(static_cast<int>(pool.size()), options.num_threads, [&](int c) {
-      CandidateScore& s = scores[c];
-      const Candidate& cand = pool[c];
-      s.cause = cand.cause;
-      s.joint = cand.joint >= 0 ? pb.nominal.rows[cand.joint].name : "";
-      s.k = static_cast<int>(cand.params.size());
-      s.identifiable = usable[c];
-      if (!usable[c] || n_res - p - s.k <= 0) {
-        s.identifiable = false;
-        s.train_rms_mm = s.heldout_rms_mm = kNaN;
-        return;
-      }
-      std::vector<ParamInfo> refit_free = screen_free;
-      for (const ParamInfo& q : cand.params) refit_free.push_back(q);
-      const FitOptions fo = pb.CandidateRefit(refit_free);
-      // Start from the Gauss-Newton step of the linearised joint model, so
-      // that the refit needs few iterations: normal equations of [base,
-      // candidate columns], Jacobi-scaled.
-      const int pb_cols = static_cast<int>(screen_raw.cols());
-      const Eigen::MatrixXd cc = candidate_columns(cand_jac, cand);
-      Eigen::MatrixXd ntn(pb_cols + s.k, pb_cols + s.k);
-      ntn.topLeftCorner(pb_cols, pb_cols) = base_ntn;
-      ntn.topRightCorner(pb_cols, s.k) = screen_raw.transpose() * cc;
-      ntn.bottomLeftCorner(s.k, pb_cols) =
-          ntn.topRightCorner(pb_cols, s.k).transpose();
-      ntn.bottomRightCorner(s.k, s.k) = cc.transpose() * cc;
-      Eigen::VectorXd ntr(pb_cols + s.k);
-      ntr.head(pb_cols) = base_ntr;
-      ntr.tail(s.k) = cc.transpose() * r0;
-      Eigen::VectorXd scale(ntn.cols());
-      for (int q = 0; q < ntn.cols(); ++q) {
-        scale[q] = ntn(q, q) > 0 ? 1.0 / std::sqrt(ntn(q, q)) : 1.0;
-      }
-      Eigen::VectorXd step;
-      if (options.exact_jacobian) {
-        step =
-            scale.asDiagonal() * (scale.asDiagonal() * ntn * scale.asDiagonal())
-                                     .ldlt()
-                                     .solve(-(scale.asDiagonal() * ntr));
-      } else {  // QR of the scaled Jacobian, as before
-        Eigen::MatrixXd a(screen_raw.rows(), pb_cols + s.k);
-        a << screen_raw, cc;
-        step = scale.asDiagonal() *
-               (a * scale.asDiagonal()).colPivHouseholderQr().solve(-r0);
-      }
-      for (int q = 0; q < static_cast<int>(fo.free.size()); ++q) {
-        if (std::isfinite(step[q]))
-          *ParamAddress(&states[c], fo.free[q]) += step[q];
-      }
-      // Differentiated in the free parameters only (diagnose/free_fit.h).
-      FreeFitOptions ffo = FreeFitOptionsFrom(fo);
-      ffo.exact_jacobian = options.exact_jacobian;
-      // A candidate whose linearised gain (the Gauss-Newton start's) is far
-      // from significant (p above 100x the step's alpha) keeps the start:
-      // its RSS there is that of a feasible model, an upper bound of the
-      // refit's, so its F-test can only be conservative. Most candidates of
-      // the later steps are such; the refits were most of the time.
-      const double lin_drop = std::max(0.0, -ntr.dot(step));
-      const double lin_d2 = n_res - p - s.k;
-      const double lin_rss = std::max(current_rss - lin_drop, 1e-300);
-      const bool hopeless =
-          options.exact_jacobian && options.free_parameter_fit && lin_d2 > 0 &&
-          LogFUpperTail((lin_drop / s.k) / (lin_rss / lin_d2), s.k, lin_d2) >
-              std::log(100.0 * alpha);
-      if (hopeless) {
-        // the start is the model scored below
-      } else if (options.free_parameter_fit) {
-        FreeFit(pb.train, ffo, &states[c]);
-      } else {
-        fits[c] = Fit(pb.train, fo, &states[c]);
-      }
-      if (options.exact_jacobian) {
-        // The same sums from the exact Jacobian's residual pass.
-        Eigen::VectorXd rt, rh;
-        ResidualsAndJacobian(pb.train, states[c], {}, &rt, nullptr);
-        ResidualsAndJacobian(pb.held, states[c], {}, &rh, nullptr);
-        s.rss = rt.squaredNorm();
-        s.train_rms_mm =
-            std::sqrt(s.rss / static_cast<double>(pb.train.size()));
-        s.heldout_rms_mm = pb.held.empty()
-                               ? kNaN
-                               : std::sqrt(rh.squaredNorm() /
-                                           static_cast<double>(pb.held.size()));
-      } else {
-        s.rss = Rss(states[c], pb.train);
-        s.train_rms_mm = Rms(states[c], pb.train);
-        s.heldout_rms_mm = Rms(states[c], pb.held);
-      }
-      const double d2 = n_res - p - s.k;
-      // RSS changes at the solver's precision are no evidence.
-      double drop = current_rss - s.rss;
-      if (drop < 1e-10 * current_rss) drop = 0.0;
-      s.f = s.rss > 0 ? (drop / s.k) / (s.rss / d2)
-                      : std::numeric_limits<double>::infinity();
-      log_p[c] = LogFUpperTail(s.f, s.k, d2);
-      s.p_value = std::exp(log_p[c]);
-      // With folds the cross-validated RMS must drop (computed only for
-      // the candidates that pass the F-test: the few that can win);
-      // without, the single held-out split's.
-      const bool f_passes =
-          std::log(alpha) > log_p[c] && drop > 0 &&
-          std::sqrt(drop / static_cast<double>(pb.train.size())) >=
-              options.min_effect_mm;
-      if (folds.folds >= 2 && f_passes) {
-        s.cv_rms_mm =
-            CrossValidatedRms(pb.train, folds, states[c], cv_options(fo.free),
-                              options.cv_refit, &cv_err[c]);
-        s.cv_z = PairedZ(current_cv_err, cv_err[c]);
-      }
-      const bool held_better =
-          folds.folds >= 2
-              ? s.cv_rms_mm < current_cv && s.cv_z > options.cv_min_z
-              : pb.held.empty() || s.heldout_rms_mm < current_held;
-      const double explained_mm =
-          std::sqrt(drop / static_cast<double>(pb.train.size()));
-      s.validation_rms_mm =
-          options.exact_jacobian
-              ? ValidationRmsFrom(states[c], validation_frame, validation)
-              : ValidationRms(states[c], validation);
-      const bool validation_better =
-          validation.empty() || s.validation_rms_mm < current_validation;
-      s.significant = std::log(alpha) > log_p[c] && held_better &&
-                      validation_better &&
-                      explained_mm >= options.min_effect_mm;
-      const Magnitude mag =
-          CandidateMagnitude(cand, states[c], fits[c], scale_of(cand));
-      s.magnitude = mag.value;
-      s.unit = unit_of(cand, mag.unit);
-    });
-    out.steps.push_back(scores);
-    if (step == 0) {
-      for (size_t c = 0; c < pool.size(); ++c) {
-        if (!usable[c])
-          out.not_identifiable.push_back(pool[c].Label(pb.nominal));
-      }
-    }
-
-    int best = -1;
-    for (size_t c = 0; c < pool.size(); ++c) {
-      if (!scores[c].significant) continue;
-      // With validation series the candidate that predicts them best wins
-      // (the F-test only admits); else with folds the lowest
-      // cross-validated RMS; else the most significant one.
-      const bool better =
-          !validation.empty()
-              ? scores[c].validation_rms_mm < scores[best].validation_rms_mm
-          : folds.folds >= 2
-              ? scores[c].cv_rms_mm < scores[best].cv_rms_mm
-              : (log_p[c] < log_p[best] ||
-                 (log_p[c] == log_p[best] && scores[c].rss < scores[best].rss));
-      if (best < 0 || better) {
-        best = static_cast<int>(c);
-      }
-    }
-    // With folds and no validation series: candidates whose out-of-fold
-    // errors are within `cv_tie_z` standard errors of the winner's (paired
-    // over the training poses) predict as well on this data; among them the
-    // most significant (the F-test's ranking, which prefers fewer
-    // parameters) wins. Without this rule a candidate that nests the true
-    // one (cyclic j5's cos, sin against compliance j5 on BH-7) wins by its
-    // extra parameter's fit to the noise (bench --only cv-sim: compliance
-    // j5 named 35/40 instead of 40/40).
-    if (best >= 0 && validation.empty() && folds.folds >= 2 &&
-        options.cv_tie_z > 0) {
-      const int cv_best = best;
-      for (size_t c = 0; c < pool.size(); ++c) {
-        if (!scores[c].significant || static_cast<int>(c) == cv_best) continue;
-        if (PairedZ(cv_err[c], cv_err[cv_best]) < options.cv_tie_z &&
-            log_p[c] < log_p[best]) {
-          best = static_cast<int>(c);
-        }
-      }
-    }
-    if (best < 0) break;
-    if (screen_free.size() < current_free.size()) {
-      // The winner refitted jointly with the extensions held in screening,
-      // kept only when it fits the training poses better without predicting
-      // the validation series worse.
-      const ModelState screened_state = states[best];
-      const CandidateScore screened = scores[best];
-      const std::vector<double> screened_cv_err = cv_err[best];
-      std::vector<ParamInfo> refit_free = current_free;
-      for (const ParamInfo& q : pool[best].params) refit_free.push_back(q);
-      const FitOptions fo = pb.CandidateRefit(refit_free);
-      if (options.free_parameter_fit) {
-        FreeFitOptions ffo = FreeFitOptionsFrom(fo);
-        ffo.exact_jacobian = options.exact_jacobian;
-        FreeFit(pb.train, ffo, &states[best]);
-      } else {
-        fits[best] = Fit(pb.train, fo, &states[best]);
-      }
-      CandidateScore& w = scores[best];
-      w.rss = Rss(states[best], pb.train);
-      w.train_rms_mm = Rms(states[best], pb.train);
-      if (!pb.held.empty()) w.heldout_rms_mm = Rms(states[best], pb.held);
-      if (!validation.empty())
-        w.validation_rms_mm = ValidationRms(states[best], validation);
-      w.magnitude = CandidateMagnitude(pool[best], states[best], fits[best],
-                                       scale_of(pool[best]))
-                        .value;
-      if (folds.folds >= 2) {
-        w.cv_rms_mm = CrossValidatedRms(pb.train, folds, states[best],
-                                        cv_options(fo.free), options.cv_refit,
-                                        &cv_err[best]);
-      }
-      if (!(w.rss <= screened.rss) ||
-          (!validation.empty() &&
-           !(w.validation_rms_mm <= screened.validation_rms_mm))) {
-        states[best] = screened_state;
-        scores[best] = screened;
-        cv_err[best] = screened_cv_err;
-      }
-    }
-    const CandidateScore& b = scores[best];
-    Finding f;
-    f.cause = b.cause;
-    f.joint = b.joint;
-    f.heldout_rms_before_mm = current_held;
-    f.heldout_rms_after_mm = b.heldout_rms_mm;
-    f.validation_rms_before_mm = current_validation;
-    f.validation_rms_after_mm = b.validation_rms_mm;
-    f.cv_rms_before_mm = current_cv;
-    f.cv_rms_after_mm = b.cv_rms_mm;
-    f.train_rms_after_mm = b.train_rms_mm;
-    f.f = b.f;
-    f.p_value = b.p_value;
-    // Candidates that predict the same errors on this data.
-    const double sigma2 = b.rss / (n_res - p - b.k);
-    for (size_t c = 0; c < pool.size(); ++c) {
-      if (static_cast<int>(c) == best || !scores[c].identifiable) continue;
-      if (scores[c].rss - b.rss < kChi2One95 * sigma2 &&
-          std::log(alpha) > log_p[c]) {
-        f.equivalent.push_back(
-            {scores[c].cause, scores[c].joint, scores[c].magnitude,
-             scores[c].unit, scores[c].train_rms_mm, scores[c].heldout_rms_mm});
-      }
-    }
-    out.findings.push_back(f);
-    accepted.push_back(pool[best]);
-    current = states[best];
-    for (const ParamInfo& q : pool[best].params) current_free.push_back(q);
-    current_rss = b.rss;
-    current_held = b.heldout_rms_mm;
-    current_validation = b.validation_rms_mm;
-    current_cv = b.cv_rms_mm;
-    current_cv_err = cv_err[best];
-    pool.erase(pool.begin() + best);
-    // A joint's error along the travel (transmission) and its low harmonics
-    // and gain describe nearly the same function inside the travel and
-    // differ outside it: once one kind is in the model, the other leaves the
-    // pool (together they drift apart along that near-degenerate direction
-    // and extrapolate wildly: UR10 C --validate A gave 128 mm on A).
-    const Candidate& won = accepted.back();
-    auto along_travel = [](const std::string& cause) {
-      return TransmissionTerms(cause) > 0                     ? 1
-             : (CyclicHarmonic(cause) > 0 || cause == "gain") ? 2
-                                                              : 0;
-    };
-    if (along_travel(won.cause) > 0) {
-      pool.erase(std::remove_if(pool.begin(), pool.end(),
-                                [&](const Candidate& c) {
-                                  const int kind = along_travel(c.cause);
-                                  return c.joint == won.joint && kind > 0 &&
-                                         kind != along_travel(won.cause);
-                                }),
-                 pool.end());
-    }
-  }
-  out.final_train_rms_mm = Rms(current, pb.train);
-  out.final_heldout_rms_mm = current_held;
-  out.final_validation_rms_mm = current_validation;
-  out.final_cv_rms_mm = current_cv;
+  Selection selection(problem, obs, options);
+  if (out.folds >= 2)
+    selection.folds = MakeFolds(problem.train, out.folds, options.seed);
+  selection.num_residuals = 3 * static_cast<int>(problem.train.size());
+  selection.thermal_kelvin = ThermalUsesTemperature(obs);
+  selection.validation = ValidationMeasurements(problem.nominal, options);
+  CurrentModel current = BaseModel(selection, &out);
+  const std::vector<Candidate> accepted =
+      SelectCandidates(selection, &current, &out);
+  out.final_train_rms_mm = Rms(current.state, problem.train);
+  out.final_heldout_rms_mm = current.heldout_rms_mm;
+  out.final_validation_rms_mm = current.validation_rms_mm;
+  out.final_cv_rms_mm = current.cv_rms_mm;
   out.residual_sigma_mm = std::sqrt(
-      current_rss / std::max(1, n_res - static_cast<int>(current_free.size())));
+      current.rss / std::max(1, selection.num_residuals -
+                                    static_cast<int>(current.free.size())));
 
-  // Final model on all poses: magnitudes and 95 % intervals.
-  ModelState final_state = current;
-  FitOptions fo = pb.Boxed(current_free);
-  fo.compute_covariance = true;
-  FitSummary final_fit;
-  if (options.exact_jacobian) {
-    final_fit =
-        FreeFitWithCovariance(pb.all, FreeFitOptionsFrom(fo), &final_state);
-  } else {
-    final_fit = Fit(pb.all, fo, &final_state);
-  }
-  for (size_t i = 0; i < accepted.size(); ++i) {
-    const Candidate& c = accepted[i];
-    const Magnitude m =
-        CandidateMagnitude(c, final_state, final_fit, scale_of(c));
-    out.findings[i].magnitude = m.value;
-    out.findings[i].unit = unit_of(c, m.unit);
-    out.findings[i].ci_low = m.ci_low;
-    out.findings[i].ci_high = m.ci_high;
-  }
-
-  // Noise and the systematic rest.
-  if (options.noise_mm > 0) {
-    out.noise_mm = options.noise_mm;
-    out.noise_source = "stated";
-  } else if (const double rep = RepeatedPoseNoise(pb.all); rep > 0) {
-    out.noise_mm = rep;
-    out.noise_source = "repeated poses";
-  } else if (const double nn = NearestPoseNoise(current, pb.train); nn > 0) {
-    out.noise_mm = nn;
-    out.noise_source = "nearest poses (upper bound)";
-  } else {
-    out.noise_source = "none";
-  }
-  const int dof = n_res - static_cast<int>(current_free.size());
-  if (out.noise_mm > 0 && dof >= 10) {
-    const double excess = out.residual_sigma_mm * out.residual_sigma_mm -
-                          out.noise_mm * out.noise_mm;
-    out.systematic_rms_mm = std::sqrt(std::max(0.0, 3.0 * excess));
-    if (out.residual_sigma_mm > options.unexplained_ratio * out.noise_mm &&
-        out.systematic_rms_mm > options.min_effect_mm) {
-      Finding u;
-      u.cause = "unexplained";
-      u.magnitude = out.systematic_rms_mm;
-      u.unit = "mm";
-      // Chi-square interval of the residual variance (normal approximation).
-      const double rel = kZ95 * std::sqrt(2.0 / dof);
-      const double s2 = out.residual_sigma_mm * out.residual_sigma_mm;
-      const double n2 = out.noise_mm * out.noise_mm;
-      u.ci_low = std::sqrt(std::max(0.0, 3.0 * (s2 * (1 - rel) - n2)));
-      u.ci_high = std::sqrt(std::max(0.0, 3.0 * (s2 * (1 + rel) - n2)));
-      u.heldout_rms_before_mm = u.heldout_rms_after_mm = current_held;
-      u.validation_rms_before_mm = u.validation_rms_after_mm =
-          current_validation;
-      u.cv_rms_before_mm = u.cv_rms_after_mm = current_cv;
-      u.train_rms_after_mm = out.final_train_rms_mm;
-      u.p_value = kNaN;
-      u.f = s2 / n2;
-      // What the rest depends on: a smooth correction over the pose inputs,
-      // chosen by cross-validation, tested on the held-out poses.
-      const SmoothCorrection sc = SmoothRest(obs, pb, current);
-      u.depends_on = sc.depends_on;
-      u.cv_explained = sc.cv_explained;
-      u.smooth_k = sc.k;
-      u.single_inputs = sc.single;
-      u.point_cv_explained = sc.point_cv_explained;
-      if (!pb.held.empty()) u.heldout_rms_after_mm = sc.heldout_rms_after_mm;
-      out.findings.push_back(u);
-    }
-  }
+  const ModelState final_state = FinalRefit(selection, current, accepted, &out);
+  EstimateNoise(options, problem, current.state, &out);
+  UnexplainedRest(selection, current, &out);
   out.verdict = out.findings.empty() ? "no_significant_effect" : "effect_found";
-  {
-    std::set<int> held_rows;
-    for (const Measurement& m : pb.held) held_rows.insert(m.row);
-    for (const Measurement& m : pb.all) {
-      out.rows.push_back(m.row);
-      out.heldout.push_back(held_rows.count(m.row) > 0);
-      out.residuals.push_back(Residual(final_state, m));
-    }
-  }
+  PerPoseResiduals(problem, final_state, &out);
   out.state = final_state;
   out.extended = final_state.chain.ToRobot(nominal);
   out.seconds =
@@ -858,27 +953,29 @@ std::vector<Magnitude> FitCandidates(const Robot& nominal,
                                      const Observations& obs,
                                      const std::vector<std::string>& labels,
                                      double* sigma0_mm) {
-  Problem pb;
-  pb.nominal = Chain::FromRobot(nominal);
-  pb.base_state = StateWithChain(pb.nominal);
-  pb.all = Measurements(pb.nominal, obs, &pb.base_state);
-  SetTransmissionTravel(pb.all, &pb.nominal);
-  SetTransmissionTravel(pb.all, &pb.base_state.chain);
-  for (Measurement& m : pb.all) FillTransmissionSines(pb.nominal, &m.input);
-  FitBase(pb.all, obs, nominal.bounds_stated, &pb);
+  Problem problem;
+  problem.nominal = Chain::FromRobot(nominal);
+  problem.base_state = StateWithChain(problem.nominal);
+  problem.all = Measurements(problem.nominal, obs, &problem.base_state);
+  SetTransmissionTravel(problem.all, &problem.nominal);
+  SetTransmissionTravel(problem.all, &problem.base_state.chain);
+  for (Measurement& m : problem.all)
+    FillTransmissionSines(problem.nominal, &m.input);
+  FitBase(problem.all, obs, nominal.bounds_stated, GeometrySolver::kCeres,
+          &problem);
   const std::vector<Candidate> catalogue =
-      CatalogueCandidates(pb.nominal, pb.all);
-  const Eigen::MatrixXd basis =
-      Basis(Normalized(ResidualJacobian(pb.all, pb.base_state, pb.base_free)));
+      CatalogueCandidates(problem.nominal, problem.all);
+  const Eigen::MatrixXd basis = Basis(Normalized(
+      ResidualJacobian(problem.all, problem.base_state, problem.base_free)));
   std::vector<Candidate> chosen(labels.size());
   std::vector<bool> found(labels.size(), false);
-  FitOptions fo = pb.Boxed(pb.base_free);
+  FitOptions fit_options = problem.Boxed(problem.base_free);
   Eigen::MatrixXd model = basis;
   for (size_t i = 0; i < labels.size(); ++i) {
     for (const Candidate& c : catalogue) {
-      if (c.Label(pb.nominal) != labels[i]) continue;
+      if (c.Label(problem.nominal) != labels[i]) continue;
       const Eigen::MatrixXd cols =
-          ResidualJacobian(pb.all, pb.base_state, c.params);
+          ResidualJacobian(problem.all, problem.base_state, c.params);
       if (!IdentifiableAgainst(model, cols)) break;
       model = Basis(Normalized([&] {
         Eigen::MatrixXd m(model.rows(), model.cols() + cols.cols());
@@ -887,11 +984,11 @@ std::vector<Magnitude> FitCandidates(const Robot& nominal,
       }()));
       chosen[i] = c;
       found[i] = true;
-      for (const ParamInfo& q : c.params) fo.free.push_back(q);
+      for (const ParamInfo& q : c.params) fit_options.free.push_back(q);
     }
   }
-  ModelState state = pb.base_state;
-  const FitSummary fit = Fit(pb.all, fo, &state);
+  ModelState state = problem.base_state;
+  const FitSummary fit = Fit(problem.all, fit_options, &state);
   if (sigma0_mm) *sigma0_mm = fit.sigma0_mm;
   std::vector<Magnitude> out;
   for (size_t i = 0; i < labels.size(); ++i) {
@@ -903,7 +1000,8 @@ std::vector<Magnitude> FitCandidates(const Robot& nominal,
     }
     const Candidate& c = chosen[i];
     out.push_back(CandidateMagnitude(
-        c, state, fit, MagnitudeScale(c.cause, c.joint, pb.nominal, pb.all)));
+        c, state, fit,
+        MagnitudeScale(c.cause, c.joint, problem.nominal, problem.all)));
   }
   return out;
 }

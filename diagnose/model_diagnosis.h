@@ -11,8 +11,9 @@
 //      lie in the span of the base's is equivalent to geometry and skipped):
 //      backlash (s), compliance (gravity torque), cyclic (cos q, sin q), gain
 //      (q), axis_tilt (Hayati beta on nominally parallel axes), drift (t).
-//   4. Each candidate is refitted JOINTLY with geometry and frame (Ceres, one
-//      Fit with the candidate's parameters freed). Nested-model F-test,
+//   4. Each candidate is refitted JOINTLY with geometry and frame
+//      (Levenberg-Marquardt on the exact Jacobian, calib/free_fit.h, with the
+//      candidate's parameters freed). Nested-model F-test,
 //      F = ((RSS0 - RSS1) / k) / (RSS1 / (n - p - k)), Bonferroni-corrected
 //      over the candidates of the step (family-wise false-alarm rate
 //      `false_alarm` per step), and the candidate must predict the left-out
@@ -63,14 +64,6 @@ struct DiagnoseOptions {
   // Residual scatter above this multiple of the noise counts as systematic.
   double unexplained_ratio = 1.5;
   int num_threads = 2;
-  // Candidate refits differentiate only the free parameters
-  // (diagnose/free_fit.h); false = calib/fit.h's Fit (the speed reference
-  // of bench/diagnose_bench --only ur10).
-  bool free_parameter_fit = true;
-  // With free_parameter_fit: Levenberg-Marquardt on the exact Jacobian
-  // (diagnose/exact_jacobian.h); false = Ceres with autodiff in the free
-  // parameters (the path before, bench/diagnose_bench --only ur10).
-  bool exact_jacobian = true;
   // Restrict candidates to these causes (empty = all of the catalogue).
   std::vector<std::string> causes;
   // Cross-series validation: other measured series of the same robot that

@@ -1,89 +1,15 @@
-#include "diagnose/free_fit.h"
-
-#include <ceres/ceres.h>
+#include "calib/free_fit.h"
 
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
 #include <algorithm>
-#include <array>
 #include <cmath>
 #include <limits>
 
-#include "diagnose/exact_jacobian.h"
+#include "calib/exact_jacobian.h"
 
 namespace kincal {
 namespace {
-
-constexpr int kMaxJoints = 16;
-// Derivatives per autodiff pass (32 was slower on UR10 C: 38.7 s CPU vs
-// 18.6 s at 8, load ~11).
-constexpr int kStride = 8;
-
-// Where each free parameter goes: its block kind, block and index.
-struct Slot {
-  ParamKind kind;
-  int block, index;
-};
-
-class FreeResidual {
- public:
-  FreeResidual(const ModelState& state, const std::vector<Slot>& slots,
-               const Measurement& m)
-      : state_(state), slots_(slots), m_(m) {}
-
-  template <typename T>
-  bool operator()(T const* const* params, T* residual) const {
-    const Chain& chain = state_.chain;
-    const int n = chain.num_joints();
-    std::array<std::array<T, kRowBlockSize>, kMaxJoints + 1> rows;
-    std::array<std::array<T, kJointErrorBlockSize>, kMaxJoints> errs;
-    std::array<T, kDriftBlockSize> global;
-    std::array<T, kFrameBlockSize> frame;
-    for (int r = 0; r <= n; ++r)
-      for (int k = 0; k < kRowBlockSize; ++k)
-        rows[r][k] = T(chain.rows[r].p[k]);
-    for (int j = 0; j < n; ++j)
-      for (int k = 0; k < kJointErrorBlockSize; ++k)
-        errs[j][k] = T(chain.joint_errors[j][k]);
-    for (int k = 0; k < kDriftBlockSize; ++k) global[k] = T(chain.drift[k]);
-    for (int k = 0; k < kFrameBlockSize; ++k)
-      frame[k] = T(state_.meas_from_base[k]);
-    const T* x = params[0];
-    for (size_t i = 0; i < slots_.size(); ++i) {
-      const Slot& s = slots_[i];
-      switch (s.kind) {
-        case ParamKind::kRow:
-          rows[s.block][s.index] = x[i];
-          break;
-        case ParamKind::kJointError:
-          errs[s.block][s.index] = x[i];
-          break;
-        case ParamKind::kDrift:
-          global[s.index] = x[i];
-          break;
-        case ParamKind::kFrame:
-          frame[s.index] = x[i];
-          break;
-        case ParamKind::kPoint:
-          break;  // not used by the diagnosis (measured rows only)
-      }
-    }
-    const T* row_ptrs[kMaxJoints + 1];
-    const T* err_ptrs[kMaxJoints];
-    for (int r = 0; r <= n; ++r) row_ptrs[r] = rows[r].data();
-    for (int j = 0; j < n; ++j) err_ptrs[j] = errs[j].data();
-    const Vec3<T> tip =
-        TipInBase<T>(chain, row_ptrs, err_ptrs, global.data(), m_.input);
-    const Vec3<T> p = ApplyFrame(frame.data(), tip);
-    for (int k = 0; k < 3; ++k) residual[k] = p[k] - m_.p_in_meas[k];
-    return true;
-  }
-
- private:
-  const ModelState& state_;
-  const std::vector<Slot>& slots_;
-  const Measurement& m_;
-};
 
 // Bounds of the free parameters: +-delta about the nominal geometry for row
 // entries (as calib/fit.h), none otherwise.
@@ -103,7 +29,7 @@ void Bounds(const FreeFitOptions& options, std::vector<double>* lower,
   }
 }
 
-// Levenberg-Marquardt on the exact Jacobian (diagnose/exact_jacobian.h),
+// Levenberg-Marquardt on the exact Jacobian (calib/exact_jacobian.h),
 // steps projected onto the bounds; stops as Ceres does: relative cost change
 // <= function_tolerance or step <= parameter_tolerance (|x| +
 // parameter_tolerance). Starts with a Gauss-Newton step (lambda 0); the
@@ -113,8 +39,9 @@ void Bounds(const FreeFitOptions& options, std::vector<double>* lower,
 // Jacobian (a chord step: the Jacobian moved by O(step), far below what the
 // tolerances see); a chord step that does not lower the cost is retried
 // with a fresh Jacobian.
-double ExactFreeFit(const std::vector<Measurement>& ms,
-                    const FreeFitOptions& options, ModelState* state) {
+double BoundedLevenbergMarquardt(const std::vector<Measurement>& ms,
+                                 const FreeFitOptions& options,
+                                 ModelState* state) {
   constexpr double kChordChange = 1e-6;
   const int k = static_cast<int>(options.free.size());
   std::vector<double> lower, upper;
@@ -227,65 +154,18 @@ FreeFitOptions FreeFitOptionsFrom(const FitOptions& fit_options) {
 
 double FreeFit(const std::vector<Measurement>& measurements,
                const FreeFitOptions& options, ModelState* state) {
-  if (options.exact_jacobian) return ExactFreeFit(measurements, options, state);
-  const int k = static_cast<int>(options.free.size());
-  std::vector<Slot> slots;
-  std::vector<double> x(k);
-  for (int i = 0; i < k; ++i) {
-    const ParamInfo& p = options.free[i];
-    slots.push_back({p.kind, p.block, p.index});
-    x[i] = ParamValue(*state, p);
-  }
-  // The functors read the frozen values from this copy.
-  const ModelState frozen = *state;
-  ceres::Problem::Options po;
-  ceres::Problem problem(po);
-  std::vector<std::unique_ptr<FreeResidual>> keep;
-  for (const Measurement& m : measurements) {
-    if (m.kind != Measurement::kMeasured) continue;
-    auto* cost = new ceres::DynamicAutoDiffCostFunction<FreeResidual, kStride>(
-        new FreeResidual(frozen, slots, m));
-    cost->AddParameterBlock(k);
-    cost->SetNumResiduals(3);
-    problem.AddResidualBlock(cost, nullptr, x.data());
-  }
-  if (k > 0 && problem.NumResidualBlocks() > 0) {
-    std::vector<double> lower, upper;
-    Bounds(options, &lower, &upper);
-    for (int i = 0; i < k; ++i) {
-      if (!std::isfinite(lower[i])) continue;  // no box (not a row entry)
-      x[i] = std::min(std::max(x[i], lower[i]), upper[i]);
-      problem.SetParameterLowerBound(x.data(), i, lower[i]);
-      problem.SetParameterUpperBound(x.data(), i, upper[i]);
-    }
-    ceres::Solver::Options solver;
-    solver.linear_solver_type = ceres::DENSE_QR;
-    solver.max_num_iterations = options.max_iterations;
-    solver.function_tolerance = options.function_tolerance;
-    solver.parameter_tolerance = options.parameter_tolerance;
-    solver.gradient_tolerance = 1e-14;
-    solver.logging_type = ceres::SILENT;
-    ceres::Solver::Summary summary;
-    ceres::Solve(solver, &problem, &summary);
-  }
-  for (int i = 0; i < k; ++i) *ParamAddress(state, options.free[i]) = x[i];
-  double rss = 0.0;
-  for (const Measurement& m : measurements)
-    rss += Residual(*state, m).squaredNorm();
-  return rss;
+  return BoundedLevenbergMarquardt(measurements, options, state);
 }
 
 FitSummary FreeFitWithCovariance(const std::vector<Measurement>& measurements,
                                  const FreeFitOptions& options,
                                  ModelState* state) {
   FitSummary summary;
-  FreeFitOptions o = options;
-  o.exact_jacobian = true;
   int m = 0;
   for (const Measurement& x : measurements)
     m += x.kind == Measurement::kMeasured ? 1 : 0;
   summary.initial_rms_mm = 0.0;
-  FreeFit(measurements, o, state);
+  FreeFit(measurements, options, state);
   Eigen::VectorXd r;
   Eigen::MatrixXd J;
   ResidualsAndJacobian(measurements, *state, options.free, &r, &J);

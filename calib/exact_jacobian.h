@@ -1,5 +1,5 @@
-#ifndef KINCAL_DIAGNOSE_EXACT_JACOBIAN_H_
-#define KINCAL_DIAGNOSE_EXACT_JACOBIAN_H_
+#ifndef KINCAL_CALIB_EXACT_JACOBIAN_H_
+#define KINCAL_CALIB_EXACT_JACOBIAN_H_
 
 // Residuals of measured rows and their exact Jacobian with respect to a
 // chosen list of parameters, for the candidate refits of `diagnose model`.
@@ -39,4 +39,4 @@ void ResidualsAndJacobian(const std::vector<Measurement>& measurements,
 
 }  // namespace kincal
 
-#endif  // KINCAL_DIAGNOSE_EXACT_JACOBIAN_H_
+#endif  // KINCAL_CALIB_EXACT_JACOBIAN_H_

@@ -1,13 +1,11 @@
-#ifndef KINCAL_DIAGNOSE_FREE_FIT_H_
-#define KINCAL_DIAGNOSE_FREE_FIT_H_
+#ifndef KINCAL_CALIB_FREE_FIT_H_
+#define KINCAL_CALIB_FREE_FIT_H_
 
-// The candidate refits of `diagnose model`, differentiated only in the free
-// parameters: one compact Ceres parameter block holds just the parameters a
-// fit may change; every frozen entry of the chain stays a plain double.
-// calib/fit.h's Fit differentiates every entry of every block (~120 for a
-// 6-joint arm) and masks the frozen ones afterwards; a candidate fit frees
-// ~25, so autodiff does ~5x less work. Same model (calib/chain.h TipInBase),
-// same bounds (+-delta about the nominal geometry), no covariance.
+// Bounded Levenberg-Marquardt on the exact Jacobian (calib/exact_jacobian.h)
+// in the free parameters only: the candidate refits of `diagnose model` and
+// its base model's geometry fits (calib/calibrate.h GeometrySolver). Same
+// model (calib/chain.h TipInBase) and bounds (+-delta about the nominal
+// geometry) as calib/fit.h's Fit; measured rows only.
 
 #include <map>
 #include <string>
@@ -27,10 +25,6 @@ struct FreeFitOptions {
   int max_iterations = 100;
   double function_tolerance = 1e-10;
   double parameter_tolerance = 1e-10;
-  // true: Levenberg-Marquardt on the exact Jacobian of
-  // diagnose/exact_jacobian.h (one pass per pose for all columns); false:
-  // Ceres with autodiff in the free parameters (the speed reference).
-  bool exact_jacobian = true;
 };
 
 // The same free parameters, box and stopping rules as a calib/fit.h fit
@@ -46,7 +40,7 @@ double FreeFitBound(const FreeFitOptions& options, const ParamInfo& p);
 double FreeFit(const std::vector<Measurement>& measurements,
                const FreeFitOptions& options, ModelState* state);
 
-// FreeFit (exact Jacobian), then, as calib/fit.h's Fit with
+// FreeFit, then, as calib/fit.h's Fit with
 // compute_covariance: sigma0 = sqrt(RSS / (3 m - p)) and the covariance
 // sigma0^2 (J^T J)^+ of the free parameters (eigenvalues below 1e-14 of the
 // largest dropped, as ceres::Covariance DENSE_SVD with null_space_rank -1).
@@ -56,4 +50,4 @@ FitSummary FreeFitWithCovariance(const std::vector<Measurement>& measurements,
 
 }  // namespace kincal
 
-#endif  // KINCAL_DIAGNOSE_FREE_FIT_H_
+#endif  // KINCAL_CALIB_FREE_FIT_H_

@@ -1,4 +1,4 @@
-#include "diagnose/exact_jacobian.h"
+#include "calib/exact_jacobian.h"
 
 #include <gtest/gtest.h>
 
