@@ -12,6 +12,7 @@
 #include "data/atomic_file.h"
 #include "data/error.h"
 #include "data/provenance.h"
+#include "data/rigid3.h"
 #include "data/urdf.h"
 #include "synth/recorded_session.h"
 #include "synth/render.h"
@@ -68,14 +69,7 @@ int RunSimulate(SimulateArgs args) {
     const Rigid3 rig_from_base =
         PlaceRigFacingTips(Simulate(nominal, opt).base_from_tip, rig,
                            TipFromTool(target), 0.9, &rig_distance);
-    const Eigen::AngleAxisd aa(rig_from_base.R);
-    const Eigen::Vector3d w = aa.axis() * aa.angle();
-    opt.meas_from_base = {w.x(),
-                          w.y(),
-                          w.z(),
-                          rig_from_base.t.x(),
-                          rig_from_base.t.y(),
-                          rig_from_base.t.z()};
+    opt.meas_from_base = PoseBlockFromRigid3(rig_from_base);
     // Tags at least ~40 px wide at that distance: scale the example tool.
     const double tag_mm = 40.0 * rig_distance / rig.cameras.at(0).intrinsics.fx;
     const double scale = std::max(1.0, tag_mm / target.tags.at(0).size_mm);
@@ -130,18 +124,11 @@ int RunSimulate(SimulateArgs args) {
   MakeDirs(args.out);
   int rendered = 0;
   if (args.render) {
-    const Rigid3 rig_from_base = Rigid3::FromMatrix([&] {
-      Eigen::Matrix4d m = Eigen::Matrix4d::Identity();
-      const Eigen::Vector3d w(s.meas_from_base[0], s.meas_from_base[1],
-                              s.meas_from_base[2]);
-      if (w.norm() > 0) {
-        m.block<3, 3>(0, 0) =
-            Eigen::AngleAxisd(w.norm(), w.normalized()).toRotationMatrix();
-      }
-      m.block<3, 1>(0, 3) = Eigen::Vector3d(
-          s.meas_from_base[3], s.meas_from_base[4], s.meas_from_base[5]);
-      return m;
-    }());
+    const Rigid3 rig_from_base{
+        RotationMatrixFromVector(Eigen::Vector3d(
+            s.meas_from_base[0], s.meas_from_base[1], s.meas_from_base[2])),
+        Eigen::Vector3d(s.meas_from_base[3], s.meas_from_base[4],
+                        s.meas_from_base[5])};
     std::vector<Rigid3> rig_from_tool;
     for (const Eigen::Matrix4d& m : s.base_from_tip) {
       rig_from_tool.push_back(rig_from_base * Rigid3::FromMatrix(m) *

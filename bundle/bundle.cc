@@ -2,7 +2,6 @@
 
 #include <ceres/ceres.h>
 #include <ceres/normal_prior.h>
-#include <ceres/rotation.h>
 
 #include <Eigen/Dense>
 #include <algorithm>
@@ -17,6 +16,7 @@
 
 #include "data/error.h"
 #include "data/observations.h"
+#include "data/rigid3.h"
 
 namespace kincal {
 namespace {
@@ -36,24 +36,15 @@ struct State {
   std::vector<std::array<double, 6>> cam_from_rig;
 };
 
-std::array<double, 6> ToBlock(const Rigid3& r) {
-  const Eigen::AngleAxisd aa(r.R);
-  const Eigen::Vector3d w = aa.axis() * aa.angle();
-  return {w.x(), w.y(), w.z(), r.t.x(), r.t.y(), r.t.z()};
-}
-
-Rigid3 FromBlock(const std::array<double, 6>& b) {
-  Rigid3 r;
-  Eigen::Matrix3d R;
-  ceres::AngleAxisToRotationMatrix(b.data(), R.data());  // column-major
-  r.R = R;
-  r.t = Eigen::Vector3d(b[3], b[4], b[5]);
-  return r;
-}
-
-// All corners of one frame (every camera): 2 residuals per corner, with the
-// per-corner Huber loss applied as a residual scaling (the cost is then
-// exactly sum rho(|r|^2) / 2).
+// All corners of one frame f (every camera c), 2 residuals per corner i:
+//   e_i = ProjectPoint(intrinsics_c, cam_from_rig_c * rig_from_base *
+//                      base_from_flange(q_f) * flange_from_tool * X_i) - u_i
+//   r_i = e_i                                 if |e_i| <= h
+//   r_i = e_i * sqrt(2 h |e_i| - h^2) / |e_i|  otherwise (h = huber_px),
+// so |r_i|^2 = rho(|e_i|^2), Huber's loss per corner, and the frame's cost
+// is sum_i rho(|e_i|^2) / 2. The loss is applied inside the functor, not as
+// a ceres::LossFunction: one residual block holds a whole frame, and a
+// LossFunction would apply one rho to the frame's summed squared norm.
 class FrameCost {
  public:
   FrameCost(const Chain* chain, const PoseInput* input, bool with_errors,
@@ -68,6 +59,23 @@ class FrameCost {
         cameras_(std::move(cameras)),
         pixels_(std::move(pixels)),
         huber_(huber_px) {}
+
+  // The cost function over `block_sizes` (the layout below), 2 residuals per
+  // corner.
+  static ceres::CostFunction* Create(
+      const Chain* chain, const PoseInput* input, bool with_errors,
+      int num_cameras, const std::vector<int>& block_sizes,
+      std::vector<Eigen::Vector3d> points_in_tool, std::vector<int> cameras,
+      std::vector<Eigen::Vector2d> pixels, double huber_px) {
+    const int num_residuals = 2 * static_cast<int>(points_in_tool.size());
+    auto* cost = new ceres::DynamicAutoDiffCostFunction<FrameCost, kStride>(
+        new FrameCost(chain, input, with_errors, num_cameras,
+                      std::move(points_in_tool), std::move(cameras),
+                      std::move(pixels), huber_px));
+    for (int size : block_sizes) cost->AddParameterBlock(size);
+    cost->SetNumResiduals(num_residuals);
+    return cost;
+  }
 
   // Blocks: rows[0..J-1] (6), rig_from_base (6), flange_from_tool (6),
   // [joint errors 0..J-1 (9)], per camera: intrinsics (12), cam_from_rig (6).
@@ -85,9 +93,8 @@ class FrameCost {
       m = m * RowTransform(chain_->convention, chain_->rows[j], p[j], q[j]);
     }
     // rig_from_tool = rig_from_base * base_from_flange * flange_from_tool.
-    Mat3T<T> r_rb, r_ft;
-    ceres::AngleAxisToRotationMatrix(p[nj], r_rb.data());
-    ceres::AngleAxisToRotationMatrix(p[nj + 1], r_ft.data());
+    const Mat3T<T> r_rb = RotationMatrixFromVectorT(p[nj]);
+    const Mat3T<T> r_ft = RotationMatrixFromVectorT(p[nj + 1]);
     const Vec3<T> t_rb(p[nj][3], p[nj][4], p[nj][5]);
     const Vec3<T> t_ft(p[nj + 1][3], p[nj + 1][4], p[nj + 1][5]);
     const Mat3T<T> r_bf = m.template block<3, 3>(0, 0);
@@ -101,8 +108,7 @@ class FrameCost {
     Vec3<T> t_cr[4];
     for (int c = 0; c < num_cameras_ && c < 4; ++c) {
       const T* e = p[cam0 + 2 * c + 1];
-      Mat3T<T> r;
-      ceres::AngleAxisToRotationMatrix(e, r.data());
+      const Mat3T<T> r = RotationMatrixFromVectorT(e);
       r_cr[c] = r * r_rt;
       t_cr[c] = r * t_rt + Vec3<T>(e[3], e[4], e[5]);
     }
@@ -129,14 +135,14 @@ class FrameCost {
   }
 
  private:
-  const Chain* chain_;
-  const PoseInput* input_;
-  bool with_errors_;
-  int num_cameras_;
-  std::vector<Eigen::Vector3d> points_;
-  std::vector<int> cameras_;
-  std::vector<Eigen::Vector2d> pixels_;
-  double huber_;
+  const Chain* const chain_;
+  const PoseInput* const input_;
+  const bool with_errors_;
+  const int num_cameras_;
+  const std::vector<Eigen::Vector3d> points_;
+  const std::vector<int> cameras_;
+  const std::vector<Eigen::Vector2d> pixels_;
+  const double huber_;
 };
 
 // What is variable in one build of the problem.
@@ -212,11 +218,9 @@ Built Build(State* st, const std::vector<Obs>& obs,
     sizes.push_back(6);
   }
   for (const Obs& o : obs) {
-    auto* cost = new ceres::DynamicAutoDiffCostFunction<FrameCost, kStride>(
-        new FrameCost(&st->chain, &inputs[o.index], fr.with_errors, ncam,
-                      o.points, o.cameras, o.pixels, opt.huber_px));
-    for (int s : sizes) cost->AddParameterBlock(s);
-    cost->SetNumResiduals(2 * static_cast<int>(o.points.size()));
+    ceres::CostFunction* cost =
+        FrameCost::Create(&st->chain, &inputs[o.index], fr.with_errors, ncam,
+                          sizes, o.points, o.cameras, o.pixels, opt.huber_px);
     b.blocks.push_back(problem->AddResidualBlock(cost, nullptr, params));
     b.residuals += 2 * static_cast<int>(o.points.size());
   }
@@ -259,7 +263,8 @@ Built Build(State* st, const std::vector<Obs>& obs,
     if (c == 0) {  // the rig frame is the first camera's frame
       problem->SetParameterBlockConstant(ext);
     } else {
-      const std::array<double, 6> e0 = ToBlock(rig0.cameras[c].cam_from_rig);
+      const std::array<double, 6> e0 =
+          PoseBlockFromRigid3(rig0.cameras[c].cam_from_rig);
       Eigen::MatrixXd E = Eigen::MatrixXd::Zero(6, 6);
       Eigen::VectorXd e(6);
       for (int i = 0; i < 6; ++i) {
@@ -468,9 +473,9 @@ bool HandEyeStart(const std::vector<Rigid3>& base_from_flange,
 
 Rigid3 ModelRigFromTool(const BundleResult& result, int index) {
   const bool errors = result.chain.HasJointErrors();
-  return FromBlock(result.rig_from_base) *
+  return Rigid3FromPoseBlock(result.rig_from_base.data()) *
          BaseFromFlange(result.chain, result.inputs.at(index), errors) *
-         FromBlock(result.flange_from_tool);
+         Rigid3FromPoseBlock(result.flange_from_tool.data());
 }
 
 BundleResult RunBundle(const Robot& nominal, const Rig& rig,
@@ -489,7 +494,7 @@ BundleResult RunBundle(const Robot& nominal, const Rig& rig,
   if (rig.cameras.size() > 4) throw InputError("bundle: more than 4 cameras");
   for (const Camera& c : rig.cameras) {
     st.intrinsics.push_back(c.intrinsics.ToArray());
-    st.cam_from_rig.push_back(ToBlock(c.cam_from_rig));
+    st.cam_from_rig.push_back(PoseBlockFromRigid3(c.cam_from_rig));
   }
   // Pose inputs (approach directions, torques) in frame order.
   Observations ob;
@@ -591,8 +596,8 @@ BundleResult RunBundle(const Robot& nominal, const Rig& rig,
         " tags); need at least 3 with different orientations to find where "
         "the base is in the rig and where the target sits on the flange");
   }
-  st.rig_from_base = ToBlock(x);
-  st.flange_from_tool = ToBlock(y);
+  st.rig_from_base = PoseBlockFromRigid3(x);
+  st.flange_from_tool = PoseBlockFromRigid3(y);
 
   Freedom fixed_robot;
   fixed_robot.row_free.assign(nj, {});
@@ -821,7 +826,7 @@ BundleResult RunBundle(const Robot& nominal, const Rig& rig,
   res.heldout_reproj_rms_px = Rms(res.heldout_corner_px);
 
   // Results: the tool row from the tip, the refined rig.
-  const Rigid3 ft = FromBlock(st.flange_from_tool);
+  const Rigid3 ft = Rigid3FromPoseBlock(st.flange_from_tool.data());
   SetToolRow(ft * target.tip_in_tool, &st.chain);
   if (!with_errors) {
     for (auto& e : st.chain.joint_errors) e.fill(0.0);
@@ -840,7 +845,8 @@ BundleResult RunBundle(const Robot& nominal, const Rig& rig,
     k.height = rig.cameras[c].intrinsics.height;
     res.rig.cameras[c].intrinsics = k;
     res.rig.cameras[c].cam_from_rig =
-        c == 0 ? rig.cameras[0].cam_from_rig : FromBlock(st.cam_from_rig[c]);
+        c == 0 ? rig.cameras[0].cam_from_rig
+               : Rigid3FromPoseBlock(st.cam_from_rig[c].data());
   }
   std::vector<double> tip_err;
   for (int i : res.heldout) {

@@ -16,6 +16,7 @@
 #include "calib/identifiability.h"
 #include "data/error.h"
 #include "data/provenance.h"
+#include "data/rigid3.h"
 
 namespace kincal {
 namespace {
@@ -40,12 +41,6 @@ PoseInput MakeInput(const Chain& chain, const std::vector<double>& q) {
   in.s.assign(n, 0.0);
   in.tau.assign(n, 0.0);
   return in;
-}
-
-std::array<double, 6> FrameBlock(const Rigid3& r) {
-  const Eigen::AngleAxisd aa(r.R);
-  const Eigen::Vector3d w = aa.axis() * aa.angle();
-  return {w.x(), w.y(), w.z(), r.t.x(), r.t.y(), r.t.z()};
 }
 
 class Sampler {
@@ -407,7 +402,7 @@ Problem MakeProblem(const Robot& robot, const PlanResult& plan,
   pr.chain = Chain::FromRobot(robot);
   pr.state.chain = pr.chain;
   pr.fixed_point = options.fixed_point;
-  pr.state.meas_from_base = FrameBlock(plan.rig_from_base);
+  pr.state.meas_from_base = PoseBlockFromRigid3(plan.rig_from_base);
   if (options.fixed_point) {
     pr.state.point_labels = {"P"};
     const Eigen::Vector3d& p = plan.fixed_point_in_base;
