@@ -5,38 +5,15 @@
 #include <cmath>
 #include <functional>
 #include <map>
-#include <random>
 #include <set>
 #include <stdexcept>
+#include <utility>
 
+#include "calib/holdout.h"
 #include "calib/paper_method.h"
 #include "data/error.h"
 
 namespace kincal {
-
-void SplitHoldout(const std::vector<Measurement>& ms, double fraction,
-                  uint64_t seed, std::vector<int>* train,
-                  std::vector<int>* heldout) {
-  train->clear();
-  heldout->clear();
-  std::map<int, std::vector<int>> groups;  // -1 = measured points
-  for (size_t i = 0; i < ms.size(); ++i) {
-    groups[ms[i].kind == Measurement::kMeasured ? -1 : ms[i].point].push_back(
-        static_cast<int>(i));
-  }
-  std::mt19937_64 rng(seed);
-  for (auto& kv : groups) {
-    std::vector<int>& idx = kv.second;
-    std::shuffle(idx.begin(), idx.end(), rng);
-    const int n = static_cast<int>(idx.size());
-    const int min_train = kv.first < 0 ? 10 : 3;
-    int hold = static_cast<int>(std::lround(fraction * n));
-    hold = std::max(0, std::min(hold, n - min_train));
-    for (int k = 0; k < n; ++k) (k < hold ? heldout : train)->push_back(idx[k]);
-  }
-  std::sort(train->begin(), train->end());
-  std::sort(heldout->begin(), heldout->end());
-}
 
 std::vector<double> CentroidDistances(const ModelState& state,
                                       const std::vector<Measurement>& ms) {
@@ -512,8 +489,10 @@ CalibrateResult Calibrate(const Robot& nominal, const Observations& obs,
     distances.push_back(pd);
   }
 
-  SplitHoldout(all, options.holdout_fraction, options.seed, &result.train_rows,
-               &result.heldout_rows);
+  HoldoutSplit split =
+      SplitHoldout(all, options.holdout_fraction, options.seed);
+  result.train_rows = std::move(split.train);
+  result.heldout_rows = std::move(split.heldout);
   const std::vector<Measurement> all_train = Pick(all, result.train_rows);
   std::vector<Measurement> train, held;
   const ModelState initial = state;

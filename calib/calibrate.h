@@ -165,12 +165,6 @@ GeometryFit FitGeometry(
     std::vector<Measurement>* train, std::vector<Measurement>* held,
     ModelState* state, const GeometryFitter& fitter = nullptr);
 
-// Splits measurement indices into train / held-out, seeded; fixed-point
-// groups are split per group so that each keeps at least 3 training poses.
-void SplitHoldout(const std::vector<Measurement>& measurements, double fraction,
-                  uint64_t seed, std::vector<int>* train,
-                  std::vector<int>* heldout);
-
 // The seed's epsilon for fixed-point measurements: for each group, distances
 // of the model tips to the group's centroid.
 std::vector<double> CentroidDistances(const ModelState& state,

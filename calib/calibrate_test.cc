@@ -274,20 +274,5 @@ TEST(CalibrateTest, SinglePointLeastSquares) {
               ::testing::Contains("j1.theta"));
 }
 
-TEST(CalibrateTest, SplitIsSeededAndKeepsGroups) {
-  const SimulatedSession s = Session(9, 50);
-  ModelState state;
-  state.chain = Chain::FromRobot(s.nominal);
-  const auto ms = MakeMeasurements(state.chain, s.observations, &state);
-  std::vector<int> a_train, a_held, b_train, b_held, c_train, c_held;
-  SplitHoldout(ms, 0.2, 1, &a_train, &a_held);
-  SplitHoldout(ms, 0.2, 1, &b_train, &b_held);
-  SplitHoldout(ms, 0.2, 2, &c_train, &c_held);
-  EXPECT_EQ(a_held, b_held);
-  EXPECT_NE(a_held, c_held);
-  EXPECT_EQ(a_held.size(), 10u);
-  EXPECT_EQ(a_train.size() + a_held.size(), ms.size());
-}
-
 }  // namespace
 }  // namespace kincal

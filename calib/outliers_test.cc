@@ -10,6 +10,7 @@
 
 #include "calib/calibrate.h"
 #include "calib/evaluate.h"
+#include "calib/holdout.h"
 #include "data/robot.h"
 #include "synth/simulate.h"
 #include "tests/testing/paths.h"
@@ -161,8 +162,8 @@ TEST(OutliersTest, HeldOutRowsLeftOutOnlyWhileFew) {
   ModelState state;
   const std::vector<Measurement> ms =
       MakeMeasurements(Chain::FromRobot(s.nominal), s.observations, &state);
-  std::vector<int> train, held;
-  SplitHoldout(ms, defaults.holdout_fraction, defaults.seed, &train, &held);
+  const std::vector<int> held =
+      SplitHoldout(ms, defaults.holdout_fraction, defaults.seed).heldout;
   ASSERT_EQ(held.size(), 40u);
   for (const int corrupt : {5, 15}) {
     Observations bad = s.observations;

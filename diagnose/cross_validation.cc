@@ -71,7 +71,7 @@ FoldPlan MakeFolds(const std::vector<Measurement>& ms, int folds,
   std::vector<int> order(groups.size());
   for (size_t g = 0; g < order.size(); ++g) order[g] = static_cast<int>(g);
   // A stream of its own, so that the folds do not repeat the held-out
-  // split's shuffle (calib/calibrate.h SplitHoldout uses `seed`).
+  // split's shuffle (calib/holdout.h SplitHoldout uses `seed`).
   std::mt19937_64 rng(seed ^ 0x9e3779b97f4a7c15ULL);
   std::shuffle(order.begin(), order.end(), rng);
   // Each group to the fold with the fewest poses so far (lowest index on

@@ -13,6 +13,7 @@
 #include <thread>
 
 #include "calib/calibrate.h"
+#include "calib/holdout.h"
 #include "calib/identifiability.h"
 #include "data/csv.h"
 #include "data/error.h"
@@ -314,11 +315,10 @@ DiagnosisResult DiagnoseModel(const Robot& nominal, const Observations& obs,
   pb.nominal = Chain::FromRobot(nominal);
   pb.base_state = StateWithChain(pb.nominal);
   pb.all = Measurements(pb.nominal, obs, &pb.base_state);
-  std::vector<int> train_idx, held_idx;
-  SplitHoldout(pb.all, options.holdout_fraction, options.seed, &train_idx,
-               &held_idx);
-  pb.train = Pick(pb.all, train_idx);
-  pb.held = Pick(pb.all, held_idx);
+  const HoldoutSplit split =
+      SplitHoldout(pb.all, options.holdout_fraction, options.seed);
+  pb.train = Pick(pb.all, split.train);
+  pb.held = Pick(pb.all, split.heldout);
   // The transmission family lives on the joints' travel in the training data.
   SetTransmissionTravel(pb.train, &pb.nominal);
   SetTransmissionTravel(pb.train, &pb.base_state.chain);
