@@ -9,12 +9,14 @@
 #include <iostream>
 #include <map>
 #include <memory>
+#include <optional>
 #include <sstream>
 
 #include "app/app_util.h"
 #include "app/command.h"
 #include "app/front_end.h"
 #include "bundle/bundle.h"
+#include "bundle/cross_validation.h"
 #include "bundle/observe.h"
 #include "calib/chain.h"
 #include "calib/model_state.h"
@@ -75,142 +77,81 @@ ToolPoseResult RefitPose(const Rig& rig, const Target& target,
   return EstimateToolPose(rig, target, dets);
 }
 
-int RunBundleCommand(BundleArgs args) {
-  const auto start = std::chrono::steady_clock::now();
-  Progress progress("kincal bundle", args.json || args.quiet);
-  progress.Stage("reading the session");
-  const Robot robot = ReadRobot(args.robot);
-  const Rig rig = ReadRigYaml(args.rig);
-  const Target target = ReadTargetYaml(args.target);
-  if (rig.cameras.size() != 2) {
-    throw InputError(args.rig +
-                     ": a recorded session has two cameras; the "
-                     "rig has " +
-                     std::to_string(rig.cameras.size()));
-  }
-  SessionReadOptions so;
-  so.joint_names = robot.JointNames();
-  so.require_joint_readings = true;
-  const Session session = ReadSession(args.session, so);
-  // A cause without a joint ("backlash") stands for that cause at every
-  // joint.
-  for (const std::string& name : SplitNames(args.extensions)) {
+// --extensions names: "j3.backlash" as given; a cause without a joint
+// ("backlash") stands for that cause at every joint; "axis_tilt" for the
+// Hayati beta of rows with parallel axes.
+std::vector<std::string> ExpandExtensions(const Robot& robot,
+                                          const std::string& text) {
+  std::vector<std::string> out;
+  for (const std::string& name : SplitNames(text)) {
     if (name.find('.') != std::string::npos) {
-      args.options.extensions.push_back(name);
+      out.push_back(name);
       continue;
     }
-    if (name == "axis_tilt") {  // Hayati beta of rows with parallel axes
+    if (name == "axis_tilt") {
       const Chain chain = Chain::FromRobot(robot);
       for (int row : ParallelAxisRows(chain)) {
-        args.options.extensions.push_back(AxisTiltParam(chain, row).name);
+        out.push_back(AxisTiltParam(chain, row).name);
       }
       continue;
     }
     for (const std::string& j : robot.JointNames()) {
       if (name == "cyclic") {
-        args.options.extensions.push_back(j + ".cyclic_cos");
-        args.options.extensions.push_back(j + ".cyclic_sin");
+        out.push_back(j + ".cyclic_cos");
+        out.push_back(j + ".cyclic_sin");
       } else {
-        args.options.extensions.push_back(j + "." + name);
+        out.push_back(j + "." + name);
       }
     }
   }
+  return out;
+}
 
-  ObserveOptions oo;
-  oo.progress = [&progress](int done, int total) {
-    progress.Update(done, total, "frames (detecting tags)");
-  };
-  const SessionObservations obs = ObserveSession(session, rig, target, oo);
-  progress.Stage("solving the bundle (" + std::to_string(obs.frames.size()) +
-                 " frames)");
-  const BundleResult r =
-      RunBundle(robot, rig, target, obs.frames, args.options);
-  // k-fold cross-validation: every used frame held out once.
-  nlohmann::json kfold;
-  if (args.folds >= 2) {
-    std::vector<double> px, mm;
-    for (int k = 0; k < args.folds; ++k) {
-      progress.Update(k, args.folds, "cross-validation folds");
-      BundleOptions o = args.options;
-      o.folds = args.folds;
-      o.fold = k;
-      const BundleResult rk = RunBundle(robot, rig, target, obs.frames, o);
-
-      px.insert(px.end(), rk.heldout_corner_px.begin(),
-                rk.heldout_corner_px.end());
-      mm.insert(mm.end(), rk.heldout_tip_mm.begin(), rk.heldout_tip_mm.end());
+// --out-obs: the needle tip the cameras saw at each frame's joint readings
+// (pose refitted on the refined rig when cameras were refined); empty where
+// the pose misses the quality gate.
+std::string TrackedTipsCsv(const BundleArgs& args, const Robot& robot,
+                           const Target& target, const Session& session,
+                           const SessionObservations& obs,
+                           const BundleResult& r, int* points) {
+  Observations out;
+  out.source = session.frames_csv;
+  out.joint_names = robot.JointNames();
+  for (const BundleFrame& f : obs.frames) {
+    Observation o;
+    o.pose = std::to_string(f.frame);
+    o.q = f.q_reading;
+    o.t_s = f.t_s;
+    ToolPoseResult p;
+    if (args.options.refine_cameras && !f.corners.empty()) {
+      p = RefitPose(r.rig, target, f);
+    } else {
+      p.found = f.tracked;
+      p.rig_from_tool = f.rig_from_tool;
+      p.rms_px = f.tracked_rms_px;
+      p.tags_used = f.tracked_tags;
     }
-    auto rms = [](const std::vector<double>& v) {
-      double s = 0;
-      for (double x : v) s += x * x;
-      return v.empty() ? 0.0 : std::sqrt(s / v.size());
-    };
-    kfold = {{"folds", args.folds},
-             {"heldout_reproj_rms_px", rms(px)},
-             {"heldout_tip_rms_mm", rms(mm)},
-             {"heldout_tips", mm.size()}};
-  }
-
-  // Outputs, all validated and computed before the first write.
-  const std::string robot_text = FormatRobotYaml(
-      r.calibrated,
-      {"calibrated by kincal bundle from the images of " + args.session,
-       "reprojection RMS " + FormatDouble(r.reproj_rms_px) +
-           " px (training), " + FormatDouble(r.heldout_reproj_rms_px) +
-           " px (held out)"});
-  std::string obs_text;
-  int obs_points = 0;
-  if (!args.out_obs.empty()) {
-    Observations out;
-    out.source = session.frames_csv;
-    out.joint_names = robot.JointNames();
-    for (const BundleFrame& f : obs.frames) {
-      Observation o;
-      o.pose = std::to_string(f.frame);
-      o.q = f.q_reading;
-      o.t_s = f.t_s;
-      ToolPoseResult p;
-      if (args.options.refine_cameras && !f.corners.empty()) {
-        p = RefitPose(r.rig, target, f);
-      } else {
-        p.found = f.tracked;
-        p.rig_from_tool = f.rig_from_tool;
-        p.rms_px = f.tracked_rms_px;
-        p.tags_used = f.tracked_tags;
-      }
-      if (p.found && p.tags_used >= args.min_tags &&
-          p.rms_px <= args.max_reproj_px && SeenByTwoCameras(f)) {
-        o.has_point = true;
-        o.p_in_meas = p.rig_from_tool * target.tip_in_tool;
-        ++obs_points;
-      }
-      out.rows.push_back(o);
+    if (p.found && p.tags_used >= args.min_tags &&
+        p.rms_px <= args.max_reproj_px && SeenByTwoCameras(f)) {
+      o.has_point = true;
+      o.p_in_meas = p.rig_from_tool * target.tip_in_tool;
+      ++*points;
     }
-    obs_text = FormatObservationsCsv(
-        out, {"needle tips seen by the cameras (rig frame, mm) at the "
-              "session's joint readings; empty where only one camera saw "
-              "the tool, or its pose used fewer than " +
-              std::to_string(args.min_tags) + " tags or fit worse than " +
-              FormatDouble(args.max_reproj_px) + " px"});
+    out.rows.push_back(o);
   }
-  progress.Done();
-  WriteFileAtomic(args.out, robot_text);
-  if (!args.out_rig.empty()) WriteRigYaml(args.out_rig, r.rig);
-  if (!args.out_obs.empty()) WriteFileAtomic(args.out_obs, obs_text);
-  const double seconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start)
-          .count();
+  return FormatObservationsCsv(
+      out, {"needle tips seen by the cameras (rig frame, mm) at the "
+            "session's joint readings; empty where only one camera saw "
+            "the tool, or its pose used fewer than " +
+            std::to_string(args.min_tags) + " tags or fit worse than " +
+            FormatDouble(args.max_reproj_px) + " px"});
+}
 
-  nlohmann::json params = nlohmann::json::array();
-  for (const BundleParam& p : r.params) {
-    params.push_back(
-        {{"name", p.name},
-         {"value", p.value},
-         {"sigma", std::isfinite(p.sigma) ? nlohmann::json(p.sigma)
-                                          : nlohmann::json(nullptr)}});
-  }
+// Each requested extension's estimate with its z = |value| / sigma.
+nlohmann::json ExtensionsJson(const BundleOptions& options,
+                              const BundleResult& r) {
   nlohmann::json extensions = nlohmann::json::array();
-  for (const std::string& name : args.options.extensions) {
+  for (const std::string& name : options.extensions) {
     for (const BundleParam& p : r.params) {
       if (p.name != name) continue;
       const double z = std::isfinite(p.sigma) && p.sigma > 0
@@ -223,33 +164,40 @@ int RunBundleCommand(BundleArgs args) {
                             {"significant", z > 4.0}});
     }
   }
-  // Significant extensions, strongest first: what the images name.
+  return extensions;
+}
+
+// Significant extensions, strongest first: what the images name.
+nlohmann::json FindingsJson(const nlohmann::json& extensions) {
   nlohmann::json findings = nlohmann::json::array();
-  {
-    std::vector<nlohmann::json> sig;
-    for (const auto& e : extensions) {
-      if (e["significant"].get<bool>()) sig.push_back(e);
-    }
-    std::sort(sig.begin(), sig.end(), [](const auto& a, const auto& b) {
-      return a["z"].template get<double>() > b["z"].template get<double>();
-    });
-    for (const auto& e : sig) {
-      const std::string name = e["name"];
-      const size_t dot = name.find('.');
-      findings.push_back(
-          {{"cause", name.substr(dot + 1)},
-           {"joint", name.substr(0, dot)},
-           {"magnitude", e["value"]},
-           {"sigma", e["sigma"]},
-           {"ci95",
-            {e["value"].get<double>() - 1.96 * e["sigma"].get<double>(),
-             e["value"].get<double>() + 1.96 * e["sigma"].get<double>()}}});
-    }
+  std::vector<nlohmann::json> sig;
+  for (const auto& e : extensions) {
+    if (e["significant"].get<bool>()) sig.push_back(e);
   }
-  // Per-frame reprojection RMS of the final model (the worst frames).
+  std::sort(sig.begin(), sig.end(), [](const auto& a, const auto& b) {
+    return a["z"].template get<double>() > b["z"].template get<double>();
+  });
+  for (const auto& e : sig) {
+    const std::string name = e["name"];
+    const size_t dot = name.find('.');
+    findings.push_back(
+        {{"cause", name.substr(dot + 1)},
+         {"joint", name.substr(0, dot)},
+         {"magnitude", e["value"]},
+         {"sigma", e["sigma"]},
+         {"ci95",
+          {e["value"].get<double>() - 1.96 * e["sigma"].get<double>(),
+           e["value"].get<double>() + 1.96 * e["sigma"].get<double>()}}});
+  }
+  return findings;
+}
+
+// The five frames the final model reprojects worst (per-frame RMS).
+nlohmann::json WorstFramesJson(const BundleResult& r, const Target& target,
+                               const std::vector<BundleFrame>& frames) {
   std::vector<std::pair<double, int>> frame_rms;
-  for (size_t i = 0; i < obs.frames.size(); ++i) {
-    const BundleFrame& f = obs.frames[i];
+  for (size_t i = 0; i < frames.size(); ++i) {
+    const BundleFrame& f = frames[i];
     if (f.corners.empty()) continue;
     const Rigid3 rt = ModelRigFromTool(r, static_cast<int>(i));
     double sum = 0;
@@ -268,58 +216,90 @@ int RunBundleCommand(BundleArgs args) {
     worst.push_back(
         {{"frame", frame_rms[k].second}, {"rms_px", frame_rms[k].first}});
   }
-  auto rigid_json = [](const std::array<double, 6>& b) {
-    return nlohmann::json{
-        {"rotation_vector_deg",
-         {b[0] * 180 / M_PI, b[1] * 180 / M_PI, b[2] * 180 / M_PI}},
-        {"t_mm", {b[3], b[4], b[5]}}};
-  };
-  if (args.json) {
-    nlohmann::json j;
-    j["frames"] = obs.session_frames;
-    j["used_frames"] = r.used_frames;
-    j["train_frames"] = r.train_frames;
-    j["heldout_frames"] = r.heldout_frames;
-    j["frames_without_joints"] = obs.without_joints;
-    j["frames_without_tags"] = obs.without_tags;
-    j["corners"] = r.corners;
-    j["dropped_tags"] = r.dropped_tags;
-    j["start_reproj_rms_px"] = r.start_reproj_rms_px;
-    j["reproj_rms_px"] = r.reproj_rms_px;
-    j["heldout_reproj_rms_px"] = r.heldout_reproj_rms_px;
-    j["heldout_tip_rms_mm"] = r.heldout_tip_rms_mm;
-    j["heldout_tips"] = r.heldout_tips;
-    j["sigma0_px"] = r.sigma0_px;
-    j["worst_frames"] = worst;
-    j["identifiable"] = r.identifiable;
-    j["unidentifiable"] = r.unidentifiable;
-    j["params"] = params;
-    if (!args.options.extensions.empty()) {
-      j["extensions"] = extensions;
-      j["findings"] = findings;
-    }
-    j["rig_from_base"] = rigid_json(r.rig_from_base);
-    j["flange_from_target"] = rigid_json(r.flange_from_tool);
-    j["refine_cameras"] = args.options.refine_cameras;
-    if (!kfold.is_null()) j["kfold"] = kfold;
-    j["termination"] = r.termination;
-    j["iterations"] = r.iterations;
-    j["detect_seconds"] = obs.seconds;
-    j["solve_seconds"] = r.seconds;
-    j["seconds"] = seconds;
-    j["out"] = args.out;
-    if (!args.out_rig.empty()) j["out_rig"] = args.out_rig;
-    if (!args.out_obs.empty()) {
-      j["out_obs"] = args.out_obs;
-      j["out_obs_points"] = obs_points;
-    }
-    PrintJson(j);
-    return 0;
+  return worst;
+}
+
+nlohmann::json PoseBlockJson(const std::array<double, 6>& b) {
+  return nlohmann::json{
+      {"rotation_vector_deg",
+       {b[0] * 180 / M_PI, b[1] * 180 / M_PI, b[2] * 180 / M_PI}},
+      {"t_mm", {b[3], b[4], b[5]}}};
+}
+
+// What one run computed, for the summary.
+struct BundleRun {
+  SessionObservations obs;
+  BundleResult result;
+  std::optional<BundleCrossValidation> cross_validation;
+  int out_obs_points = 0;
+  double seconds = 0.0;
+};
+
+nlohmann::json SummaryJson(const BundleArgs& args, const Target& target,
+                           const BundleRun& run) {
+  const BundleResult& r = run.result;
+  nlohmann::json params = nlohmann::json::array();
+  for (const BundleParam& p : r.params) {
+    params.push_back(
+        {{"name", p.name},
+         {"value", p.value},
+         {"sigma", std::isfinite(p.sigma) ? nlohmann::json(p.sigma)
+                                          : nlohmann::json(nullptr)}});
   }
+  nlohmann::json j;
+  j["frames"] = run.obs.session_frames;
+  j["used_frames"] = r.used_frames;
+  j["train_frames"] = r.train_frames;
+  j["heldout_frames"] = r.heldout_frames;
+  j["frames_without_joints"] = run.obs.without_joints;
+  j["frames_without_tags"] = run.obs.without_tags;
+  j["corners"] = r.corners;
+  j["dropped_tags"] = r.dropped_tags;
+  j["start_reproj_rms_px"] = r.start_reproj_rms_px;
+  j["reproj_rms_px"] = r.reproj_rms_px;
+  j["heldout_reproj_rms_px"] = r.heldout_reproj_rms_px;
+  j["heldout_tip_rms_mm"] = r.heldout_tip_rms_mm;
+  j["heldout_tips"] = r.heldout_tips;
+  j["sigma0_px"] = r.sigma0_px;
+  j["worst_frames"] = WorstFramesJson(r, target, run.obs.frames);
+  j["identifiable"] = r.identifiable;
+  j["unidentifiable"] = r.unidentifiable;
+  j["params"] = params;
+  if (!args.options.extensions.empty()) {
+    const nlohmann::json extensions = ExtensionsJson(args.options, r);
+    j["extensions"] = extensions;
+    j["findings"] = FindingsJson(extensions);
+  }
+  j["rig_from_base"] = PoseBlockJson(r.rig_from_base);
+  j["flange_from_target"] = PoseBlockJson(r.flange_from_tool);
+  j["refine_cameras"] = args.options.refine_cameras;
+  if (run.cross_validation) {
+    const BundleCrossValidation& cv = *run.cross_validation;
+    j["kfold"] = {{"folds", cv.folds},
+                  {"heldout_reproj_rms_px", cv.heldout_reproj_rms_px},
+                  {"heldout_tip_rms_mm", cv.heldout_tip_rms_mm},
+                  {"heldout_tips", cv.heldout_tips}};
+  }
+  j["termination"] = r.termination;
+  j["iterations"] = r.iterations;
+  j["detect_seconds"] = run.obs.seconds;
+  j["solve_seconds"] = r.seconds;
+  j["seconds"] = run.seconds;
+  j["out"] = args.out;
+  if (!args.out_rig.empty()) j["out_rig"] = args.out_rig;
+  if (!args.out_obs.empty()) {
+    j["out_obs"] = args.out_obs;
+    j["out_obs_points"] = run.out_obs_points;
+  }
+  return j;
+}
+
+void PrintSummary(const BundleArgs& args, const BundleRun& run) {
+  const BundleResult& r = run.result;
   std::printf(
       "kincal bundle: %d frames, %d used (%d train, %d held out), %d "
       "corners\n",
-      obs.session_frames, r.used_frames, r.train_frames, r.heldout_frames,
+      run.obs.session_frames, r.used_frames, r.train_frames, r.heldout_frames,
       r.corners);
   std::printf(
       "  reprojection RMS %.4f px (start %.3f px), held out %.4f px; "
@@ -332,7 +312,71 @@ int RunBundleCommand(BundleArgs args) {
     std::printf("    %-16s %12.5f +- %.5f\n", p.name.c_str(), p.value, p.sigma);
   }
   std::printf("  wrote %s (%.1f s: detection %.1f s, solve %.2f s)\n",
-              args.out.c_str(), seconds, obs.seconds, r.seconds);
+              args.out.c_str(), run.seconds, run.obs.seconds, r.seconds);
+}
+
+int RunBundleCommand(BundleArgs args) {
+  const auto start = std::chrono::steady_clock::now();
+  Progress progress("kincal bundle", args.json || args.quiet);
+  progress.Stage("reading the session");
+  const Robot robot = ReadRobot(args.robot);
+  const Rig rig = ReadRigYaml(args.rig);
+  const Target target = ReadTargetYaml(args.target);
+  if (rig.cameras.size() != 2) {
+    throw InputError(args.rig +
+                     ": a recorded session has two cameras; the "
+                     "rig has " +
+                     std::to_string(rig.cameras.size()));
+  }
+  SessionReadOptions so;
+  so.joint_names = robot.JointNames();
+  so.require_joint_readings = true;
+  const Session session = ReadSession(args.session, so);
+  for (const std::string& name : ExpandExtensions(robot, args.extensions)) {
+    args.options.extensions.push_back(name);
+  }
+
+  BundleRun run;
+  ObserveOptions oo;
+  oo.progress = [&progress](int done, int total) {
+    progress.Update(done, total, "frames (detecting tags)");
+  };
+  run.obs = ObserveSession(session, rig, target, oo);
+  progress.Stage("solving the bundle (" +
+                 std::to_string(run.obs.frames.size()) + " frames)");
+  run.result = RunBundle(robot, rig, target, run.obs.frames, args.options);
+  if (args.folds >= 2) {
+    run.cross_validation = CrossValidateBundle(
+        robot, rig, target, run.obs.frames, args.options, args.folds,
+        [&progress](int k, int folds) {
+          progress.Update(k, folds, "cross-validation folds");
+        });
+  }
+
+  // Outputs, all validated and computed before the first write.
+  const BundleResult& r = run.result;
+  const std::string robot_text = FormatRobotYaml(
+      r.calibrated,
+      {"calibrated by kincal bundle from the images of " + args.session,
+       "reprojection RMS " + FormatDouble(r.reproj_rms_px) +
+           " px (training), " + FormatDouble(r.heldout_reproj_rms_px) +
+           " px (held out)"});
+  const std::string obs_text =
+      args.out_obs.empty() ? std::string()
+                           : TrackedTipsCsv(args, robot, target, session,
+                                            run.obs, r, &run.out_obs_points);
+  progress.Done();
+  WriteFileAtomic(args.out, robot_text);
+  if (!args.out_rig.empty()) WriteRigYaml(args.out_rig, r.rig);
+  if (!args.out_obs.empty()) WriteFileAtomic(args.out_obs, obs_text);
+  run.seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start)
+          .count();
+  if (args.json) {
+    PrintJson(SummaryJson(args, target, run));
+  } else {
+    PrintSummary(args, run);
+  }
   return 0;
 }
 

@@ -52,9 +52,8 @@ nlohmann::json PoseJson(const Rigid3& pose) {
   return {{"R", r}, {"t", {pose.t.x(), pose.t.y(), pose.t.z()}}};
 }
 
-int RunCamcal(const CamcalArgs& args) {
-  // Everything that can be checked before reading images comes first.
-  const CalibTargetSpec spec = ParseCalibTargetSpec(args.target);
+// The calibration options of the command line.
+CalibrationOptions ResolveOptions(const CamcalArgs& args) {
   CalibrationOptions options;
   options.num_distortion = args.distortion;
   options.loss_scale_px = args.loss_scale_px;
@@ -69,7 +68,12 @@ int RunCamcal(const CamcalArgs& args) {
                      "': expected huber, cauchy or none");
   }
   options.Check();
+  return options;
+}
 
+// Image files per camera (left, then right when given), paired by name
+// order.
+std::vector<std::vector<std::string>> ImageFiles(const CamcalArgs& args) {
   std::vector<std::vector<std::string>> files;
   files.push_back(GlobSortedOrThrow(args.left, "--left"));
   if (!args.right.empty()) {
@@ -81,9 +85,18 @@ int RunCamcal(const CamcalArgs& args) {
                        "; stereo images are paired in name order");
     }
   }
+  return files;
+}
+
+// Detects the target in every image; each camera takes the image size of
+// its first image. InputError when sizes differ or a camera sees the target
+// in fewer than options.min_views images.
+CalibrationProblem DetectTargets(
+    const CamcalArgs& args, const CalibTargetSpec& spec,
+    const CalibrationOptions& options,
+    const std::vector<std::vector<std::string>>& files, Progress* progress) {
   const size_t nc = files.size();
   const size_t nv = files[0].size();
-
   CalibrationProblem problem;
   for (size_t c = 0; c < nc; ++c) {
     problem.cameras.push_back(
@@ -91,10 +104,9 @@ int RunCamcal(const CamcalArgs& args) {
   }
   CalibTargetDetector detector(spec);
   std::vector<int> found(nc, 0);
-  Progress progress("kincal camcal", args.json);
   for (size_t v = 0; v < nv; ++v) {
-    progress.Update(static_cast<long>(v + 1), static_cast<long>(nv),
-                    "detecting the target: view");
+    progress->Update(static_cast<long>(v + 1), static_cast<long>(nv),
+                     "detecting the target: view");
     CalibrationView view;
     view.label = files[0][v];
     for (size_t c = 0; c < nc; ++c) {
@@ -127,97 +139,107 @@ int RunCamcal(const CamcalArgs& args) {
     }
   }
 
-  progress.Stage("calibrating (OpenCV start, Ceres refinement, covariance)");
-  const CalibrationSummary sum = CalibrateCameras(problem, options);
-  progress.Done();
-  WriteRigYaml(args.out, sum.rig);
+  return problem;
+}
 
-  if (args.json) {
-    nlohmann::json j;
-    j["rms_px"] = sum.rms_px;
-    j["baseline"] = sum.baseline;
-    j["baseline_sigma"] = Nullable(sum.baseline_sigma);
-    j["target"] = spec.text;
-    j["out"] = args.out;
-    j["views"] = nv;
-    j["termination"] = sum.termination;
-    j["converged"] = sum.converged;
-    j["iterations"] = sum.iterations;
-    j["residual_sigma_px"] = sum.residual_sigma_px;
-    j["seconds"] = sum.seconds;
-    if (!sum.covariance_note.empty())
-      j["covariance_note"] = sum.covariance_note;
-    nlohmann::json cams = nlohmann::json::array();
-    for (size_t c = 0; c < nc; ++c) {
-      const CameraCalibrationSummary& cs = sum.cameras[c];
-      const CameraIntrinsics& in = cs.intrinsics;
-      nlohmann::json cj = {
-          {"name", in.name},
-          {"width", in.width},
-          {"height", in.height},
-          {"fx", in.fx},
-          {"fy", in.fy},
-          {"cx", in.cx},
-          {"cy", in.cy},
-          {"distortion", in.distortion},
-          {"rms_px", cs.rms_px},
-          {"max_px", cs.max_px},
-          {"outliers", cs.outliers},
-          {"opencv_rms_px", cs.opencv_rms_px},
-          {"views_used", cs.num_views},
-          {"points", cs.num_points},
-          {"holdout_rms_px", Nullable(cs.holdout_rms_px)},
-          {"half_diff_rms_px", Nullable(cs.half_diff_rms_px)},
-          {"half_diff_max_px", Nullable(cs.half_diff_max_px)},
-          {"cam_from_rig", PoseJson(sum.rig.cameras[c].cam_from_rig)}};
-      if (!cs.sigma.empty()) {
-        cj["sigma"] = {
-            {"fx", cs.sigma[kFx]},
-            {"fy", cs.sigma[kFy]},
-            {"cx", cs.sigma[kCx]},
-            {"cy", cs.sigma[kCy]},
-            {"distortion", std::vector<double>(
-                               cs.sigma.begin() + kK1,
-                               cs.sigma.begin() + kK1 + in.distortion.size())}};
-      }
-      nlohmann::json per_view = nlohmann::json::array();
-      for (double r : cs.view_rms_px) per_view.push_back(Nullable(r));
-      cj["view_rms_px"] = per_view;
-      const ImageResidualGrid& g = cs.image_grid;
-      auto nullable = [](const std::vector<double>& v) {
-        nlohmann::json a = nlohmann::json::array();
-        for (double x : v) a.push_back(Nullable(x));
-        return a;
-      };
-      cj["image_grid"] = {{"cols", g.cols},
-                          {"rows", g.rows},
-                          {"cell_w_px", g.cell_w_px},
-                          {"cell_h_px", g.cell_h_px},
-                          {"count", g.count},
-                          {"rms_px", nullable(g.rms_px)},
-                          {"mean_dx_px", nullable(g.mean_dx_px)},
-                          {"mean_dy_px", nullable(g.mean_dy_px)}};
-      cams.push_back(cj);
-    }
-    j["cameras"] = cams;
-    if (nc == 2 && !sum.extrinsic_rotation_sigma_deg.empty()) {
-      j["extrinsics_sigma"] = {
-          {"rotation_deg", sum.extrinsic_rotation_sigma_deg},
-          {"translation", sum.extrinsic_translation_sigma}};
-    }
-    nlohmann::json images = nlohmann::json::array();
-    for (size_t v = 0; v < nv; ++v) {
-      nlohmann::json row;
-      for (size_t c = 0; c < nc; ++c) {
-        row[problem.cameras[c].name] = files[c][v];
-      }
-      images.push_back(row);
-    }
-    j["images"] = images;
-    PrintJson(j);
-    return 0;
+nlohmann::json CameraJson(const CalibrationSummary& sum, size_t c) {
+  const CameraCalibrationSummary& cs = sum.cameras[c];
+  const CameraIntrinsics& in = cs.intrinsics;
+  nlohmann::json cj = {
+      {"name", in.name},
+      {"width", in.width},
+      {"height", in.height},
+      {"fx", in.fx},
+      {"fy", in.fy},
+      {"cx", in.cx},
+      {"cy", in.cy},
+      {"distortion", in.distortion},
+      {"rms_px", cs.rms_px},
+      {"max_px", cs.max_px},
+      {"outliers", cs.outliers},
+      {"opencv_rms_px", cs.opencv_rms_px},
+      {"views_used", cs.num_views},
+      {"points", cs.num_points},
+      {"holdout_rms_px", Nullable(cs.holdout_rms_px)},
+      {"half_diff_rms_px", Nullable(cs.half_diff_rms_px)},
+      {"half_diff_max_px", Nullable(cs.half_diff_max_px)},
+      {"cam_from_rig", PoseJson(sum.rig.cameras[c].cam_from_rig)}};
+  if (!cs.sigma.empty()) {
+    cj["sigma"] = {
+        {"fx", cs.sigma[kFx]},
+        {"fy", cs.sigma[kFy]},
+        {"cx", cs.sigma[kCx]},
+        {"cy", cs.sigma[kCy]},
+        {"distortion",
+         std::vector<double>(cs.sigma.begin() + kK1,
+                             cs.sigma.begin() + kK1 + in.distortion.size())}};
   }
+  nlohmann::json per_view = nlohmann::json::array();
+  for (double r : cs.view_rms_px) per_view.push_back(Nullable(r));
+  cj["view_rms_px"] = per_view;
+  const ImageResidualGrid& g = cs.image_grid;
+  auto nullable = [](const std::vector<double>& v) {
+    nlohmann::json a = nlohmann::json::array();
+    for (double x : v) a.push_back(Nullable(x));
+    return a;
+  };
+  cj["image_grid"] = {{"cols", g.cols},
+                      {"rows", g.rows},
+                      {"cell_w_px", g.cell_w_px},
+                      {"cell_h_px", g.cell_h_px},
+                      {"count", g.count},
+                      {"rms_px", nullable(g.rms_px)},
+                      {"mean_dx_px", nullable(g.mean_dx_px)},
+                      {"mean_dy_px", nullable(g.mean_dy_px)}};
+  return cj;
+}
 
+nlohmann::json SummaryJson(const CamcalArgs& args, const CalibTargetSpec& spec,
+                           const CalibrationProblem& problem,
+                           const std::vector<std::vector<std::string>>& files,
+                           const CalibrationSummary& sum) {
+  const size_t nc = files.size();
+  const size_t nv = files[0].size();
+  nlohmann::json j;
+  j["rms_px"] = sum.rms_px;
+  j["baseline"] = sum.baseline;
+  j["baseline_sigma"] = Nullable(sum.baseline_sigma);
+  j["target"] = spec.text;
+  j["out"] = args.out;
+  j["views"] = nv;
+  j["termination"] = sum.termination;
+  j["converged"] = sum.converged;
+  j["iterations"] = sum.iterations;
+  j["residual_sigma_px"] = sum.residual_sigma_px;
+  j["seconds"] = sum.seconds;
+  if (!sum.covariance_note.empty()) j["covariance_note"] = sum.covariance_note;
+  nlohmann::json cams = nlohmann::json::array();
+  for (size_t c = 0; c < nc; ++c) {
+    cams.push_back(CameraJson(sum, c));
+  }
+  j["cameras"] = cams;
+  if (nc == 2 && !sum.extrinsic_rotation_sigma_deg.empty()) {
+    j["extrinsics_sigma"] = {{"rotation_deg", sum.extrinsic_rotation_sigma_deg},
+                             {"translation", sum.extrinsic_translation_sigma}};
+  }
+  nlohmann::json images = nlohmann::json::array();
+  for (size_t v = 0; v < nv; ++v) {
+    nlohmann::json row;
+    for (size_t c = 0; c < nc; ++c) {
+      row[problem.cameras[c].name] = files[c][v];
+    }
+    images.push_back(row);
+  }
+  j["images"] = images;
+  return j;
+}
+
+void PrintSummary(const CamcalArgs& args, const CalibTargetSpec& spec,
+                  const CalibrationOptions& options,
+                  const std::vector<std::vector<std::string>>& files,
+                  const CalibrationSummary& sum) {
+  const size_t nc = files.size();
+  const size_t nv = files[0].size();
   std::printf("kincal camcal: %zu %s, target %s, %d distortion coefficients\n",
               nv, nc == 2 ? "stereo pairs" : "images", spec.text.c_str(),
               options.num_distortion);
@@ -261,6 +283,25 @@ int RunCamcal(const CamcalArgs& args) {
   }
   std::printf("  RMS %.4f px over all cameras; wrote %s\n", sum.rms_px,
               args.out.c_str());
+}
+
+int RunCamcal(const CamcalArgs& args) {
+  // Everything that can be checked before reading images comes first.
+  const CalibTargetSpec spec = ParseCalibTargetSpec(args.target);
+  const CalibrationOptions options = ResolveOptions(args);
+  const std::vector<std::vector<std::string>> files = ImageFiles(args);
+  Progress progress("kincal camcal", args.json);
+  const CalibrationProblem problem =
+      DetectTargets(args, spec, options, files, &progress);
+  progress.Stage("calibrating (OpenCV start, Ceres refinement, covariance)");
+  const CalibrationSummary sum = CalibrateCameras(problem, options);
+  progress.Done();
+  WriteRigYaml(args.out, sum.rig);
+  if (args.json) {
+    PrintJson(SummaryJson(args, spec, problem, files, sum));
+  } else {
+    PrintSummary(args, spec, options, files, sum);
+  }
   return 0;
 }
 

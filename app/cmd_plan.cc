@@ -12,6 +12,7 @@
 #include "data/atomic_file.h"
 #include "data/error.h"
 #include "data/progress.h"
+#include "data/rigid3.h"
 #include "data/urdf.h"
 #include "plan/confirm.h"
 #include "plan/plan.h"
@@ -51,10 +52,7 @@ int RunPlan(PlanArgs args) {
     const Eigen::Vector3d w(args.rig_from_base[0], args.rig_from_base[1],
                             args.rig_from_base[2]);
     Rigid3 r;
-    if (w.norm() > 0) {
-      r.R = Eigen::AngleAxisd(w.norm() * M_PI / 180, w.normalized())
-                .toRotationMatrix();
-    }
+    r.R = RotationMatrixFromVector(w * M_PI / 180);
     r.t = Eigen::Vector3d(args.rig_from_base[3], args.rig_from_base[4],
                           args.rig_from_base[5]);
     args.options.rig_from_base = r;
@@ -113,8 +111,8 @@ int RunPlan(PlanArgs args) {
     j["draws"] = plan.draws;
     j["swaps"] = plan.swaps;
     if (rig) {
-      const Eigen::AngleAxisd aa(plan.rig_from_base.R);
-      const Eigen::Vector3d w = aa.axis() * aa.angle() * 180 / M_PI;
+      const Eigen::Vector3d w =
+          RotationVectorFromMatrix(plan.rig_from_base.R) * 180 / M_PI;
       j["rig_from_base"] = {w.x(),
                             w.y(),
                             w.z(),

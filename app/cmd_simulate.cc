@@ -12,6 +12,7 @@
 #include "data/atomic_file.h"
 #include "data/error.h"
 #include "data/provenance.h"
+#include "data/rigid3.h"
 #include "data/urdf.h"
 #include "synth/recorded_session.h"
 #include "synth/render.h"
@@ -32,8 +33,8 @@ struct SimulateArgs {
   RenderOptions render_options;
 };
 
-int RunSimulate(SimulateArgs args) {
-  const Robot nominal = ReadRobot(args.robot, args.root, args.tip);
+// The simulation options of the command line (mode, effects, columns).
+SimulateOptions ResolveOptions(const SimulateArgs& args, const Robot& nominal) {
   SimulateOptions opt = args.options;
   if (args.mode == "random") {
     opt.mode = SimulateOptions::kRandom;
@@ -48,6 +49,145 @@ int RunSimulate(SimulateArgs args) {
   }
   if (args.no_time) opt.seconds_per_pose = 0;
   opt.measure_points = !args.no_points;
+  return opt;
+}
+
+// Places the rig to see the tips of the simulated poses (its frame becomes
+// the measuring frame, in `opt`) and scales the example tool so tags are at
+// least ~40 px wide at that distance. Returns the rig's distance (mm).
+double PlaceRigAndScaleTool(const Robot& nominal, const Rig& rig,
+                            SimulateOptions* opt, Target* target) {
+  double rig_distance = 0.0;
+  // Same seed, so the same poses and truth; only the frame is placed.
+  // 90 % of the tips in view: the rest leave the image, as on a real rig.
+  const Rigid3 rig_from_base =
+      PlaceRigFacingTips(Simulate(nominal, *opt).base_from_tip, rig,
+                         TipFromTool(*target), 0.9, &rig_distance);
+  opt->meas_from_base = PoseBlockFromRigid3(rig_from_base);
+  const double tag_mm = 40.0 * rig_distance / rig.cameras.at(0).intrinsics.fx;
+  const double scale = std::max(1.0, tag_mm / target->tags.at(0).size_mm);
+  for (TargetTag& tag : target->tags) {
+    tag.size_mm *= scale;
+    tag.tool_from_tag.t *= scale;
+  }
+  target->tip_in_tool *= scale;
+  return rig_distance;
+}
+
+nlohmann::json EffectsJson(const SimulatedSession& s) {
+  nlohmann::json effects = nlohmann::json::array();
+  for (size_t i = 0; i < s.effects.size(); ++i) {
+    effects.push_back({{"cause", s.effects[i].cause},
+                       {"joint", s.effects[i].joint.empty()
+                                     ? nlohmann::json(nullptr)
+                                     : nlohmann::json(s.effects[i].joint)},
+                       {"magnitude", s.effects[i].magnitude},
+                       {"note", s.effect_notes[i]}});
+  }
+  return effects;
+}
+
+// truth.json: the seed, effects, measuring frame and true parameters, for
+// tests and for judging a diagnosis.
+nlohmann::json TruthJson(const SimulatedSession& s, const SimulateOptions& opt,
+                         const std::string& mode) {
+  nlohmann::json truth;
+  truth["command"] = CommandLine();
+  truth["seed"] = opt.seed;
+  truth["noise_mm"] = opt.noise_mm;
+  truth["mode"] = mode;
+  truth["poses"] = s.observations.rows.size();
+  truth["effects"] = EffectsJson(s);
+  truth["meas_from_base"] = {
+      {"rotation_vector_deg",
+       {s.meas_from_base[0] * 180 / M_PI, s.meas_from_base[1] * 180 / M_PI,
+        s.meas_from_base[2] * 180 / M_PI}},
+      {"t_mm",
+       {s.meas_from_base[3], s.meas_from_base[4], s.meas_from_base[5]}}};
+  ModelState truth_state;
+  truth_state.chain = Chain::FromRobot(s.truth);
+  nlohmann::json params;
+  for (const ParamInfo& p : GeometryParams(truth_state.chain)) {
+    params[p.name] = p.ToInterface(ParamValue(truth_state, p));
+  }
+  truth["parameters"] = params;
+  return truth;
+}
+
+// Renders the simulated poses as a recorded session OUT/session (spec
+// layout, joint columns) beside the rig and target it was seen with.
+// Returns the frames rendered.
+int WriteRenderedSession(const SimulateArgs& args, const Robot& nominal,
+                         const SimulatedSession& s, const Rig& rig,
+                         const Target& target) {
+  const Rigid3 tip_from_tool = TipFromTool(target);
+  const Rigid3 rig_from_base{
+      RotationMatrixFromVector(Eigen::Vector3d(
+          s.meas_from_base[0], s.meas_from_base[1], s.meas_from_base[2])),
+      Eigen::Vector3d(s.meas_from_base[3], s.meas_from_base[4],
+                      s.meas_from_base[5])};
+  RecordedSessionInput in;
+  for (const Eigen::Matrix4d& m : s.base_from_tip) {
+    in.rig_from_tool.push_back(rig_from_base * Rigid3::FromMatrix(m) *
+                               tip_from_tool);
+  }
+  in.joint_names = nominal.JointNames();
+  for (const Observation& row : s.observations.rows) {
+    in.joints.push_back(row.q);
+    in.t_s.push_back(row.HasTime() ? row.t_s : 0.0);
+  }
+  if (!s.observations.AnyTime()) in.t_s.clear();
+  int rendered = 0;
+#ifndef KINCAL_FRONT_END
+  rendered = RenderRecordedSession(rig, target, in, args.render_options,
+                                   args.options.seed, args.out + "/session");
+#endif
+  WriteRigYaml(args.out + "/rig.yaml", rig);
+  WriteTargetYaml(args.out + "/target.yaml", target);
+  return rendered;
+}
+
+void PrintSummary(const SimulateArgs& args, const Robot& nominal,
+                  const SimulatedSession& s, int rendered, double rig_distance,
+                  const Target& target) {
+  if (args.json) {
+    nlohmann::json j = {
+        {"out", args.out},
+        {"poses", s.observations.rows.size()},
+        {"effects", EffectsJson(s)},
+        {"files",
+         {"robot.yaml", "observations.csv", "truth.json", "truth_robot.yaml"}}};
+    if (args.render) {
+      j["render"] = {{"session", args.out + "/session"},
+                     {"rig", args.out + "/rig.yaml"},
+                     {"target", args.out + "/target.yaml"},
+                     {"frames", rendered},
+                     {"rig_distance_mm", rig_distance},
+                     {"tag_size_mm", target.tags.at(0).size_mm}};
+    }
+    PrintJson(j);
+    return;
+  }
+  std::cout << "simulated " << s.observations.rows.size() << " poses of "
+            << nominal.name << " into " << args.out
+            << "/ (robot.yaml, observations.csv, truth.json)\n";
+  if (!args.render) return;
+  std::cout << "rendered " << rendered << " stereo pairs into " << args.out
+            << "/session/ (rig " << rig_distance
+            << " mm from the workspace centre); calibrate from them with\n"
+            << "  kincal bundle --robot " << args.out << "/robot.yaml --rig "
+            << args.out << "/rig.yaml --target " << args.out
+            << "/target.yaml --session " << args.out
+            << "/session --out cal.yaml --out-obs tracked.csv\n"
+            << "or track them with\n  kincal track --rig " << args.out
+            << "/rig.yaml --target " << args.out << "/target.yaml --session "
+            << args.out << "/session --robot " << args.out
+            << "/robot.yaml --out points.csv --out-obs tracked.csv\n";
+}
+
+int RunSimulate(SimulateArgs args) {
+  const Robot nominal = ReadRobot(args.robot, args.root, args.tip);
+  SimulateOptions opt = ResolveOptions(args, nominal);
 #ifdef KINCAL_FRONT_END
   // bin/kincal links no image code (app/front_end.h): kincal-vision renders.
   if (args.render) return ExecImageBinary();
@@ -63,61 +203,10 @@ int RunSimulate(SimulateArgs args) {
 #ifndef KINCAL_FRONT_END
     args.render_options.Check();
 #endif
-    // Same seed, so the same poses and truth; only the frame is placed.
-    // 90 % of the tips in view: the rest leave the image, as on a real rig.
-    const Rigid3 rig_from_base =
-        PlaceRigFacingTips(Simulate(nominal, opt).base_from_tip, rig,
-                           TipFromTool(target), 0.9, &rig_distance);
-    const Eigen::AngleAxisd aa(rig_from_base.R);
-    const Eigen::Vector3d w = aa.axis() * aa.angle();
-    opt.meas_from_base = {w.x(),
-                          w.y(),
-                          w.z(),
-                          rig_from_base.t.x(),
-                          rig_from_base.t.y(),
-                          rig_from_base.t.z()};
-    // Tags at least ~40 px wide at that distance: scale the example tool.
-    const double tag_mm = 40.0 * rig_distance / rig.cameras.at(0).intrinsics.fx;
-    const double scale = std::max(1.0, tag_mm / target.tags.at(0).size_mm);
-    for (TargetTag& tag : target.tags) {
-      tag.size_mm *= scale;
-      tag.tool_from_tag.t *= scale;
-    }
-    target.tip_in_tool *= scale;
+    rig_distance = PlaceRigAndScaleTool(nominal, rig, &opt, &target);
   }
-  const Rigid3 tip_from_tool = TipFromTool(target);
   const SimulatedSession s = Simulate(nominal, opt);
-
-  // Truth, for tests and for judging a diagnosis.
-  nlohmann::json truth;
-  truth["command"] = CommandLine();
-  truth["seed"] = opt.seed;
-  truth["noise_mm"] = opt.noise_mm;
-  truth["mode"] = args.mode;
-  truth["poses"] = s.observations.rows.size();
-  nlohmann::json effects = nlohmann::json::array();
-  for (size_t i = 0; i < s.effects.size(); ++i) {
-    effects.push_back({{"cause", s.effects[i].cause},
-                       {"joint", s.effects[i].joint.empty()
-                                     ? nlohmann::json(nullptr)
-                                     : nlohmann::json(s.effects[i].joint)},
-                       {"magnitude", s.effects[i].magnitude},
-                       {"note", s.effect_notes[i]}});
-  }
-  truth["effects"] = effects;
-  truth["meas_from_base"] = {
-      {"rotation_vector_deg",
-       {s.meas_from_base[0] * 180 / M_PI, s.meas_from_base[1] * 180 / M_PI,
-        s.meas_from_base[2] * 180 / M_PI}},
-      {"t_mm",
-       {s.meas_from_base[3], s.meas_from_base[4], s.meas_from_base[5]}}};
-  ModelState truth_state;
-  truth_state.chain = Chain::FromRobot(s.truth);
-  nlohmann::json params;
-  for (const ParamInfo& p : GeometryParams(truth_state.chain)) {
-    params[p.name] = p.ToInterface(ParamValue(truth_state, p));
-  }
-  truth["parameters"] = params;
+  const nlohmann::json truth = TruthJson(s, opt, args.mode);
 
   const std::vector<std::string> comment = {
       "simulated session, seed " + std::to_string(opt.seed) +
@@ -128,82 +217,13 @@ int RunSimulate(SimulateArgs args) {
       s.truth, {"TRUE robot of a simulated session (for tests)"});
   const std::string obs_text = FormatObservationsCsv(s.observations, comment);
   MakeDirs(args.out);
-  int rendered = 0;
-  if (args.render) {
-    const Rigid3 rig_from_base = Rigid3::FromMatrix([&] {
-      Eigen::Matrix4d m = Eigen::Matrix4d::Identity();
-      const Eigen::Vector3d w(s.meas_from_base[0], s.meas_from_base[1],
-                              s.meas_from_base[2]);
-      if (w.norm() > 0) {
-        m.block<3, 3>(0, 0) =
-            Eigen::AngleAxisd(w.norm(), w.normalized()).toRotationMatrix();
-      }
-      m.block<3, 1>(0, 3) = Eigen::Vector3d(
-          s.meas_from_base[3], s.meas_from_base[4], s.meas_from_base[5]);
-      return m;
-    }());
-    std::vector<Rigid3> rig_from_tool;
-    for (const Eigen::Matrix4d& m : s.base_from_tip) {
-      rig_from_tool.push_back(rig_from_base * Rigid3::FromMatrix(m) *
-                              tip_from_tool);
-    }
-    // A recorded session (spec layout, joint columns) beside the rig and
-    // target it was seen with.
-    RecordedSessionInput in;
-    in.rig_from_tool = rig_from_tool;
-    in.joint_names = nominal.JointNames();
-    for (const Observation& row : s.observations.rows) {
-      in.joints.push_back(row.q);
-      in.t_s.push_back(row.HasTime() ? row.t_s : 0.0);
-    }
-    if (!s.observations.AnyTime()) in.t_s.clear();
-#ifndef KINCAL_FRONT_END
-    rendered = RenderRecordedSession(rig, target, in, args.render_options,
-                                     opt.seed, args.out + "/session");
-#endif
-    WriteRigYaml(args.out + "/rig.yaml", rig);
-    WriteTargetYaml(args.out + "/target.yaml", target);
-  }
+  const int rendered =
+      args.render ? WriteRenderedSession(args, nominal, s, rig, target) : 0;
   WriteFileAtomic(args.out + "/robot.yaml", robot_text);
   WriteFileAtomic(args.out + "/truth_robot.yaml", truth_robot_text);
   WriteFileAtomic(args.out + "/observations.csv", obs_text);
   WriteFileAtomic(args.out + "/truth.json", truth.dump(2) + "\n");
-
-  if (args.json) {
-    nlohmann::json j = {
-        {"out", args.out},
-        {"poses", s.observations.rows.size()},
-        {"effects", effects},
-        {"files",
-         {"robot.yaml", "observations.csv", "truth.json", "truth_robot.yaml"}}};
-    if (args.render) {
-      j["render"] = {{"session", args.out + "/session"},
-                     {"rig", args.out + "/rig.yaml"},
-                     {"target", args.out + "/target.yaml"},
-                     {"frames", rendered},
-                     {"rig_distance_mm", rig_distance},
-                     {"tag_size_mm", target.tags.at(0).size_mm}};
-    }
-    PrintJson(j);
-  } else {
-    std::cout << "simulated " << s.observations.rows.size() << " poses of "
-              << nominal.name << " into " << args.out
-              << "/ (robot.yaml, observations.csv, truth.json)\n";
-    if (args.render) {
-      std::cout << "rendered " << rendered << " stereo pairs into " << args.out
-                << "/session/ (rig " << rig_distance
-                << " mm from the workspace centre); calibrate from them with\n"
-                << "  kincal bundle --robot " << args.out
-                << "/robot.yaml --rig " << args.out << "/rig.yaml --target "
-                << args.out << "/target.yaml --session " << args.out
-                << "/session --out cal.yaml --out-obs tracked.csv\n"
-                << "or track them with\n  kincal track --rig " << args.out
-                << "/rig.yaml --target " << args.out
-                << "/target.yaml --session " << args.out << "/session --robot "
-                << args.out
-                << "/robot.yaml --out points.csv --out-obs tracked.csv\n";
-    }
-  }
+  PrintSummary(args, nominal, s, rendered, rig_distance, target);
   return 0;
 }
 

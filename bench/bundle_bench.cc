@@ -12,7 +12,7 @@
 #include <map>
 
 #include "bundle/bundle.h"
-#include "bundle/synthetic.h"
+#include "bundle/testing/synthetic.h"
 #include "data/robot.h"
 
 namespace kincal {

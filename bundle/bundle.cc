@@ -2,7 +2,6 @@
 
 #include <ceres/ceres.h>
 #include <ceres/normal_prior.h>
-#include <ceres/rotation.h>
 
 #include <Eigen/Dense>
 #include <algorithm>
@@ -15,8 +14,10 @@
 #include <set>
 #include <sstream>
 
+#include "calib/holdout.h"
 #include "data/error.h"
 #include "data/observations.h"
+#include "data/rigid3.h"
 
 namespace kincal {
 namespace {
@@ -36,24 +37,15 @@ struct State {
   std::vector<std::array<double, 6>> cam_from_rig;
 };
 
-std::array<double, 6> ToBlock(const Rigid3& r) {
-  const Eigen::AngleAxisd aa(r.R);
-  const Eigen::Vector3d w = aa.axis() * aa.angle();
-  return {w.x(), w.y(), w.z(), r.t.x(), r.t.y(), r.t.z()};
-}
-
-Rigid3 FromBlock(const std::array<double, 6>& b) {
-  Rigid3 r;
-  Eigen::Matrix3d R;
-  ceres::AngleAxisToRotationMatrix(b.data(), R.data());  // column-major
-  r.R = R;
-  r.t = Eigen::Vector3d(b[3], b[4], b[5]);
-  return r;
-}
-
-// All corners of one frame (every camera): 2 residuals per corner, with the
-// per-corner Huber loss applied as a residual scaling (the cost is then
-// exactly sum rho(|r|^2) / 2).
+// All corners of one frame f (every camera c), 2 residuals per corner i:
+//   e_i = ProjectPoint(intrinsics_c, cam_from_rig_c * rig_from_base *
+//                      base_from_flange(q_f) * flange_from_tool * X_i) - u_i
+//   r_i = e_i                                 if |e_i| <= h
+//   r_i = e_i * sqrt(2 h |e_i| - h^2) / |e_i|  otherwise (h = huber_px),
+// so |r_i|^2 = rho(|e_i|^2), Huber's loss per corner, and the frame's cost
+// is sum_i rho(|e_i|^2) / 2. The loss is applied inside the functor, not as
+// a ceres::LossFunction: one residual block holds a whole frame, and a
+// LossFunction would apply one rho to the frame's summed squared norm.
 class FrameCost {
  public:
   FrameCost(const Chain* chain, const PoseInput* input, bool with_errors,
@@ -68,6 +60,23 @@ class FrameCost {
         cameras_(std::move(cameras)),
         pixels_(std::move(pixels)),
         huber_(huber_px) {}
+
+  // The cost function over `block_sizes` (the layout below), 2 residuals per
+  // corner.
+  static ceres::CostFunction* Create(
+      const Chain* chain, const PoseInput* input, bool with_errors,
+      int num_cameras, const std::vector<int>& block_sizes,
+      std::vector<Eigen::Vector3d> points_in_tool, std::vector<int> cameras,
+      std::vector<Eigen::Vector2d> pixels, double huber_px) {
+    const int num_residuals = 2 * static_cast<int>(points_in_tool.size());
+    auto* cost = new ceres::DynamicAutoDiffCostFunction<FrameCost, kStride>(
+        new FrameCost(chain, input, with_errors, num_cameras,
+                      std::move(points_in_tool), std::move(cameras),
+                      std::move(pixels), huber_px));
+    for (int size : block_sizes) cost->AddParameterBlock(size);
+    cost->SetNumResiduals(num_residuals);
+    return cost;
+  }
 
   // Blocks: rows[0..J-1] (6), rig_from_base (6), flange_from_tool (6),
   // [joint errors 0..J-1 (9)], per camera: intrinsics (12), cam_from_rig (6).
@@ -85,9 +94,8 @@ class FrameCost {
       m = m * RowTransform(chain_->convention, chain_->rows[j], p[j], q[j]);
     }
     // rig_from_tool = rig_from_base * base_from_flange * flange_from_tool.
-    Mat3T<T> r_rb, r_ft;
-    ceres::AngleAxisToRotationMatrix(p[nj], r_rb.data());
-    ceres::AngleAxisToRotationMatrix(p[nj + 1], r_ft.data());
+    const Mat3T<T> r_rb = RotationMatrixFromVectorT(p[nj]);
+    const Mat3T<T> r_ft = RotationMatrixFromVectorT(p[nj + 1]);
     const Vec3<T> t_rb(p[nj][3], p[nj][4], p[nj][5]);
     const Vec3<T> t_ft(p[nj + 1][3], p[nj + 1][4], p[nj + 1][5]);
     const Mat3T<T> r_bf = m.template block<3, 3>(0, 0);
@@ -101,8 +109,7 @@ class FrameCost {
     Vec3<T> t_cr[4];
     for (int c = 0; c < num_cameras_ && c < 4; ++c) {
       const T* e = p[cam0 + 2 * c + 1];
-      Mat3T<T> r;
-      ceres::AngleAxisToRotationMatrix(e, r.data());
+      const Mat3T<T> r = RotationMatrixFromVectorT(e);
       r_cr[c] = r * r_rt;
       t_cr[c] = r * t_rt + Vec3<T>(e[3], e[4], e[5]);
     }
@@ -129,14 +136,14 @@ class FrameCost {
   }
 
  private:
-  const Chain* chain_;
-  const PoseInput* input_;
-  bool with_errors_;
-  int num_cameras_;
-  std::vector<Eigen::Vector3d> points_;
-  std::vector<int> cameras_;
-  std::vector<Eigen::Vector2d> pixels_;
-  double huber_;
+  const Chain* const chain_;
+  const PoseInput* const input_;
+  const bool with_errors_;
+  const int num_cameras_;
+  const std::vector<Eigen::Vector3d> points_;
+  const std::vector<int> cameras_;
+  const std::vector<Eigen::Vector2d> pixels_;
+  const double huber_;
 };
 
 // What is variable in one build of the problem.
@@ -212,11 +219,9 @@ Built Build(State* st, const std::vector<Obs>& obs,
     sizes.push_back(6);
   }
   for (const Obs& o : obs) {
-    auto* cost = new ceres::DynamicAutoDiffCostFunction<FrameCost, kStride>(
-        new FrameCost(&st->chain, &inputs[o.index], fr.with_errors, ncam,
-                      o.points, o.cameras, o.pixels, opt.huber_px));
-    for (int s : sizes) cost->AddParameterBlock(s);
-    cost->SetNumResiduals(2 * static_cast<int>(o.points.size()));
+    ceres::CostFunction* cost =
+        FrameCost::Create(&st->chain, &inputs[o.index], fr.with_errors, ncam,
+                          sizes, o.points, o.cameras, o.pixels, opt.huber_px);
     b.blocks.push_back(problem->AddResidualBlock(cost, nullptr, params));
     b.residuals += 2 * static_cast<int>(o.points.size());
   }
@@ -259,7 +264,8 @@ Built Build(State* st, const std::vector<Obs>& obs,
     if (c == 0) {  // the rig frame is the first camera's frame
       problem->SetParameterBlockConstant(ext);
     } else {
-      const std::array<double, 6> e0 = ToBlock(rig0.cameras[c].cam_from_rig);
+      const std::array<double, 6> e0 =
+          PoseBlockFromRigid3(rig0.cameras[c].cam_from_rig);
       Eigen::MatrixXd E = Eigen::MatrixXd::Zero(6, 6);
       Eigen::VectorXd e(6);
       for (int i = 0; i < 6; ++i) {
@@ -468,30 +474,18 @@ bool HandEyeStart(const std::vector<Rigid3>& base_from_flange,
 
 Rigid3 ModelRigFromTool(const BundleResult& result, int index) {
   const bool errors = result.chain.HasJointErrors();
-  return FromBlock(result.rig_from_base) *
+  return Rigid3FromPoseBlock(result.rig_from_base.data()) *
          BaseFromFlange(result.chain, result.inputs.at(index), errors) *
-         FromBlock(result.flange_from_tool);
+         Rigid3FromPoseBlock(result.flange_from_tool.data());
 }
 
-BundleResult RunBundle(const Robot& nominal, const Rig& rig,
-                       const Target& target,
-                       const std::vector<BundleFrame>& frames,
-                       const BundleOptions& opt) {
-  const auto start = std::chrono::steady_clock::now();
-  BundleResult res;
-  res.frames = static_cast<int>(frames.size());
-  res.rig = rig;
-  State st;
-  st.chain = Chain::FromRobot(nominal);
-  const Chain nominal_chain = st.chain;
-  const int nj = st.chain.num_joints();
-  if (nj > kMaxJoints) throw InputError("bundle: more than 16 joints");
-  if (rig.cameras.size() > 4) throw InputError("bundle: more than 4 cameras");
-  for (const Camera& c : rig.cameras) {
-    st.intrinsics.push_back(c.intrinsics.ToArray());
-    st.cam_from_rig.push_back(ToBlock(c.cam_from_rig));
-  }
-  // Pose inputs (approach directions, torques) in frame order.
+namespace {
+
+// Pose inputs (approach directions, torques) of every frame, in frame order.
+std::vector<PoseInput> FramePoseInputs(const Robot& nominal,
+                                       const Chain& nominal_chain,
+                                       const std::vector<BundleFrame>& frames) {
+  const int nj = nominal_chain.num_joints();
   Observations ob;
   ob.joint_names = nominal.JointNames();
   for (const BundleFrame& f : frames) {
@@ -506,10 +500,14 @@ BundleResult RunBundle(const Robot& nominal, const Rig& rig,
     o.t_s = f.t_s;
     ob.rows.push_back(o);
   }
-  res.inputs = MakePoseInputs(nominal_chain, ob);
-  // Extensions.
+  return MakePoseInputs(nominal_chain, ob);
+}
+
+// The parameters of --extensions: joint error parameters or a beta.
+std::vector<ParamInfo> ExtensionParams(const Chain& chain,
+                                       const BundleOptions& opt) {
   ModelState names_state;
-  names_state.chain = st.chain;
+  names_state.chain = chain;
   std::vector<ParamInfo> ext;
   for (const std::string& name : opt.extensions) {
     const ParamInfo p = FindParam(names_state, name);
@@ -521,65 +519,65 @@ BundleResult RunBundle(const Robot& nominal, const Rig& rig,
     }
     ext.push_back(p);
   }
-  bool with_errors = false;
-  for (const ParamInfo& p : ext)
-    with_errors |= p.kind == ParamKind::kJointError;
-  with_errors |= st.chain.HasJointErrors();
+  return ext;
+}
 
-  // Frames in the problem: joints and corners.
+// Frames with corners split into training and held-out frames (each in
+// frame order): fold `opt.fold` of `opt.folds`, or the first
+// floor(holdout_fraction * n) of a seeded shuffle.
+HoldoutSplit SplitFrames(const std::vector<BundleFrame>& frames,
+                         const BundleOptions& opt) {
   std::vector<int> usable;
   for (size_t i = 0; i < frames.size(); ++i) {
     if (!frames[i].corners.empty()) usable.push_back(static_cast<int>(i));
   }
-  res.used_frames = static_cast<int>(usable.size());
-  // Seeded hold-out.
-  std::vector<int> order = usable;
+  if (opt.folds >= 2) return HoldOutFold(usable, opt.folds, opt.fold, opt.seed);
   std::mt19937_64 rng(opt.seed);
-  std::shuffle(order.begin(), order.end(), rng);
-  std::set<int> held;
-  if (opt.folds >= 2) {
-    for (size_t k = 0; k < order.size(); ++k) {
-      if (static_cast<int>(k % opt.folds) == opt.fold) held.insert(order[k]);
+  const int num_heldout = static_cast<int>(
+      std::floor(opt.holdout_fraction * static_cast<double>(usable.size())));
+  return HoldOutFirst(usable, num_heldout, &rng);
+}
+
+// The fit's view of frames `indices`: tool corners, cameras and pixels,
+// without the tag observations in `dropped` (key: (frame * 8 + camera) *
+// 1000 + tag).
+std::vector<Obs> MakeObs(const std::vector<BundleFrame>& frames,
+                         const Target& target, const std::vector<int>& indices,
+                         const std::set<int>& dropped) {
+  std::vector<Obs> out;
+  for (int i : indices) {
+    Obs o;
+    o.index = i;
+    for (const BundleCorner& c : frames[i].corners) {
+      const int key = (i * 8 + c.camera) * 1000 + c.tag;
+      if (dropped.count(key)) continue;
+      o.points.push_back(target.tags.at(c.tag).CornerInTool(c.corner));
+      o.cameras.push_back(c.camera);
+      o.pixels.push_back(c.px);
+      o.tag_of.push_back(key);
     }
-  } else {
-    const int nh = static_cast<int>(
-        std::floor(opt.holdout_fraction * static_cast<double>(order.size())));
-    held.insert(order.begin(), order.begin() + nh);
+    if (!o.points.empty()) out.push_back(std::move(o));
   }
-  for (int i : usable) (held.count(i) ? res.heldout : res.train).push_back(i);
-  res.train_frames = static_cast<int>(res.train.size());
-  res.heldout_frames = static_cast<int>(res.heldout.size());
+  return out;
+}
 
-  auto make_obs = [&](const std::vector<int>& idx,
-                      const std::set<int>& dropped) {
-    std::vector<Obs> out;
-    for (int i : idx) {
-      Obs o;
-      o.index = i;
-      for (const BundleCorner& c : frames[i].corners) {
-        const int key = (i * 8 + c.camera) * 1000 + c.tag;
-        if (dropped.count(key)) continue;
-        o.points.push_back(target.tags.at(c.tag).CornerInTool(c.corner));
-        o.cameras.push_back(c.camera);
-        o.pixels.push_back(c.px);
-        o.tag_of.push_back(key);
-      }
-      if (!o.points.empty()) out.push_back(std::move(o));
-    }
-    return out;
-  };
-  std::set<int> dropped;
-  std::vector<Obs> train = make_obs(res.train, dropped);
+// A tracked tool pose good enough to start from or to compare tips with:
+// enough tags, a small RMS, both cameras (one camera leaves its depth weak:
+// tens of mm at 2 m).
+bool WellTracked(const BundleFrame& f, const BundleOptions& opt) {
+  return !(!f.tracked || f.tracked_tags < opt.start_min_tags ||
+           f.tracked_rms_px > opt.start_max_rms_px || !SeenByTwoCameras(f));
+}
 
-  // Start: hand-eye from the tracked poses of training frames.
+// Start values of rig_from_base and flange_from_tool: hand-eye from the
+// well-tracked training frames with the nominal robot.
+void StartFrames(const std::vector<BundleFrame>& frames,
+                 const BundleResult& res, const BundleOptions& opt, State* st) {
   std::vector<Rigid3> bf, rt;
   for (int i : res.train) {
     const BundleFrame& f = frames[i];
-    if (!f.tracked || f.tracked_tags < opt.start_min_tags ||
-        f.tracked_rms_px > opt.start_max_rms_px || !SeenByTwoCameras(f)) {
-      continue;
-    }
-    bf.push_back(BaseFromFlange(st.chain, res.inputs[i], false));
+    if (!WellTracked(f, opt)) continue;
+    bf.push_back(BaseFromFlange(st->chain, res.inputs[i], false));
     rt.push_back(f.rig_from_tool);
   }
   Rigid3 x, y;
@@ -591,290 +589,395 @@ BundleResult RunBundle(const Robot& nominal, const Rig& rig,
         " tags); need at least 3 with different orientations to find where "
         "the base is in the rig and where the target sits on the flange");
   }
-  st.rig_from_base = ToBlock(x);
-  st.flange_from_tool = ToBlock(y);
+  st->rig_from_base = PoseBlockFromRigid3(x);
+  st->flange_from_tool = PoseBlockFromRigid3(y);
+}
 
+// The dense pixel Jacobian of the training frames with respect to the two
+// frames (columns 0..11) and every row and error block (columns from
+// `column_of[(0 row | 1 error, joint)]`).
+Eigen::MatrixXd PixelJacobian(State* st, const std::vector<Obs>& train,
+                              const std::vector<PoseInput>& inputs,
+                              const Freedom& fixed_robot,
+                              const BundleOptions& opt, const Rig& rig,
+                              std::map<std::pair<int, int>, int>* column_of) {
+  const int nj = st->chain.num_joints();
+  const bool with_errors = fixed_robot.with_errors;
+  // Evaluate with every candidate block fully variable, columns per block.
+  Freedom eval = fixed_robot;
+  for (int j = 0; j < nj; ++j) {
+    eval.row_free[j] = {0, 1, 2, 3, 4, 5};
+    if (with_errors) {
+      eval.error_free[j].resize(kJointErrorBlockSize);
+      std::iota(eval.error_free[j].begin(), eval.error_free[j].end(), 0);
+    }
+  }
+  Built b = Build(st, train, inputs, eval, opt, rig);
+  ceres::Problem::EvaluateOptions eo;
+  std::vector<double*> blocks = {st->rig_from_base.data(),
+                                 st->flange_from_tool.data()};
+  int col = 12;
+  for (int j = 0; j < nj; ++j) {
+    blocks.push_back(st->chain.rows[j].p.data());
+    (*column_of)[{0, j}] = col;
+    col += kRowBlockSize;
+  }
+  if (with_errors) {
+    for (int j = 0; j < nj; ++j) {
+      blocks.push_back(st->chain.joint_errors[j].data());
+      (*column_of)[{1, j}] = col;
+      col += kJointErrorBlockSize;
+    }
+  }
+  eo.parameter_blocks = blocks;
+  eo.residual_blocks = b.blocks;
+  eo.num_threads = opt.num_threads;
+  double cost = 0;
+  std::vector<double> residuals;
+  ceres::CRSMatrix crs;
+  b.problem->Evaluate(eo, &cost, &residuals, nullptr, &crs);
+  Eigen::MatrixXd J = Eigen::MatrixXd::Zero(crs.num_rows, crs.num_cols);
+  for (int r = 0; r < crs.num_rows; ++r) {
+    for (int k = crs.rows[r]; k < crs.rows[r + 1]; ++k) {
+      J(r, crs.cols[k]) = crs.values[k];
+    }
+  }
+  return J;
+}
+
+// Pixel noise for the statistical criterion: the median tracked RMS of the
+// training frames (the per-frame tool pose fits, 6 parameters per frame,
+// see detection noise, not model error); at least 0.02 px, 0.1 px without
+// tracked frames.
+double TrackedPixelNoise(const std::vector<BundleFrame>& frames,
+                         const std::vector<int>& train) {
+  std::vector<double> tracked_rms;
+  for (int i : train) {
+    if (frames[i].tracked) tracked_rms.push_back(frames[i].tracked_rms_px);
+  }
+  if (tracked_rms.empty()) return 0.1;
+  std::nth_element(tracked_rms.begin(),
+                   tracked_rms.begin() + tracked_rms.size() / 2,
+                   tracked_rms.end());
+  return std::max(0.02, tracked_rms[tracked_rms.size() / 2]);
+}
+
+struct IdentifiabilityScan {
+  std::vector<std::string> accepted;        // in priority order
+  std::vector<std::string> unidentifiable;  // held at nominal
+  Freedom fit;                              // the accepted ones free
+};
+
+// Gram-Schmidt on the pixel Jacobian in priority order (the two frames,
+// then `candidates`): a candidate is accepted when the part of its column
+// outside the span of those before it is larger than the tolerance (sine of
+// the angle) and, for a row parameter, its conditional sigma
+// sigma_px / (|column| sine) is below max_sigma_fraction of its bound.
+// calib/identifiability.h scans point measurements; this scan works on the
+// bundle's pixel residuals and the frames' columns.
+IdentifiabilityScan ScanIdentifiability(
+    const Eigen::MatrixXd& J,
+    const std::map<std::pair<int, int>, int>& column_of,
+    const std::vector<ParamInfo>& candidates, const Chain& chain,
+    double sigma_px, const Freedom& fixed_robot, const BundleOptions& opt) {
+  IdentifiabilityScan scan;
+  scan.fit = fixed_robot;
+  std::vector<Eigen::VectorXd> basis;
+  auto residual_part = [&](Eigen::VectorXd v) {
+    for (int pass = 0; pass < 2; ++pass) {
+      for (const Eigen::VectorXd& e : basis) v -= e.dot(v) * e;
+    }
+    return v;
+  };
+  for (int c = 0; c < 12; ++c) {
+    const Eigen::VectorXd v = J.col(c);
+    if (v.norm() == 0) continue;
+    const Eigen::VectorXd r = residual_part(v / v.norm());
+    if (r.norm() > opt.identifiability_tolerance)
+      basis.push_back(r.normalized());
+  }
+  for (const ParamInfo& p : candidates) {
+    const int column =
+        column_of.at({p.kind == ParamKind::kRow ? 0 : 1, p.block}) + p.index;
+    const Eigen::VectorXd v = J.col(column);
+    const double norm = v.norm();
+    bool ok = norm > 0;
+    if (ok) {
+      const Eigen::VectorXd r = residual_part(v / norm);
+      const double sine = r.norm();
+      ok = sine > opt.identifiability_tolerance;
+      if (ok && p.kind == ParamKind::kRow) {
+        const double bound =
+            p.angle ? chain.bound_angle_rad : chain.bound_length_mm;
+        const double cond_sigma = sigma_px / (norm * sine);
+        ok = cond_sigma < opt.max_sigma_fraction * bound;
+      }
+      if (ok) basis.push_back(r / sine);
+    }
+    if (!ok) {
+      scan.unidentifiable.push_back(p.name);
+      continue;
+    }
+    scan.accepted.push_back(p.name);
+    if (p.kind == ParamKind::kRow)
+      scan.fit.row_free[p.block].push_back(p.index);
+    if (p.kind == ParamKind::kJointError) {
+      scan.fit.error_free[p.block].push_back(p.index);
+    }
+  }
+  return scan;
+}
+
+// Tag observations of the training frames whose RMS exceeds
+// max(outlier_px, outlier_ratio * median tag RMS), added to `*dropped`.
+void DropOutlierTags(State* st, const std::vector<Obs>& train,
+                     const std::vector<PoseInput>& inputs, bool with_errors,
+                     const BundleOptions& opt, const Rig& rig,
+                     std::set<int>* dropped) {
+  const std::vector<double> e =
+      CornerErrors(st, train, inputs, with_errors, rig);
+  std::map<int, std::pair<double, int>> per_tag;
+  size_t k = 0;
+  for (const Obs& o : train) {
+    for (size_t i = 0; i < o.points.size(); ++i, ++k) {
+      per_tag[o.tag_of[i]].first += e[k] * e[k];
+      per_tag[o.tag_of[i]].second += 1;
+    }
+  }
+  std::vector<double> rms;
+  for (auto& [key, v] : per_tag) rms.push_back(std::sqrt(v.first / v.second));
+  std::vector<double> sorted = rms;
+  std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2,
+                   sorted.end());
+  const double limit =
+      std::max(opt.outlier_px, opt.outlier_ratio * sorted[sorted.size() / 2]);
+  size_t t = 0;
+  for (auto& [key, v] : per_tag) {
+    if (rms[t++] > limit) dropped->insert(key);
+  }
+}
+
+// sigma0 (px) of the final fit and each accepted parameter's value and
+// sigma (interface units; NaN where the covariance is not available), from
+// the covariance of the free blocks scaled by sigma0^2.
+void EstimateCovariance(State* st, const std::vector<Obs>& train,
+                        const std::vector<PoseInput>& inputs,
+                        const Freedom& fit, const BundleOptions& opt,
+                        const Rig& rig,
+                        const std::vector<ParamInfo>& candidates,
+                        const std::vector<std::string>& accepted,
+                        BundleResult* res) {
+  const int nj = st->chain.num_joints();
+  Built b = Build(st, train, inputs, fit, opt, rig);
+  int nfree = 12;
+  for (const auto& r : fit.row_free) nfree += static_cast<int>(r.size());
+  for (const auto& r : fit.error_free) nfree += static_cast<int>(r.size());
+  double cost = 0;
+  b.problem->Evaluate(ceres::Problem::EvaluateOptions(), &cost, nullptr,
+                      nullptr, nullptr);
+  res->sigma0_px = std::sqrt(2 * cost / std::max(1, b.residuals - nfree));
+  ceres::Covariance::Options co;
+  co.algorithm_type = ceres::DENSE_SVD;
+  co.null_space_rank = -1;
+  co.num_threads = opt.num_threads;
+  ceres::Covariance cov(co);
+  std::vector<std::pair<const double*, const double*>> pairs;
+  for (int j = 0; j < nj; ++j) {
+    if (!fit.row_free[j].empty()) {
+      pairs.push_back({st->chain.rows[j].p.data(), st->chain.rows[j].p.data()});
+    }
+    if (fit.with_errors && !fit.error_free[j].empty()) {
+      pairs.push_back(
+          {st->chain.joint_errors[j].data(), st->chain.joint_errors[j].data()});
+    }
+  }
+  const bool have_cov = !pairs.empty() && cov.Compute(pairs, b.problem.get());
+  const double s2 = res->sigma0_px * res->sigma0_px;
+  for (const ParamInfo& p : candidates) {
+    if (std::find(accepted.begin(), accepted.end(), p.name) == accepted.end()) {
+      continue;
+    }
+    BundleParam bp;
+    bp.name = p.name;
+    ModelState ms;
+    ms.chain = st->chain;
+    bp.value = p.ToInterface(ParamValue(ms, p));
+    bp.sigma = std::numeric_limits<double>::quiet_NaN();
+    if (have_cov) {
+      const int size =
+          p.kind == ParamKind::kRow ? kRowBlockSize : kJointErrorBlockSize;
+      const double* blk = p.kind == ParamKind::kRow
+                              ? st->chain.rows[p.block].p.data()
+                              : st->chain.joint_errors[p.block].data();
+      std::vector<double> c(size * size);
+      if (cov.GetCovarianceBlock(blk, blk, c.data())) {
+        const double var = c[p.index * size + p.index] * s2;
+        bp.sigma = std::abs(p.ToInterface(std::sqrt(std::max(0.0, var))));
+      }
+    }
+    res->params.push_back(bp);
+  }
+}
+
+// The solved state into the result: the tool row from the tip, the robot,
+// both frames and the refined rig.
+void WriteSolution(const Robot& nominal, const Rig& rig, const Target& target,
+                   bool with_errors, State* st, BundleResult* res) {
+  const Rigid3 ft = Rigid3FromPoseBlock(st->flange_from_tool.data());
+  SetToolRow(ft * target.tip_in_tool, &st->chain);
+  if (!with_errors) {
+    for (auto& e : st->chain.joint_errors) e.fill(0.0);
+  }
+  res->chain = st->chain;
+  res->calibrated = st->chain.ToRobot(nominal);
+  res->rig_from_base = st->rig_from_base;
+  res->flange_from_tool = st->flange_from_tool;
+  for (size_t c = 0; c < rig.cameras.size(); ++c) {
+    const int nd =
+        static_cast<int>(rig.cameras[c].intrinsics.distortion.size());
+    CameraIntrinsics k =
+        CameraIntrinsics::FromArray(st->intrinsics[c].data(), nd);
+    k.name = rig.cameras[c].intrinsics.name;
+    k.width = rig.cameras[c].intrinsics.width;
+    k.height = rig.cameras[c].intrinsics.height;
+    res->rig.cameras[c].intrinsics = k;
+    res->rig.cameras[c].cam_from_rig =
+        c == 0 ? rig.cameras[0].cam_from_rig
+               : Rigid3FromPoseBlock(st->cam_from_rig[c].data());
+  }
+}
+
+// Held-out tips: the model's tip against the tracked tip of every
+// well-tracked held-out frame (mm).
+void HeldOutTips(const std::vector<BundleFrame>& frames, const Target& target,
+                 const BundleOptions& opt, BundleResult* res) {
+  std::vector<double> tip_err;
+  for (int i : res->heldout) {
+    const BundleFrame& f = frames[i];
+    if (!WellTracked(f, opt)) continue;
+    const Eigen::Vector3d model =
+        ModelRigFromTool(*res, i) * target.tip_in_tool;
+    const Eigen::Vector3d seen = f.rig_from_tool * target.tip_in_tool;
+    tip_err.push_back((model - seen).norm());
+  }
+  res->heldout_tips = static_cast<int>(tip_err.size());
+  res->heldout_tip_mm = tip_err;
+  res->heldout_tip_rms_mm = Rms(tip_err);
+}
+
+// Names: the two frames and the tool row's position are determined by
+// construction, its orientation is not; then the accepted candidates.
+void NameIdentifiable(const Chain& chain,
+                      const std::vector<std::string>& accepted,
+                      BundleResult* res) {
+  const char* fn[6] = {"rx", "ry", "rz", "tx", "ty", "tz"};
+  for (int k = 0; k < 6; ++k) {
+    res->identifiable.push_back(std::string("frame.") + fn[k]);
+  }
+  for (int k = 0; k < 6; ++k) {
+    res->identifiable.push_back(std::string("flange_from_target.") + fn[k]);
+  }
+  for (const std::string& a : accepted) res->identifiable.push_back(a);
+  for (const ParamInfo& p : GeometryParams(chain)) {
+    if (p.block != chain.tool_row()) continue;
+    const bool position = chain.convention == Convention::kMdh
+                              ? p.index >= 1 && p.index <= 3
+                              : p.index < 3;
+    (position ? res->identifiable : res->unidentifiable).push_back(p.name);
+  }
+}
+
+}  // namespace
+
+BundleResult RunBundle(const Robot& nominal, const Rig& rig,
+                       const Target& target,
+                       const std::vector<BundleFrame>& frames,
+                       const BundleOptions& opt) {
+  const auto start = std::chrono::steady_clock::now();
+  BundleResult res;
+  res.frames = static_cast<int>(frames.size());
+  res.rig = rig;
+  State st;
+  st.chain = Chain::FromRobot(nominal);
+  const int nj = st.chain.num_joints();
+  if (nj > kMaxJoints) throw InputError("bundle: more than 16 joints");
+  if (rig.cameras.size() > 4) throw InputError("bundle: more than 4 cameras");
+  for (const Camera& c : rig.cameras) {
+    st.intrinsics.push_back(c.intrinsics.ToArray());
+    st.cam_from_rig.push_back(PoseBlockFromRigid3(c.cam_from_rig));
+  }
+  res.inputs = FramePoseInputs(nominal, st.chain, frames);
+  const std::vector<ParamInfo> ext = ExtensionParams(st.chain, opt);
+  bool with_errors = st.chain.HasJointErrors();
+  for (const ParamInfo& p : ext) {
+    with_errors |= p.kind == ParamKind::kJointError;
+  }
+
+  // Hold-out, start values, the two frames with the nominal robot.
+  HoldoutSplit split = SplitFrames(frames, opt);
+  res.train = std::move(split.train);
+  res.heldout = std::move(split.heldout);
+  res.used_frames = static_cast<int>(res.train.size() + res.heldout.size());
+  res.train_frames = static_cast<int>(res.train.size());
+  res.heldout_frames = static_cast<int>(res.heldout.size());
+  std::set<int> dropped;
+  std::vector<Obs> train = MakeObs(frames, target, res.train, dropped);
+  StartFrames(frames, res, opt, &st);
   Freedom fixed_robot;
   fixed_robot.row_free.assign(nj, {});
   fixed_robot.error_free.assign(nj, {});
   fixed_robot.with_errors = with_errors;
   res.start_reproj_rms_px =
       Rms(CornerErrors(&st, train, res.inputs, with_errors, rig));
-  {  // Stage 1: the two frames with the nominal robot.
+  {
     Built b = Build(&st, train, res.inputs, fixed_robot, opt, rig);
     Solve(b.problem.get(), opt);
   }
 
   // Identifiability on the pixel Jacobian, all candidates free.
-  std::vector<ParamInfo> cand_info;
+  std::vector<ParamInfo> candidates;
   for (const ParamInfo& p : GeometryParams(st.chain)) {
-    if (p.block < st.chain.tool_row()) cand_info.push_back(p);
+    if (p.block < st.chain.tool_row()) candidates.push_back(p);
   }
-  for (const ParamInfo& p : ext) cand_info.push_back(p);
-  Freedom all = fixed_robot;
-  for (const ParamInfo& p : cand_info) {
-    if (p.kind == ParamKind::kRow) all.row_free[p.block].push_back(p.index);
-    if (p.kind == ParamKind::kJointError) {
-      all.error_free[p.block].push_back(p.index);
-    }
-  }
-  std::vector<std::string> accepted;
-  Freedom fit = fixed_robot;
-  {
-    // Evaluate with every candidate block fully variable, columns per block.
-    Freedom eval = fixed_robot;
-    for (int j = 0; j < nj; ++j) {
-      eval.row_free[j] = {0, 1, 2, 3, 4, 5};
-      if (with_errors) {
-        eval.error_free[j].resize(kJointErrorBlockSize);
-        std::iota(eval.error_free[j].begin(), eval.error_free[j].end(), 0);
-      }
-    }
-    Built b = Build(&st, train, res.inputs, eval, opt, rig);
-    ceres::Problem::EvaluateOptions eo;
-    std::vector<double*> blocks = {st.rig_from_base.data(),
-                                   st.flange_from_tool.data()};
-    std::map<std::pair<int, int>, int> base;  // (kind, block) -> column
-    int col = 12;
-    for (int j = 0; j < nj; ++j) {
-      blocks.push_back(st.chain.rows[j].p.data());
-      base[{0, j}] = col;
-      col += kRowBlockSize;
-    }
-    if (with_errors) {
-      for (int j = 0; j < nj; ++j) {
-        blocks.push_back(st.chain.joint_errors[j].data());
-        base[{1, j}] = col;
-        col += kJointErrorBlockSize;
-      }
-    }
-    eo.parameter_blocks = blocks;
-    eo.residual_blocks = b.blocks;
-    eo.num_threads = opt.num_threads;
-    double cost = 0;
-    std::vector<double> residuals;
-    ceres::CRSMatrix crs;
-    b.problem->Evaluate(eo, &cost, &residuals, nullptr, &crs);
-    Eigen::MatrixXd J = Eigen::MatrixXd::Zero(crs.num_rows, crs.num_cols);
-    for (int r = 0; r < crs.num_rows; ++r) {
-      for (int k = crs.rows[r]; k < crs.rows[r + 1]; ++k) {
-        J(r, crs.cols[k]) = crs.values[k];
-      }
-    }
-    // Pixel noise for the statistical criterion: the per-frame tool pose
-    // fits (6 parameters per frame) see detection noise, not model error.
-    std::vector<double> tracked_rms;
-    for (int i : res.train) {
-      if (frames[i].tracked) tracked_rms.push_back(frames[i].tracked_rms_px);
-    }
-    double sigma_px = 0.1;
-    if (!tracked_rms.empty()) {
-      std::nth_element(tracked_rms.begin(),
-                       tracked_rms.begin() + tracked_rms.size() / 2,
-                       tracked_rms.end());
-      sigma_px = std::max(0.02, tracked_rms[tracked_rms.size() / 2]);
-    }
-    // Gram-Schmidt in priority order: the two frames, then candidates.
-    std::vector<Eigen::VectorXd> basis;
-    auto residual_part = [&](Eigen::VectorXd v) {
-      for (int pass = 0; pass < 2; ++pass) {
-        for (const Eigen::VectorXd& e : basis) v -= e.dot(v) * e;
-      }
-      return v;
-    };
-    for (int c = 0; c < 12; ++c) {
-      const Eigen::VectorXd v = J.col(c);
-      if (v.norm() == 0) continue;
-      const Eigen::VectorXd r = residual_part(v / v.norm());
-      if (r.norm() > opt.identifiability_tolerance)
-        basis.push_back(r.normalized());
-    }
-    for (const ParamInfo& p : cand_info) {
-      const int column =
-          base[{p.kind == ParamKind::kRow ? 0 : 1, p.block}] + p.index;
-      const Eigen::VectorXd v = J.col(column);
-      const double norm = v.norm();
-      bool ok = norm > 0;
-      if (ok) {
-        const Eigen::VectorXd r = residual_part(v / norm);
-        const double sine = r.norm();
-        ok = sine > opt.identifiability_tolerance;
-        if (ok && p.kind == ParamKind::kRow) {
-          const double bound =
-              p.angle ? st.chain.bound_angle_rad : st.chain.bound_length_mm;
-          const double cond_sigma = sigma_px / (norm * sine);
-          ok = cond_sigma < opt.max_sigma_fraction * bound;
-        }
-        if (ok) basis.push_back(r / sine);
-      }
-      if (ok) {
-        accepted.push_back(p.name);
-        if (p.kind == ParamKind::kRow) fit.row_free[p.block].push_back(p.index);
-        if (p.kind == ParamKind::kJointError) {
-          fit.error_free[p.block].push_back(p.index);
-        }
-      } else {
-        res.unidentifiable.push_back(p.name);
-      }
-    }
-  }
+  for (const ParamInfo& p : ext) candidates.push_back(p);
+  std::map<std::pair<int, int>, int> column_of;
+  const Eigen::MatrixXd J =
+      PixelJacobian(&st, train, res.inputs, fixed_robot, opt, rig, &column_of);
+  IdentifiabilityScan scan = ScanIdentifiability(
+      J, column_of, candidates, st.chain, TrackedPixelNoise(frames, res.train),
+      fixed_robot, opt);
+  res.unidentifiable = scan.unidentifiable;
+  Freedom& fit = scan.fit;
   fit.cameras = opt.refine_cameras;
 
-  // Stage 2: the joint fit; then drop outlier tags and refit.
+  // The joint fit; then drop outlier tags and refit.
   ceres::Solver::Summary summary;
   for (int round = 0; round < 2; ++round) {
     Built b = Build(&st, train, res.inputs, fit, opt, rig);
     summary = Solve(b.problem.get(), opt);
     if (round == 1) break;
-    // Per tag observation RMS.
-    const std::vector<double> e =
-        CornerErrors(&st, train, res.inputs, with_errors, rig);
-    std::map<int, std::pair<double, int>> per_tag;
-    size_t k = 0;
-    for (const Obs& o : train) {
-      for (size_t i = 0; i < o.points.size(); ++i, ++k) {
-        per_tag[o.tag_of[i]].first += e[k] * e[k];
-        per_tag[o.tag_of[i]].second += 1;
-      }
-    }
-    std::vector<double> rms;
-    for (auto& [key, v] : per_tag) rms.push_back(std::sqrt(v.first / v.second));
-    std::vector<double> sorted = rms;
-    std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2,
-                     sorted.end());
-    const double limit =
-        std::max(opt.outlier_px, opt.outlier_ratio * sorted[sorted.size() / 2]);
-    size_t t = 0;
-    for (auto& [key, v] : per_tag) {
-      if (rms[t++] > limit) dropped.insert(key);
-    }
+    DropOutlierTags(&st, train, res.inputs, with_errors, opt, rig, &dropped);
     if (dropped.empty()) break;
     res.dropped_tags = static_cast<int>(dropped.size());
-    train = make_obs(res.train, dropped);
+    train = MakeObs(frames, target, res.train, dropped);
   }
   res.termination = summary.message;
   res.iterations = static_cast<int>(summary.iterations.size());
+  EstimateCovariance(&st, train, res.inputs, fit, opt, rig, candidates,
+                     scan.accepted, &res);
 
-  // Covariance of the free parameters, scaled by the pixel noise estimate.
-  {
-    Built b = Build(&st, train, res.inputs, fit, opt, rig);
-    int nfree = 12;
-    for (const auto& r : fit.row_free) nfree += static_cast<int>(r.size());
-    for (const auto& r : fit.error_free) nfree += static_cast<int>(r.size());
-    double cost = 0;
-    b.problem->Evaluate(ceres::Problem::EvaluateOptions(), &cost, nullptr,
-                        nullptr, nullptr);
-    res.sigma0_px = std::sqrt(2 * cost / std::max(1, b.residuals - nfree));
-    ceres::Covariance::Options co;
-    co.algorithm_type = ceres::DENSE_SVD;
-    co.null_space_rank = -1;
-    co.num_threads = opt.num_threads;
-    ceres::Covariance cov(co);
-    std::vector<std::pair<const double*, const double*>> pairs;
-    std::vector<const double*> row_blocks;
-    for (int j = 0; j < nj; ++j) {
-      if (!fit.row_free[j].empty()) {
-        pairs.push_back({st.chain.rows[j].p.data(), st.chain.rows[j].p.data()});
-      }
-      if (with_errors && !fit.error_free[j].empty()) {
-        pairs.push_back(
-            {st.chain.joint_errors[j].data(), st.chain.joint_errors[j].data()});
-      }
-    }
-    const bool have_cov = !pairs.empty() && cov.Compute(pairs, b.problem.get());
-    const double s2 = res.sigma0_px * res.sigma0_px;
-    for (const ParamInfo& p : cand_info) {
-      if (std::find(accepted.begin(), accepted.end(), p.name) ==
-          accepted.end()) {
-        continue;
-      }
-      BundleParam bp;
-      bp.name = p.name;
-      ModelState ms;
-      ms.chain = st.chain;
-      bp.value = p.ToInterface(ParamValue(ms, p));
-      bp.sigma = std::numeric_limits<double>::quiet_NaN();
-      if (have_cov) {
-        const int size =
-            p.kind == ParamKind::kRow ? kRowBlockSize : kJointErrorBlockSize;
-        const double* blk = p.kind == ParamKind::kRow
-                                ? st.chain.rows[p.block].p.data()
-                                : st.chain.joint_errors[p.block].data();
-        std::vector<double> c(size * size);
-        if (cov.GetCovarianceBlock(blk, blk, c.data())) {
-          const double var = c[p.index * size + p.index] * s2;
-          bp.sigma = std::abs(p.ToInterface(std::sqrt(std::max(0.0, var))));
-        }
-      }
-      res.params.push_back(bp);
-    }
-  }
-
-  // Training and held-out statistics.
+  // Training and held-out statistics, then the solution.
   res.reproj_rms_px =
       Rms(CornerErrors(&st, train, res.inputs, with_errors, rig));
   res.corners = 0;
   for (const Obs& o : train) res.corners += static_cast<int>(o.points.size());
-  const std::vector<Obs> heldout = make_obs(res.heldout, {});
+  const std::vector<Obs> heldout = MakeObs(frames, target, res.heldout, {});
   res.heldout_corner_px =
       CornerErrors(&st, heldout, res.inputs, with_errors, rig);
   res.heldout_reproj_rms_px = Rms(res.heldout_corner_px);
-
-  // Results: the tool row from the tip, the refined rig.
-  const Rigid3 ft = FromBlock(st.flange_from_tool);
-  SetToolRow(ft * target.tip_in_tool, &st.chain);
-  if (!with_errors) {
-    for (auto& e : st.chain.joint_errors) e.fill(0.0);
-  }
-  res.chain = st.chain;
-  res.calibrated = st.chain.ToRobot(nominal);
-  res.rig_from_base = st.rig_from_base;
-  res.flange_from_tool = st.flange_from_tool;
-  for (size_t c = 0; c < rig.cameras.size(); ++c) {
-    const int nd =
-        static_cast<int>(rig.cameras[c].intrinsics.distortion.size());
-    CameraIntrinsics k =
-        CameraIntrinsics::FromArray(st.intrinsics[c].data(), nd);
-    k.name = rig.cameras[c].intrinsics.name;
-    k.width = rig.cameras[c].intrinsics.width;
-    k.height = rig.cameras[c].intrinsics.height;
-    res.rig.cameras[c].intrinsics = k;
-    res.rig.cameras[c].cam_from_rig =
-        c == 0 ? rig.cameras[0].cam_from_rig : FromBlock(st.cam_from_rig[c]);
-  }
-  std::vector<double> tip_err;
-  for (int i : res.heldout) {
-    const BundleFrame& f = frames[i];
-    // A tracked tip is a measurement only when both cameras saw the tool
-    // (one camera leaves its depth weak: tens of mm at 2 m).
-    if (!f.tracked || f.tracked_tags < opt.start_min_tags ||
-        f.tracked_rms_px > opt.start_max_rms_px || !SeenByTwoCameras(f)) {
-      continue;
-    }
-    const Eigen::Vector3d model = ModelRigFromTool(res, i) * target.tip_in_tool;
-    const Eigen::Vector3d seen = f.rig_from_tool * target.tip_in_tool;
-    tip_err.push_back((model - seen).norm());
-  }
-  res.heldout_tips = static_cast<int>(tip_err.size());
-  res.heldout_tip_mm = tip_err;
-  res.heldout_tip_rms_mm = Rms(tip_err);
-
-  // Names: the two frames and the tool row are determined by construction.
-  const char* fn[6] = {"rx", "ry", "rz", "tx", "ty", "tz"};
-  for (int k = 0; k < 6; ++k) {
-    res.identifiable.push_back(std::string("frame.") + fn[k]);
-  }
-  for (int k = 0; k < 6; ++k) {
-    res.identifiable.push_back(std::string("flange_from_target.") + fn[k]);
-  }
-  for (const std::string& a : accepted) res.identifiable.push_back(a);
-  for (const ParamInfo& p : GeometryParams(st.chain)) {
-    if (p.block != st.chain.tool_row()) continue;
-    const bool position = st.chain.convention == Convention::kMdh
-                              ? p.index >= 1 && p.index <= 3
-                              : p.index < 3;
-    (position ? res.identifiable : res.unidentifiable).push_back(p.name);
-  }
+  WriteSolution(nominal, rig, target, with_errors, &st, &res);
+  HeldOutTips(frames, target, opt, &res);
+  NameIdentifiable(st.chain, scan.accepted, &res);
   res.seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start)
           .count();

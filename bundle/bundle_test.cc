@@ -6,7 +6,7 @@
 #include <cmath>
 #include <random>
 
-#include "bundle/synthetic.h"
+#include "bundle/testing/synthetic.h"
 #include "calib/model_state.h"
 #include "data/error.h"
 #include "data/robot.h"

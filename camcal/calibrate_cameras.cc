@@ -12,6 +12,7 @@
 #include <sstream>
 #include <utility>
 
+#include "camcal/cost_functions.h"
 #include "data/error.h"
 
 namespace kincal {
@@ -19,117 +20,6 @@ namespace kincal {
 namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-
-// Reprojection error of a target point seen by the reference camera (whose
-// frame is the rig frame):
-//   residual = ProjectPoint(intrinsics, rig_from_target * p_in_target) - pixel
-// rig_from_target is a unit quaternion (Eigen order x, y, z, w) and a
-// translation in target units.
-class TargetReprojectionError {
- public:
-  TargetReprojectionError(const Eigen::Vector3d& p_in_target,
-                          const Eigen::Vector2d& pixel)
-      : p_in_target_(p_in_target), pixel_(pixel) {}
-
-  template <typename T>
-  bool operator()(const T* intrinsics, const T* rig_from_target_q,
-                  const T* rig_from_target_t, T* residuals) const {
-    const Eigen::Map<const Eigen::Quaternion<T>> q(rig_from_target_q);
-    const Eigen::Map<const Eigen::Matrix<T, 3, 1>> t(rig_from_target_t);
-    const Eigen::Matrix<T, 3, 1> p_in_cam = q * p_in_target_.cast<T>() + t;
-    T pixel[2];
-    if (!ProjectPoint(intrinsics, p_in_cam.data(), pixel)) return false;
-    residuals[0] = pixel[0] - T(pixel_.x());
-    residuals[1] = pixel[1] - T(pixel_.y());
-    return true;
-  }
-
-  static ceres::CostFunction* Create(const Eigen::Vector3d& p_in_target,
-                                     const Eigen::Vector2d& pixel) {
-    return new ceres::AutoDiffCostFunction<TargetReprojectionError, 2,
-                                           kNumIntrinsics, 4, 3>(
-        new TargetReprojectionError(p_in_target, pixel));
-  }
-
- private:
-  const Eigen::Vector3d p_in_target_;
-  const Eigen::Vector2d pixel_;
-};
-
-// Reprojection error of a target point seen by a non-reference camera:
-//   residual = ProjectPoint(intrinsics,
-//                 cam_from_rig * rig_from_target * p_in_target) - pixel
-class RigTargetReprojectionError {
- public:
-  RigTargetReprojectionError(const Eigen::Vector3d& p_in_target,
-                             const Eigen::Vector2d& pixel)
-      : p_in_target_(p_in_target), pixel_(pixel) {}
-
-  template <typename T>
-  bool operator()(const T* intrinsics, const T* cam_from_rig_q,
-                  const T* cam_from_rig_t, const T* rig_from_target_q,
-                  const T* rig_from_target_t, T* residuals) const {
-    const Eigen::Map<const Eigen::Quaternion<T>> q_cr(cam_from_rig_q);
-    const Eigen::Map<const Eigen::Matrix<T, 3, 1>> t_cr(cam_from_rig_t);
-    const Eigen::Map<const Eigen::Quaternion<T>> q_rt(rig_from_target_q);
-    const Eigen::Map<const Eigen::Matrix<T, 3, 1>> t_rt(rig_from_target_t);
-    const Eigen::Matrix<T, 3, 1> p_in_rig =
-        q_rt * p_in_target_.cast<T>() + t_rt;
-    const Eigen::Matrix<T, 3, 1> p_in_cam = q_cr * p_in_rig + t_cr;
-    T pixel[2];
-    if (!ProjectPoint(intrinsics, p_in_cam.data(), pixel)) return false;
-    residuals[0] = pixel[0] - T(pixel_.x());
-    residuals[1] = pixel[1] - T(pixel_.y());
-    return true;
-  }
-
-  static ceres::CostFunction* Create(const Eigen::Vector3d& p_in_target,
-                                     const Eigen::Vector2d& pixel) {
-    return new ceres::AutoDiffCostFunction<RigTargetReprojectionError, 2,
-                                           kNumIntrinsics, 4, 3, 4, 3>(
-        new RigTargetReprojectionError(p_in_target, pixel));
-  }
-
- private:
-  const Eigen::Vector3d p_in_target_;
-  const Eigen::Vector2d pixel_;
-};
-
-// A ray at infinity of one model, rotated, projected by another model:
-//   residual = ProjectPoint(intrinsics_b, R(rotation_aa) * ray_a) - pixel
-class RotatedRayError {
- public:
-  RotatedRayError(const Eigen::Vector3d& ray_a, const Eigen::Vector2d& pixel,
-                  const std::array<double, kNumIntrinsics>& intrinsics_b)
-      : ray_a_(ray_a), pixel_(pixel), intrinsics_b_(intrinsics_b) {}
-
-  template <typename T>
-  bool operator()(const T* rotation_aa, T* residuals) const {
-    const T ray[3] = {T(ray_a_.x()), T(ray_a_.y()), T(ray_a_.z())};
-    T p_in_b[3];
-    ceres::AngleAxisRotatePoint(rotation_aa, ray, p_in_b);
-    T intrinsics[kNumIntrinsics];
-    for (int i = 0; i < kNumIntrinsics; ++i)
-      intrinsics[i] = T(intrinsics_b_[i]);
-    T pixel[2];
-    if (!ProjectPoint(intrinsics, p_in_b, pixel)) return false;
-    residuals[0] = pixel[0] - T(pixel_.x());
-    residuals[1] = pixel[1] - T(pixel_.y());
-    return true;
-  }
-
-  static ceres::CostFunction* Create(
-      const Eigen::Vector3d& ray_a, const Eigen::Vector2d& pixel,
-      const std::array<double, kNumIntrinsics>& intrinsics_b) {
-    return new ceres::AutoDiffCostFunction<RotatedRayError, 2, 3>(
-        new RotatedRayError(ray_a, pixel, intrinsics_b));
-  }
-
- private:
-  const Eigen::Vector3d ray_a_;
-  const Eigen::Vector2d pixel_;
-  const std::array<double, kNumIntrinsics> intrinsics_b_;
-};
 
 // A pose as one Ceres quaternion block (x, y, z, w) and one translation block.
 struct PoseBlock {
@@ -622,6 +512,98 @@ std::pair<double, double> ProjectionDifferencePx(const CameraIntrinsics& a,
   return {n ? std::sqrt(ss / n) : kNaN, n ? max : kNaN};
 }
 
+namespace {
+
+// Standard deviations of the intrinsics and, with two cameras, of the
+// extrinsics and the baseline, from the solved problem's covariance scaled
+// by the residual variance; a note instead when the Jacobian is rank
+// deficient.
+void AddCovariance(const State& s, size_t nc, double variance,
+                   ceres::Problem* problem, CalibrationSummary* out) {
+  ceres::Covariance::Options copt;
+  copt.algorithm_type = ceres::DENSE_SVD;
+  copt.num_threads = 1;
+  ceres::Covariance covariance(copt);
+  std::vector<std::pair<const double*, const double*>> blocks;
+  for (size_t c = 0; c < nc; ++c) {
+    blocks.emplace_back(s.intrinsics[c].data(), s.intrinsics[c].data());
+  }
+  if (nc == 2) {
+    blocks.emplace_back(s.cam_from_rig[1].q.data(), s.cam_from_rig[1].q.data());
+    blocks.emplace_back(s.cam_from_rig[1].t.data(), s.cam_from_rig[1].t.data());
+  }
+  if (covariance.Compute(blocks, problem)) {
+    for (size_t c = 0; c < nc; ++c) {
+      Eigen::Matrix<double, kNumIntrinsics, kNumIntrinsics, Eigen::RowMajor>
+          cov;
+      covariance.GetCovarianceBlock(s.intrinsics[c].data(),
+                                    s.intrinsics[c].data(), cov.data());
+      for (int i = 0; i < kNumIntrinsics; ++i) {
+        out->cameras[c].sigma.push_back(
+            std::sqrt(std::max(0.0, cov(i, i) * variance)));
+      }
+    }
+    if (nc == 2) {
+      Eigen::Matrix<double, 3, 3, Eigen::RowMajor> cov_r, cov_t;
+      covariance.GetCovarianceBlockInTangentSpace(
+          s.cam_from_rig[1].q.data(), s.cam_from_rig[1].q.data(), cov_r.data());
+      covariance.GetCovarianceBlock(s.cam_from_rig[1].t.data(),
+                                    s.cam_from_rig[1].t.data(), cov_t.data());
+      // EigenQuaternionManifold's tangent is half the rotation vector.
+      for (int i = 0; i < 3; ++i) {
+        out->extrinsic_rotation_sigma_deg.push_back(
+            2.0 * std::sqrt(std::max(0.0, cov_r(i, i) * variance)) * 180.0 /
+            M_PI);
+        out->extrinsic_translation_sigma.push_back(
+            std::sqrt(std::max(0.0, cov_t(i, i) * variance)));
+      }
+      // baseline = |t| (camera centre distance = |R^T t| = |t|).
+      const Eigen::Vector3d t(s.cam_from_rig[1].t.data());
+      const Eigen::Vector3d u = t.normalized();
+      out->baseline_sigma = std::sqrt(u.dot(cov_t * u) * variance);
+    }
+  } else {
+    out->covariance_note =
+        "covariance not available: the Jacobian is rank deficient (the "
+        "views do not determine every parameter)";
+  }
+}
+
+// Even/odd views calibrated apart: each half's held-out RMS on the other
+// and the projection difference between the halves' intrinsics (NaN when a
+// half has too few views).
+void CrossValidateHalves(const CalibrationProblem& input,
+                         const CalibrationOptions& options,
+                         CalibrationSummary* out) {
+  const size_t nc = input.cameras.size();
+  const size_t nv = input.views.size();
+  // Even and odd views.
+  CalibrationProblem half[2];
+  for (int h = 0; h < 2; ++h) half[h].cameras = input.cameras;
+  for (size_t v = 0; v < nv; ++v) half[v % 2].views.push_back(input.views[v]);
+  CalibrationOptions sub = options;
+  sub.cross_validate = false;
+  sub.compute_covariance = false;
+  try {
+    const CalibrationSummary a = CalibrateCameras(half[0], sub);
+    const CalibrationSummary b = CalibrateCameras(half[1], sub);
+    const std::vector<double> a_on_b = HeldOutRmsPx(a.rig, half[1].views, sub);
+    const std::vector<double> b_on_a = HeldOutRmsPx(b.rig, half[0].views, sub);
+    for (size_t c = 0; c < nc; ++c) {
+      out->cameras[c].holdout_rms_px =
+          std::sqrt(0.5 * (a_on_b[c] * a_on_b[c] + b_on_a[c] * b_on_a[c]));
+      const auto diff = ProjectionDifferencePx(a.rig.cameras[c].intrinsics,
+                                               b.rig.cameras[c].intrinsics);
+      out->cameras[c].half_diff_rms_px = diff.first;
+      out->cameras[c].half_diff_max_px = diff.second;
+    }
+  } catch (const InputError&) {
+    // Too few views in a half: cross-validation figures stay NaN.
+  }
+}
+
+}  // namespace
+
 CalibrationSummary CalibrateCameras(const CalibrationProblem& input,
                                     const CalibrationOptions& options) {
   const auto start = std::chrono::steady_clock::now();
@@ -699,85 +681,9 @@ CalibrationSummary CalibrateCameras(const CalibrationProblem& input,
   out.residual_sigma_px = std::sqrt(variance);
 
   if (options.compute_covariance && dof > 0) {
-    ceres::Covariance::Options copt;
-    copt.algorithm_type = ceres::DENSE_SVD;
-    copt.num_threads = 1;
-    ceres::Covariance covariance(copt);
-    std::vector<std::pair<const double*, const double*>> blocks;
-    for (size_t c = 0; c < nc; ++c) {
-      blocks.emplace_back(s.intrinsics[c].data(), s.intrinsics[c].data());
-    }
-    if (nc == 2) {
-      blocks.emplace_back(s.cam_from_rig[1].q.data(),
-                          s.cam_from_rig[1].q.data());
-      blocks.emplace_back(s.cam_from_rig[1].t.data(),
-                          s.cam_from_rig[1].t.data());
-    }
-    if (covariance.Compute(blocks, &problem)) {
-      for (size_t c = 0; c < nc; ++c) {
-        Eigen::Matrix<double, kNumIntrinsics, kNumIntrinsics, Eigen::RowMajor>
-            cov;
-        covariance.GetCovarianceBlock(s.intrinsics[c].data(),
-                                      s.intrinsics[c].data(), cov.data());
-        for (int i = 0; i < kNumIntrinsics; ++i) {
-          out.cameras[c].sigma.push_back(
-              std::sqrt(std::max(0.0, cov(i, i) * variance)));
-        }
-      }
-      if (nc == 2) {
-        Eigen::Matrix<double, 3, 3, Eigen::RowMajor> cov_r, cov_t;
-        covariance.GetCovarianceBlockInTangentSpace(s.cam_from_rig[1].q.data(),
-                                                    s.cam_from_rig[1].q.data(),
-                                                    cov_r.data());
-        covariance.GetCovarianceBlock(s.cam_from_rig[1].t.data(),
-                                      s.cam_from_rig[1].t.data(), cov_t.data());
-        // EigenQuaternionManifold's tangent is half the rotation vector.
-        for (int i = 0; i < 3; ++i) {
-          out.extrinsic_rotation_sigma_deg.push_back(
-              2.0 * std::sqrt(std::max(0.0, cov_r(i, i) * variance)) * 180.0 /
-              M_PI);
-          out.extrinsic_translation_sigma.push_back(
-              std::sqrt(std::max(0.0, cov_t(i, i) * variance)));
-        }
-        // baseline = |t| (camera centre distance = |R^T t| = |t|).
-        const Eigen::Vector3d t(s.cam_from_rig[1].t.data());
-        const Eigen::Vector3d u = t.normalized();
-        out.baseline_sigma = std::sqrt(u.dot(cov_t * u) * variance);
-      }
-    } else {
-      out.covariance_note =
-          "covariance not available: the Jacobian is rank deficient (the "
-          "views do not determine every parameter)";
-    }
+    AddCovariance(s, nc, variance, &problem, &out);
   }
-
-  if (options.cross_validate) {
-    // Even and odd views.
-    CalibrationProblem half[2];
-    for (int h = 0; h < 2; ++h) half[h].cameras = input.cameras;
-    for (size_t v = 0; v < nv; ++v) half[v % 2].views.push_back(input.views[v]);
-    CalibrationOptions sub = options;
-    sub.cross_validate = false;
-    sub.compute_covariance = false;
-    try {
-      const CalibrationSummary a = CalibrateCameras(half[0], sub);
-      const CalibrationSummary b = CalibrateCameras(half[1], sub);
-      const std::vector<double> a_on_b =
-          HeldOutRmsPx(a.rig, half[1].views, sub);
-      const std::vector<double> b_on_a =
-          HeldOutRmsPx(b.rig, half[0].views, sub);
-      for (size_t c = 0; c < nc; ++c) {
-        out.cameras[c].holdout_rms_px =
-            std::sqrt(0.5 * (a_on_b[c] * a_on_b[c] + b_on_a[c] * b_on_a[c]));
-        const auto diff = ProjectionDifferencePx(a.rig.cameras[c].intrinsics,
-                                                 b.rig.cameras[c].intrinsics);
-        out.cameras[c].half_diff_rms_px = diff.first;
-        out.cameras[c].half_diff_max_px = diff.second;
-      }
-    } catch (const InputError&) {
-      // Too few views in a half: cross-validation figures stay NaN.
-    }
-  }
+  if (options.cross_validate) CrossValidateHalves(input, options, &out);
   out.seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start)
           .count();

@@ -25,6 +25,8 @@
 #include <string>
 #include <vector>
 
+#include "data/rigid3.h"
+
 namespace kincal {
 
 // Layout of the parameter block that ProjectPoint reads and the calibration
@@ -82,28 +84,6 @@ struct CameraIntrinsics {
   }
 };
 
-// A rigid transform target_from_source: p_in_target = R * p_in_source + t
-// (t in mm at interfaces, or target units during calibration).
-struct Rigid3 {
-  Eigen::Matrix3d R = Eigen::Matrix3d::Identity();
-  Eigen::Vector3d t = Eigen::Vector3d::Zero();
-
-  Eigen::Vector3d operator*(const Eigen::Vector3d& p) const {
-    return R * p + t;
-  }
-  Rigid3 operator*(const Rigid3& b) const { return {R * b.R, R * b.t + t}; }
-  Rigid3 Inverse() const { return {R.transpose(), -(R.transpose() * t)}; }
-  Eigen::Isometry3d ToIsometry() const {
-    Eigen::Isometry3d iso = Eigen::Isometry3d::Identity();
-    iso.linear() = R;
-    iso.translation() = t;
-    return iso;
-  }
-  // From a 4x4 homogeneous transform (its top 3x4 block).
-  static Rigid3 FromMatrix(const Eigen::Matrix4d& m) {
-    return {m.block<3, 3>(0, 0), m.block<3, 1>(0, 3)};
-  }
-};
 using CameraPose = Rigid3;
 
 // Applies distortion to normalized coordinates (x, y) = (X/Z, Y/Z).

@@ -7,6 +7,7 @@
 #include "calib/chain.h"
 #include "calib/fit.h"
 #include "data/error.h"
+#include "data/rigid3.h"
 
 namespace kincal {
 namespace {
@@ -51,14 +52,7 @@ ConfirmResult ConfirmDesign(const Robot& robot, const PlanResult& plan,
   for (int rep = 0; rep < options.repetitions; ++rep) {
     ModelState truth;
     truth.chain = nominal;
-    const Eigen::AngleAxisd aa(plan.rig_from_base.R);
-    const Eigen::Vector3d w = aa.axis() * aa.angle();
-    truth.meas_from_base = {w.x(),
-                            w.y(),
-                            w.z(),
-                            plan.rig_from_base.t.x(),
-                            plan.rig_from_base.t.y(),
-                            plan.rig_from_base.t.z()};
+    truth.meas_from_base = PoseBlockFromRigid3(plan.rig_from_base);
     for (const ParamInfo& info : plan.params) {
       if (!IsRobot(info)) continue;
       const double sd = info.angle ? options.sigma_angle_deg * M_PI / 180

@@ -16,6 +16,7 @@
 #include "calib/identifiability.h"
 #include "data/error.h"
 #include "data/provenance.h"
+#include "data/rigid3.h"
 
 namespace kincal {
 namespace {
@@ -40,12 +41,6 @@ PoseInput MakeInput(const Chain& chain, const std::vector<double>& q) {
   in.s.assign(n, 0.0);
   in.tau.assign(n, 0.0);
   return in;
-}
-
-std::array<double, 6> FrameBlock(const Rigid3& r) {
-  const Eigen::AngleAxisd aa(r.R);
-  const Eigen::Vector3d w = aa.axis() * aa.angle();
-  return {w.x(), w.y(), w.z(), r.t.x(), r.t.y(), r.t.z()};
 }
 
 class Sampler {
@@ -407,7 +402,7 @@ Problem MakeProblem(const Robot& robot, const PlanResult& plan,
   pr.chain = Chain::FromRobot(robot);
   pr.state.chain = pr.chain;
   pr.fixed_point = options.fixed_point;
-  pr.state.meas_from_base = FrameBlock(plan.rig_from_base);
+  pr.state.meas_from_base = PoseBlockFromRigid3(plan.rig_from_base);
   if (options.fixed_point) {
     pr.state.point_labels = {"P"};
     const Eigen::Vector3d& p = plan.fixed_point_in_base;
@@ -487,8 +482,11 @@ DesignQuality PredictQuality(const Robot& robot, const PlanResult& plan,
   return q;
 }
 
-PlanResult PlanPoses(const Robot& robot, const PlanOptions& options) {
-  const auto start = std::chrono::steady_clock::now();
+namespace {
+
+// InputError for inputs plan cannot work with: joints without limits or
+// with empty ranges, too few poses or candidates, a rig without a target.
+void CheckPlanInputs(const Robot& robot, const PlanOptions& options) {
   for (const RobotRow& row : robot.joints) {
     if (!row.HasLimits()) {
       throw InputError("robot '" + robot.name + "': joint '" + row.name +
@@ -507,6 +505,64 @@ PlanResult PlanPoses(const Robot& robot, const PlanOptions& options) {
   if (options.candidates < options.n) {
     throw InputError("--candidates must be at least --n");
   }
+}
+
+// The fixed point: the tip of a feasible pose whose tip is nearest the
+// median of 200 feasible tips. Adds the draws it made to `*draws`.
+template <typename Visible>
+Eigen::Vector3d ChooseFixedPoint(const Chain& chain, const PlanOptions& options,
+                                 Sampler* sampler, const Visible& visible,
+                                 long* draws) {
+  Poses first;
+  while (static_cast<int>(first.size()) < 200 && *draws < options.max_draws) {
+    ++*draws;
+    std::vector<double> q = sampler->Draw();
+    if (visible(q)) first.push_back(q);
+  }
+  if (first.size() < 20) {
+    throw InputError("no feasible poses found in " + std::to_string(*draws) +
+                     " random draws: are the tags visible from the rig?");
+  }
+  std::vector<double> xs[3];
+  std::vector<Eigen::Vector3d> tips;
+  for (const auto& q : first) {
+    tips.push_back(BaseFromTip(chain, q).block<3, 1>(0, 3));
+    for (int k = 0; k < 3; ++k) xs[k].push_back(tips.back()[k]);
+  }
+  Eigen::Vector3d median;
+  for (int k = 0; k < 3; ++k) {
+    std::nth_element(xs[k].begin(), xs[k].begin() + xs[k].size() / 2,
+                     xs[k].end());
+    median[k] = xs[k][xs[k].size() / 2];
+  }
+  size_t best = 0;
+  for (size_t i = 0; i < tips.size(); ++i) {
+    if ((tips[i] - median).norm() < (tips[best] - median).norm()) best = i;
+  }
+  return tips[best];
+}
+
+// Geometric mean over the robot parameters of sigma / the robot's bound.
+double RobotSigmaGeometricMean(const Robot& robot,
+                               const std::vector<ParamInfo>& params,
+                               const std::vector<double>& sigma) {
+  double sum = 0;
+  int count = 0;
+  for (size_t k = 0; k < params.size(); ++k) {
+    if (!IsRobotParam(params[k])) continue;
+    const double bound =
+        params[k].angle ? robot.bound_angle_deg : robot.bound_length_mm;
+    sum += std::log(sigma[k] / bound);
+    ++count;
+  }
+  return std::exp(sum / std::max(1, count));
+}
+
+}  // namespace
+
+PlanResult PlanPoses(const Robot& robot, const PlanOptions& options) {
+  const auto start = std::chrono::steady_clock::now();
+  CheckPlanInputs(robot, options);
   PlanResult plan;
   const Chain chain = Chain::FromRobot(robot);
   Rigid3 tip_from_tool;
@@ -529,37 +585,8 @@ PlanResult PlanPoses(const Robot& robot, const PlanOptions& options) {
 
   Sampler sampler(robot, options.seed);
   if (options.fixed_point) {
-    // The point: the tip of a feasible pose whose tip is nearest the median
-    // of 200 feasible tips.
-    Poses first;
-    while (static_cast<int>(first.size()) < 200 &&
-           plan.draws < options.max_draws) {
-      ++plan.draws;
-      std::vector<double> q = sampler.Draw();
-      if (visible(q)) first.push_back(q);
-    }
-    if (first.size() < 20) {
-      throw InputError("no feasible poses found in " +
-                       std::to_string(plan.draws) +
-                       " random draws: are the tags visible from the rig?");
-    }
-    std::vector<double> xs[3];
-    std::vector<Eigen::Vector3d> tips;
-    for (const auto& q : first) {
-      tips.push_back(BaseFromTip(chain, q).block<3, 1>(0, 3));
-      for (int k = 0; k < 3; ++k) xs[k].push_back(tips.back()[k]);
-    }
-    Eigen::Vector3d median;
-    for (int k = 0; k < 3; ++k) {
-      std::nth_element(xs[k].begin(), xs[k].begin() + xs[k].size() / 2,
-                       xs[k].end());
-      median[k] = xs[k][xs[k].size() / 2];
-    }
-    size_t best = 0;
-    for (size_t i = 0; i < tips.size(); ++i) {
-      if ((tips[i] - median).norm() < (tips[best] - median).norm()) best = i;
-    }
-    plan.fixed_point_in_base = tips[best];
+    plan.fixed_point_in_base =
+        ChooseFixedPoint(chain, options, &sampler, visible, &plan.draws);
   }
   // Feasible poses from `s`: random draws (fixed point: random starts of the
   // inverse kinematics) that are within limits and visible.
@@ -650,20 +677,10 @@ PlanResult PlanPoses(const Robot& robot, const PlanOptions& options) {
 
   plan.planned = PredictQuality(robot, plan, plan.poses, options);
   plan.random = PredictQuality(robot, plan, plan.random_poses, options);
-  auto gmean = [&](const std::vector<double>& sigma) {
-    double sum = 0;
-    int count = 0;
-    for (int k = 0; k < p; ++k) {
-      if (!IsRobotParam(plan.params[k])) continue;
-      const double bound =
-          plan.params[k].angle ? robot.bound_angle_deg : robot.bound_length_mm;
-      sum += std::log(sigma[k] / bound);
-      ++count;
-    }
-    return std::exp(sum / std::max(1, count));
-  };
-  plan.planned_sigma_gmean = gmean(plan.planned.sigma);
-  plan.random_sigma_gmean = gmean(plan.random.sigma);
+  plan.planned_sigma_gmean =
+      RobotSigmaGeometricMean(robot, plan.params, plan.planned.sigma);
+  plan.random_sigma_gmean =
+      RobotSigmaGeometricMean(robot, plan.params, plan.random.sigma);
   plan.seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start)
           .count();

@@ -41,17 +41,11 @@ int RenderRecordedSession(const Rig& rig, const Target& target,
   std::mt19937_64 rng(seed);
   const std::string header =
       "# written by " + ToolVersion() + ": " + CommandLine() + "\n";
-  std::ostringstream frames, truth, corners;
+  std::ostringstream frames;
+  TruthTables tables(header, seed);
   frames << header << "frame,t_left,t_right,seq_left,seq_right";
   for (const std::string& j : input.joint_names) frames << "," << j;
   frames << "\n";
-  truth << header << "# seed " << seed
-        << "; rig_from_tool (R row-major, t mm), tip in rig (mm)\n"
-        << "frame,r00,r01,r02,r10,r11,r12,r20,r21,r22,tx,ty,tz,tip_x,tip_y,"
-           "tip_z\n";
-  corners << header
-          << "# tag corners in px (OpenCV pixel centres, libapriltag order)\n"
-          << "frame,camera,tag,corner,u,v,visible\n";
   const std::vector<int> png_params = {cv::IMWRITE_PNG_COMPRESSION, 1};
   for (size_t f = 0; f < n; ++f) {
     const StereoFrameTruth frame =
@@ -63,14 +57,6 @@ int RenderRecordedSession(const Rig& rig, const Target& target,
       cv::imencode(".png", frame.views[c].image, png, png_params);
       WriteFileAtomic(dir + (c == 0 ? "/left/" : "/right/") + name,
                       std::string(png.begin(), png.end()));
-      for (const TagTruth& t : frame.views[c].tags) {
-        for (int k = 0; k < 4; ++k) {
-          corners << f << "," << c << "," << t.id << "," << k << ","
-                  << FormatDouble(t.corners[k].x()) << ","
-                  << FormatDouble(t.corners[k].y()) << ","
-                  << (t.visible ? 1 : 0) << "\n";
-        }
-      }
     }
     const double t = input.t_s.size() == n ? input.t_s[f] : 0.1 * f;
     frames << f << "," << FormatDouble(t) << "," << FormatDouble(t) << "," << f
@@ -81,20 +67,10 @@ int RenderRecordedSession(const Rig& rig, const Target& target,
       if (has) frames << FormatDouble(input.joints[f].at(j));
     }
     frames << "\n";
-    truth << f;
-    for (int i = 0; i < 9; ++i) {
-      truth << "," << FormatDouble(frame.rig_from_tool.R(i / 3, i % 3));
-    }
-    for (int i = 0; i < 3; ++i) {
-      truth << "," << FormatDouble(frame.rig_from_tool.t(i));
-    }
-    for (int i = 0; i < 3; ++i) {
-      truth << "," << FormatDouble(frame.tip_in_rig(i));
-    }
-    truth << "\n";
+    tables.Add(f, frame, {"0", "1"});
   }
-  WriteFileAtomic(dir + "/truth.csv", truth.str());
-  WriteFileAtomic(dir + "/corners.csv", corners.str());
+  WriteFileAtomic(dir + "/truth.csv", tables.TruthCsv());
+  WriteFileAtomic(dir + "/corners.csv", tables.CornersCsv());
   WriteFileAtomic(dir + "/frames.csv", frames.str());
   std::ostringstream yaml;
   yaml << "# written by " << ToolVersion() << ": " << CommandLine() << "\n"

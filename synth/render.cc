@@ -8,6 +8,7 @@
 #include <limits>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
+#include <optional>
 #include <sstream>
 
 #include "data/atomic_file.h"
@@ -102,6 +103,315 @@ inline double SegmentDistance(const Eigen::Vector2d& p,
   return (p - (a + t * ab)).norm();
 }
 
+// The plane `p` as `camera` sees it, with the pixel box that can see it;
+// nothing when the plane is seen from behind or falls outside the image.
+std::optional<PlaneInCam> PlaneInCamera(const TexturedPlane& p,
+                                        const Camera& camera, int width,
+                                        int height) {
+  if (p.texture.empty() || p.texture.type() != CV_8UC1) {
+    throw InputError("render: a plane's texture is not an 8-bit gray image");
+  }
+  const CameraIntrinsics& K = camera.intrinsics;
+  const Rigid3 cam_from_plane = camera.cam_from_rig * p.rig_from_plane;
+  const Rigid3 plane_from_cam = cam_from_plane.Inverse();
+  if (plane_from_cam.t.z() >= 0) return std::nullopt;  // seen from behind
+  PlaneInCam pc;
+  pc.R = plane_from_cam.R;
+  pc.t = plane_from_cam.t;
+  pc.x0 = p.top_left_mm.x();
+  pc.y0 = p.top_left_mm.y();
+  pc.cols = p.texture.cols;
+  pc.rows = p.texture.rows;
+  pc.texel_w = p.size_mm.x() / pc.cols;
+  pc.texel_h = p.size_mm.y() / pc.rows;
+  pc.texture = &p.texture;
+  // Bounding box from points along the border (distortion bends edges).
+  double u0 = 1e18, v0 = 1e18, u1 = -1e18, v1 = -1e18;
+  bool behind = false;
+  const int n = 16;
+  for (int side = 0; side < 4 && !behind; ++side) {
+    for (int k = 0; k <= n; ++k) {
+      const double s = static_cast<double>(k) / n;
+      double x = 0, y = 0;
+      switch (side) {
+        case 0:
+          x = s;
+          y = 0;
+          break;
+        case 1:
+          x = 1;
+          y = s;
+          break;
+        case 2:
+          x = 1 - s;
+          y = 1;
+          break;
+        default:
+          x = 0;
+          y = 1 - s;
+          break;
+      }
+      const Eigen::Vector3d p_in_plane(pc.x0 + x * p.size_mm.x(),
+                                       pc.y0 + y * p.size_mm.y(), 0.0);
+      const Eigen::Vector3d p_in_cam = cam_from_plane * p_in_plane;
+      if (p_in_cam.z() <= 1e-6) {
+        behind = true;
+        break;
+      }
+      const Eigen::Vector2d uv = Project(K, p_in_cam);
+      u0 = std::min(u0, uv.x());
+      v0 = std::min(v0, uv.y());
+      u1 = std::max(u1, uv.x());
+      v1 = std::max(v1, uv.y());
+    }
+  }
+  if (behind) {
+    pc.bbox = cv::Rect(0, 0, width, height);
+    return pc;
+  }
+  const double margin = 3.0;
+  const double lo_u = std::max(u0 - margin, -1.0);
+  const double lo_v = std::max(v0 - margin, -1.0);
+  const double hi_u = std::min(u1 + margin, width + 1.0);
+  const double hi_v = std::min(v1 + margin, height + 1.0);
+  if (lo_u > hi_u || lo_v > hi_v) return std::nullopt;
+  pc.bbox = cv::Rect(cv::Point(static_cast<int>(std::floor(lo_u)),
+                               static_cast<int>(std::floor(lo_v))),
+                     cv::Point(static_cast<int>(std::ceil(hi_u)) + 1,
+                               static_cast<int>(std::ceil(hi_v)) + 1));
+  return pc;
+}
+
+// The label (plane and texel, or background) at every pixel corner: corner
+// (i, j) is pixel position (i - .5, j - .5), its ray in `corner_rays`.
+std::vector<int64_t> LabelCorners(const std::vector<PlaneInCam>& in_cam,
+                                  const std::vector<Eigen::Vector2d>& rays,
+                                  int width, int height) {
+  const int gw = width + 1;
+  std::vector<int64_t> labels(static_cast<size_t>(gw) * (height + 1),
+                              kBackground);
+  cv::parallel_for_(cv::Range(0, height + 1), [&](const cv::Range& range) {
+    std::vector<int> candidates;
+    for (int j = range.start; j < range.end; ++j) {
+      for (int i = 0; i <= width; ++i) {
+        candidates.clear();
+        for (size_t p = 0; p < in_cam.size(); ++p) {
+          const cv::Rect& b = in_cam[p].bbox;
+          if (i >= b.x && i <= b.x + b.width && j >= b.y &&
+              j <= b.y + b.height) {
+            candidates.push_back(static_cast<int>(p));
+          }
+        }
+        if (candidates.empty()) continue;
+        const Eigen::Vector2d& r = rays[static_cast<size_t>(j) * gw + i];
+        labels[static_cast<size_t>(j) * gw + i] =
+            Trace(in_cam, candidates, r.x(), r.y());
+      }
+    }
+  });
+  return labels;
+}
+
+// Pixel radiance: a pixel whose four corners agree takes that label's
+// value, the others the mean over the sample lattice.
+cv::Mat ShadePixels(const std::vector<PlaneInCam>& in_cam,
+                    const std::vector<int64_t>& labels,
+                    const std::vector<Eigen::Vector2d>& rays, int width,
+                    int height, const RenderOptions& options) {
+  const int gw = width + 1;
+  cv::Mat radiance(height, width, CV_64FC1);
+  const SampleLattice& lat = Lattice();
+  cv::parallel_for_(cv::Range(0, height), [&](const cv::Range& range) {
+    std::vector<int> candidates;
+    for (int y = range.start; y < range.end; ++y) {
+      double* row = radiance.ptr<double>(y);
+      for (int x = 0; x < width; ++x) {
+        const size_t c00 = static_cast<size_t>(y) * gw + x;
+        const int64_t l00 = labels[c00], l10 = labels[c00 + 1];
+        const int64_t l01 = labels[c00 + gw], l11 = labels[c00 + gw + 1];
+        if (l00 == l10 && l00 == l01 && l00 == l11) {
+          row[x] = Radiance(in_cam, l00, options);
+          continue;
+        }
+        candidates.clear();
+        for (size_t p = 0; p < in_cam.size(); ++p) {
+          const cv::Rect& b = in_cam[p].bbox;
+          if (x + 1 >= b.x && x <= b.x + b.width && y + 1 >= b.y &&
+              y <= b.y + b.height) {
+            candidates.push_back(static_cast<int>(p));
+          }
+        }
+        const Eigen::Vector2d& r00 = rays[c00];
+        const Eigen::Vector2d& r10 = rays[c00 + 1];
+        const Eigen::Vector2d& r01 = rays[c00 + gw];
+        const Eigen::Vector2d& r11 = rays[c00 + gw + 1];
+        double sum = 0;
+        for (int k = 0; k < kNumSamples; ++k) {
+          const double sx = lat.x[k], sy = lat.y[k];
+          const Eigen::Vector2d r = (1 - sy) * ((1 - sx) * r00 + sx * r10) +
+                                    sy * ((1 - sx) * r01 + sx * r11);
+          sum += Radiance(in_cam, Trace(in_cam, candidates, r.x(), r.y()),
+                          options);
+        }
+        row[x] = sum / kNumSamples;
+      }
+    }
+  });
+  return radiance;
+}
+
+// Paints a needle over `radiance`: the coverage of a thick polyline along
+// the projected cylinder axis, blended to the needle's gray.
+void DrawNeedle(const Needle& needle, const Camera& camera, cv::Mat* radiance) {
+  const CameraIntrinsics& K = camera.intrinsics;
+  const int width = radiance->cols, height = radiance->rows;
+  const SampleLattice& lat = Lattice();
+  const Eigen::Vector3d a = camera.cam_from_rig * needle.base_in_rig;
+  const Eigen::Vector3d b = camera.cam_from_rig * needle.tip_in_rig;
+  const int m = 48;
+  std::vector<Eigen::Vector2d> pts;
+  std::vector<double> half_width;
+  for (int k = 0; k <= m; ++k) {
+    const Eigen::Vector3d p = a + (b - a) * (static_cast<double>(k) / m);
+    if (p.z() <= 1e-3) continue;
+    pts.push_back(Project(K, p));
+    half_width.push_back(needle.radius_mm * K.fx / p.z());
+  }
+  cv::Mat coverage(height, width, CV_64FC1, cv::Scalar(0));
+  for (size_t k = 0; k + 1 < pts.size(); ++k) {
+    const double w = std::max(half_width[k], half_width[k + 1]);
+    const int x0 = std::max(
+        0, static_cast<int>(
+               std::floor(std::min(pts[k].x(), pts[k + 1].x()) - w - 1)));
+    const int y0 = std::max(
+        0, static_cast<int>(
+               std::floor(std::min(pts[k].y(), pts[k + 1].y()) - w - 1)));
+    const int x1 =
+        std::min(width - 1, static_cast<int>(std::ceil(
+                                std::max(pts[k].x(), pts[k + 1].x()) + w + 1)));
+    const int y1 = std::min(height - 1,
+                            static_cast<int>(std::ceil(
+                                std::max(pts[k].y(), pts[k + 1].y()) + w + 1)));
+    for (int y = y0; y <= y1; ++y) {
+      for (int x = x0; x <= x1; ++x) {
+        int inside = 0;
+        for (int s = 0; s < kNumSamples; ++s) {
+          const Eigen::Vector2d p(x - 0.5 + lat.x[s], y - 0.5 + lat.y[s]);
+          double t;
+          const double d = SegmentDistance(p, pts[k], pts[k + 1], &t);
+          const double hw = (1 - t) * half_width[k] + t * half_width[k + 1];
+          if (d < hw) ++inside;
+        }
+        double& c = coverage.at<double>(y, x);
+        c = std::max(c, static_cast<double>(inside) / kNumSamples);
+      }
+    }
+  }
+  *radiance = radiance->mul(1.0 - coverage) + coverage * needle.gray;
+}
+
+// Disk of radius `radius_px`, anti-aliased by 8x8 supersampling per kernel
+// cell, normalised to sum 1.
+cv::Mat DefocusKernel(double radius_px) {
+  const double R = radius_px;
+  const int h = static_cast<int>(std::ceil(R));
+  cv::Mat k(2 * h + 1, 2 * h + 1, CV_64FC1, cv::Scalar(0));
+  for (int y = -h; y <= h; ++y) {
+    for (int x = -h; x <= h; ++x) {
+      int in = 0;
+      for (int sy = 0; sy < 8; ++sy) {
+        for (int sx = 0; sx < 8; ++sx) {
+          const double px = x - 0.5 + (sx + 0.5) / 8;
+          const double py = y - 0.5 + (sy + 0.5) / 8;
+          in += px * px + py * py <= R * R ? 1 : 0;
+        }
+      }
+      k.at<double>(y + h, x + h) = in;
+    }
+  }
+  k /= cv::sum(k)[0];
+  return k;
+}
+
+// A line segment of length `length_px` at `angle_deg` (box profile), drawn
+// with 32 bilinear samples per px, normalised to sum 1.
+cv::Mat MotionKernel(double length_px, double angle_deg) {
+  const double L = length_px;
+  const double a = angle_deg * M_PI / 180.0;
+  const int h = static_cast<int>(std::ceil(L / 2)) + 1;
+  cv::Mat k(2 * h + 1, 2 * h + 1, CV_64FC1, cv::Scalar(0));
+  const int n = std::max(2, static_cast<int>(32 * L));
+  for (int i = 0; i < n; ++i) {
+    const double t = (i + 0.5) / n - 0.5;
+    const double x = t * L * std::cos(a) + h, y = t * L * std::sin(a) + h;
+    const int x0 = static_cast<int>(std::floor(x)),
+              y0 = static_cast<int>(std::floor(y));
+    const double fx = x - x0, fy = y - y0;
+    k.at<double>(y0, x0) += (1 - fx) * (1 - fy);
+    k.at<double>(y0, x0 + 1) += fx * (1 - fy);
+    k.at<double>(y0 + 1, x0) += (1 - fx) * fy;
+    k.at<double>(y0 + 1, x0 + 1) += fx * fy;
+  }
+  k /= cv::sum(k)[0];
+  return k;
+}
+
+// Exposure (gain jitter, vignetting, light gradient), optics (defocus,
+// motion, Gaussian blur) and sensor (noise, 8-bit rounding, JPEG) applied
+// to the scene radiance.
+cv::Mat ExposeAndRecord(cv::Mat radiance, const RenderOptions& options,
+                        std::mt19937_64* rng) {
+  const int width = radiance.cols, height = radiance.rows;
+  double gain = 1.0;
+  if (options.exposure_jitter > 0) {
+    std::normal_distribution<double> g(1.0, options.exposure_jitter);
+    gain = std::clamp(g(*rng), 0.5, 1.5);
+  }
+  radiance *= gain;
+  if (options.vignetting > 0 || options.light_gradient != 0) {
+    const double cx = 0.5 * (width - 1), cy = 0.5 * (height - 1);
+    const double r2max = cx * cx + cy * cy;
+    for (int y = 0; y < height; ++y) {
+      double* row = radiance.ptr<double>(y);
+      for (int x = 0; x < width; ++x) {
+        const double r2 = (x - cx) * (x - cx) + (y - cy) * (y - cy);
+        row[x] *= (1.0 - options.vignetting * r2 / r2max) *
+                  (1.0 + options.light_gradient *
+                             (static_cast<double>(x) / width - 0.5));
+      }
+    }
+  }
+  if (options.defocus_px > 0) {
+    cv::filter2D(radiance, radiance, -1, DefocusKernel(options.defocus_px),
+                 cv::Point(-1, -1), 0, cv::BORDER_REPLICATE);
+  }
+  if (options.motion_px > 0) {
+    cv::filter2D(radiance, radiance, -1,
+                 MotionKernel(options.motion_px, options.motion_angle_deg),
+                 cv::Point(-1, -1), 0, cv::BORDER_REPLICATE);
+  }
+  if (options.blur_sigma_px > 0) {
+    cv::GaussianBlur(radiance, radiance, cv::Size(0, 0), options.blur_sigma_px,
+                     options.blur_sigma_px, cv::BORDER_REPLICATE);
+  }
+  if (options.noise_sigma > 0) {
+    std::normal_distribution<double> noise(0.0, options.noise_sigma);
+    for (int y = 0; y < height; ++y) {
+      double* row = radiance.ptr<double>(y);
+      for (int x = 0; x < width; ++x) row[x] += noise(*rng);
+    }
+  }
+  cv::Mat out;
+  radiance.convertTo(out, CV_8UC1);  // rounds and saturates
+  if (options.jpeg_quality > 0) {
+    std::vector<uchar> buf;
+    cv::imencode(".jpg", out, buf,
+                 {cv::IMWRITE_JPEG_QUALITY, options.jpeg_quality});
+    out = cv::imdecode(buf, cv::IMREAD_GRAYSCALE);
+  }
+  return out;
+}
+
 }  // namespace
 
 void RenderOptions::Check() const {
@@ -182,279 +492,17 @@ cv::Mat ViewRenderer::Render(const std::vector<TexturedPlane>& planes,
                              const RenderOptions& options,
                              std::mt19937_64* rng) const {
   options.Check();
-  const CameraIntrinsics& K = camera_.intrinsics;
-  const cv::Rect image_rect(0, 0, width_, height_);
-  // Planes in this camera, with the pixels that can see them.
   std::vector<PlaneInCam> in_cam;
   for (const TexturedPlane& p : planes) {
-    if (p.texture.empty() || p.texture.type() != CV_8UC1) {
-      throw InputError("render: a plane's texture is not an 8-bit gray image");
-    }
-    const Rigid3 cam_from_plane = camera_.cam_from_rig * p.rig_from_plane;
-    const Rigid3 plane_from_cam = cam_from_plane.Inverse();
-    if (plane_from_cam.t.z() >= 0) continue;  // seen from behind
-    PlaneInCam pc;
-    pc.R = plane_from_cam.R;
-    pc.t = plane_from_cam.t;
-    pc.x0 = p.top_left_mm.x();
-    pc.y0 = p.top_left_mm.y();
-    pc.cols = p.texture.cols;
-    pc.rows = p.texture.rows;
-    pc.texel_w = p.size_mm.x() / pc.cols;
-    pc.texel_h = p.size_mm.y() / pc.rows;
-    pc.texture = &p.texture;
-    // Bounding box from points along the border (distortion bends edges).
-    double u0 = 1e18, v0 = 1e18, u1 = -1e18, v1 = -1e18;
-    bool behind = false;
-    const int n = 16;
-    for (int side = 0; side < 4 && !behind; ++side) {
-      for (int k = 0; k <= n; ++k) {
-        const double s = static_cast<double>(k) / n;
-        double x = 0, y = 0;
-        switch (side) {
-          case 0:
-            x = s;
-            y = 0;
-            break;
-          case 1:
-            x = 1;
-            y = s;
-            break;
-          case 2:
-            x = 1 - s;
-            y = 1;
-            break;
-          default:
-            x = 0;
-            y = 1 - s;
-            break;
-        }
-        const Eigen::Vector3d p_in_plane(pc.x0 + x * p.size_mm.x(),
-                                         pc.y0 + y * p.size_mm.y(), 0.0);
-        const Eigen::Vector3d p_in_cam = cam_from_plane * p_in_plane;
-        if (p_in_cam.z() <= 1e-6) {
-          behind = true;
-          break;
-        }
-        const Eigen::Vector2d uv = Project(K, p_in_cam);
-        u0 = std::min(u0, uv.x());
-        v0 = std::min(v0, uv.y());
-        u1 = std::max(u1, uv.x());
-        v1 = std::max(v1, uv.y());
-      }
-    }
-    if (behind) {
-      pc.bbox = image_rect;
-    } else {
-      const double margin = 3.0;
-      const double lo_u = std::max(u0 - margin, -1.0);
-      const double lo_v = std::max(v0 - margin, -1.0);
-      const double hi_u = std::min(u1 + margin, width_ + 1.0);
-      const double hi_v = std::min(v1 + margin, height_ + 1.0);
-      if (lo_u > hi_u || lo_v > hi_v) continue;
-      pc.bbox = cv::Rect(cv::Point(static_cast<int>(std::floor(lo_u)),
-                                   static_cast<int>(std::floor(lo_v))),
-                         cv::Point(static_cast<int>(std::ceil(hi_u)) + 1,
-                                   static_cast<int>(std::ceil(hi_v)) + 1));
-    }
-    in_cam.push_back(pc);
+    std::optional<PlaneInCam> pc = PlaneInCamera(p, camera_, width_, height_);
+    if (pc) in_cam.push_back(*pc);
   }
-
-  // Labels at pixel corners: corner (i, j) is pixel position (i-.5, j-.5).
-  const int gw = width_ + 1;
-  std::vector<int64_t> labels(static_cast<size_t>(gw) * (height_ + 1),
-                              kBackground);
-  cv::parallel_for_(cv::Range(0, height_ + 1), [&](const cv::Range& range) {
-    std::vector<int> candidates;
-    for (int j = range.start; j < range.end; ++j) {
-      for (int i = 0; i <= width_; ++i) {
-        candidates.clear();
-        for (size_t p = 0; p < in_cam.size(); ++p) {
-          const cv::Rect& b = in_cam[p].bbox;
-          if (i >= b.x && i <= b.x + b.width && j >= b.y &&
-              j <= b.y + b.height) {
-            candidates.push_back(static_cast<int>(p));
-          }
-        }
-        if (candidates.empty()) continue;
-        const Eigen::Vector2d& r =
-            corner_rays_[static_cast<size_t>(j) * gw + i];
-        labels[static_cast<size_t>(j) * gw + i] =
-            Trace(in_cam, candidates, r.x(), r.y());
-      }
-    }
-  });
-
-  // Pixel values: uniform pixels directly, the others by supersampling.
-  cv::Mat radiance(height_, width_, CV_64FC1);
-  const SampleLattice& lat = Lattice();
-  cv::parallel_for_(cv::Range(0, height_), [&](const cv::Range& range) {
-    std::vector<int> candidates;
-    for (int y = range.start; y < range.end; ++y) {
-      double* row = radiance.ptr<double>(y);
-      for (int x = 0; x < width_; ++x) {
-        const size_t c00 = static_cast<size_t>(y) * gw + x;
-        const int64_t l00 = labels[c00], l10 = labels[c00 + 1];
-        const int64_t l01 = labels[c00 + gw], l11 = labels[c00 + gw + 1];
-        if (l00 == l10 && l00 == l01 && l00 == l11) {
-          row[x] = Radiance(in_cam, l00, options);
-          continue;
-        }
-        candidates.clear();
-        for (size_t p = 0; p < in_cam.size(); ++p) {
-          const cv::Rect& b = in_cam[p].bbox;
-          if (x + 1 >= b.x && x <= b.x + b.width && y + 1 >= b.y &&
-              y <= b.y + b.height) {
-            candidates.push_back(static_cast<int>(p));
-          }
-        }
-        const Eigen::Vector2d& r00 = corner_rays_[c00];
-        const Eigen::Vector2d& r10 = corner_rays_[c00 + 1];
-        const Eigen::Vector2d& r01 = corner_rays_[c00 + gw];
-        const Eigen::Vector2d& r11 = corner_rays_[c00 + gw + 1];
-        double sum = 0;
-        for (int k = 0; k < kNumSamples; ++k) {
-          const double sx = lat.x[k], sy = lat.y[k];
-          const Eigen::Vector2d r = (1 - sy) * ((1 - sx) * r00 + sx * r10) +
-                                    sy * ((1 - sx) * r01 + sx * r11);
-          sum += Radiance(in_cam, Trace(in_cam, candidates, r.x(), r.y()),
-                          options);
-        }
-        row[x] = sum / kNumSamples;
-      }
-    }
-  });
-
-  // Needles: coverage of a thick polyline (projected cylinder axis).
-  for (const Needle& needle : needles) {
-    const Eigen::Vector3d a = camera_.cam_from_rig * needle.base_in_rig;
-    const Eigen::Vector3d b = camera_.cam_from_rig * needle.tip_in_rig;
-    const int m = 48;
-    std::vector<Eigen::Vector2d> pts;
-    std::vector<double> half_width;
-    for (int k = 0; k <= m; ++k) {
-      const Eigen::Vector3d p = a + (b - a) * (static_cast<double>(k) / m);
-      if (p.z() <= 1e-3) continue;
-      pts.push_back(Project(K, p));
-      half_width.push_back(needle.radius_mm * K.fx / p.z());
-    }
-    cv::Mat coverage(height_, width_, CV_64FC1, cv::Scalar(0));
-    for (size_t k = 0; k + 1 < pts.size(); ++k) {
-      const double w = std::max(half_width[k], half_width[k + 1]);
-      const int x0 = std::max(
-          0, static_cast<int>(
-                 std::floor(std::min(pts[k].x(), pts[k + 1].x()) - w - 1)));
-      const int y0 = std::max(
-          0, static_cast<int>(
-                 std::floor(std::min(pts[k].y(), pts[k + 1].y()) - w - 1)));
-      const int x1 = std::min(
-          width_ - 1, static_cast<int>(std::ceil(
-                          std::max(pts[k].x(), pts[k + 1].x()) + w + 1)));
-      const int y1 = std::min(
-          height_ - 1, static_cast<int>(std::ceil(
-                           std::max(pts[k].y(), pts[k + 1].y()) + w + 1)));
-      for (int y = y0; y <= y1; ++y) {
-        for (int x = x0; x <= x1; ++x) {
-          int inside = 0;
-          for (int s = 0; s < kNumSamples; ++s) {
-            const Eigen::Vector2d p(x - 0.5 + lat.x[s], y - 0.5 + lat.y[s]);
-            double t;
-            const double d = SegmentDistance(p, pts[k], pts[k + 1], &t);
-            const double hw = (1 - t) * half_width[k] + t * half_width[k + 1];
-            if (d < hw) ++inside;
-          }
-          double& c = coverage.at<double>(y, x);
-          c = std::max(c, static_cast<double>(inside) / kNumSamples);
-        }
-      }
-    }
-    radiance = radiance.mul(1.0 - coverage) + coverage * needle.gray;
-  }
-
-  // Exposure, optics, sensor.
-  double gain = 1.0;
-  if (options.exposure_jitter > 0) {
-    std::normal_distribution<double> g(1.0, options.exposure_jitter);
-    gain = std::clamp(g(*rng), 0.5, 1.5);
-  }
-  radiance *= gain;
-  if (options.vignetting > 0 || options.light_gradient != 0) {
-    const double cx = 0.5 * (width_ - 1), cy = 0.5 * (height_ - 1);
-    const double r2max = cx * cx + cy * cy;
-    for (int y = 0; y < height_; ++y) {
-      double* row = radiance.ptr<double>(y);
-      for (int x = 0; x < width_; ++x) {
-        const double r2 = (x - cx) * (x - cx) + (y - cy) * (y - cy);
-        row[x] *= (1.0 - options.vignetting * r2 / r2max) *
-                  (1.0 + options.light_gradient *
-                             (static_cast<double>(x) / width_ - 0.5));
-      }
-    }
-  }
-  if (options.defocus_px > 0) {
-    // Disk of radius R, anti-aliased by 8x8 supersampling per kernel cell.
-    const double R = options.defocus_px;
-    const int h = static_cast<int>(std::ceil(R));
-    cv::Mat k(2 * h + 1, 2 * h + 1, CV_64FC1, cv::Scalar(0));
-    for (int y = -h; y <= h; ++y) {
-      for (int x = -h; x <= h; ++x) {
-        int in = 0;
-        for (int sy = 0; sy < 8; ++sy) {
-          for (int sx = 0; sx < 8; ++sx) {
-            const double px = x - 0.5 + (sx + 0.5) / 8;
-            const double py = y - 0.5 + (sy + 0.5) / 8;
-            in += px * px + py * py <= R * R ? 1 : 0;
-          }
-        }
-        k.at<double>(y + h, x + h) = in;
-      }
-    }
-    k /= cv::sum(k)[0];
-    cv::filter2D(radiance, radiance, -1, k, cv::Point(-1, -1), 0,
-                 cv::BORDER_REPLICATE);
-  }
-  if (options.motion_px > 0) {
-    // A line segment of length L (box profile), drawn with 32 samples per px.
-    const double L = options.motion_px;
-    const double a = options.motion_angle_deg * M_PI / 180.0;
-    const int h = static_cast<int>(std::ceil(L / 2)) + 1;
-    cv::Mat k(2 * h + 1, 2 * h + 1, CV_64FC1, cv::Scalar(0));
-    const int n = std::max(2, static_cast<int>(32 * L));
-    for (int i = 0; i < n; ++i) {
-      const double t = (i + 0.5) / n - 0.5;
-      const double x = t * L * std::cos(a) + h, y = t * L * std::sin(a) + h;
-      const int x0 = static_cast<int>(std::floor(x)),
-                y0 = static_cast<int>(std::floor(y));
-      const double fx = x - x0, fy = y - y0;
-      k.at<double>(y0, x0) += (1 - fx) * (1 - fy);
-      k.at<double>(y0, x0 + 1) += fx * (1 - fy);
-      k.at<double>(y0 + 1, x0) += (1 - fx) * fy;
-      k.at<double>(y0 + 1, x0 + 1) += fx * fy;
-    }
-    k /= cv::sum(k)[0];
-    cv::filter2D(radiance, radiance, -1, k, cv::Point(-1, -1), 0,
-                 cv::BORDER_REPLICATE);
-  }
-  if (options.blur_sigma_px > 0) {
-    cv::GaussianBlur(radiance, radiance, cv::Size(0, 0), options.blur_sigma_px,
-                     options.blur_sigma_px, cv::BORDER_REPLICATE);
-  }
-  if (options.noise_sigma > 0) {
-    std::normal_distribution<double> noise(0.0, options.noise_sigma);
-    for (int y = 0; y < height_; ++y) {
-      double* row = radiance.ptr<double>(y);
-      for (int x = 0; x < width_; ++x) row[x] += noise(*rng);
-    }
-  }
-  cv::Mat out;
-  radiance.convertTo(out, CV_8UC1);  // rounds and saturates
-  if (options.jpeg_quality > 0) {
-    std::vector<uchar> buf;
-    cv::imencode(".jpg", out, buf,
-                 {cv::IMWRITE_JPEG_QUALITY, options.jpeg_quality});
-    out = cv::imdecode(buf, cv::IMREAD_GRAYSCALE);
-  }
-  return out;
+  const std::vector<int64_t> labels =
+      LabelCorners(in_cam, corner_rays_, width_, height_);
+  cv::Mat radiance =
+      ShadePixels(in_cam, labels, corner_rays_, width_, height_, options);
+  for (const Needle& needle : needles) DrawNeedle(needle, camera_, &radiance);
+  return ExposeAndRecord(radiance, options, rng);
 }
 
 std::vector<TagTruth> ProjectTargetCorners(const Camera& camera,
@@ -516,6 +564,41 @@ StereoFrameTruth StereoRenderer::Render(const Rigid3& rig_from_tool,
   return frame;
 }
 
+TruthTables::TruthTables(const std::string& header, uint64_t seed) {
+  truth_ << header << "# seed " << seed
+         << "; rig_from_tool (R row-major, t mm), tip in rig (mm)\n"
+         << "frame,r00,r01,r02,r10,r11,r12,r20,r21,r22,tx,ty,tz,tip_x,tip_y,"
+            "tip_z\n";
+  corners_ << header
+           << "# tag corners in px (OpenCV pixel centres, libapriltag order)\n"
+           << "frame,camera,tag,corner,u,v,visible\n";
+}
+
+void TruthTables::Add(size_t frame_index, const StereoFrameTruth& frame,
+                      const std::vector<std::string>& camera_labels) {
+  for (size_t c = 0; c < frame.views.size(); ++c) {
+    for (const TagTruth& t : frame.views[c].tags) {
+      for (int k = 0; k < 4; ++k) {
+        corners_ << frame_index << "," << camera_labels.at(c) << "," << t.id
+                 << "," << k << "," << FormatDouble(t.corners[k].x()) << ","
+                 << FormatDouble(t.corners[k].y()) << "," << (t.visible ? 1 : 0)
+                 << "\n";
+      }
+    }
+  }
+  truth_ << frame_index;
+  for (int i = 0; i < 9; ++i) {
+    truth_ << "," << FormatDouble(frame.rig_from_tool.R(i / 3, i % 3));
+  }
+  for (int i = 0; i < 3; ++i) {
+    truth_ << "," << FormatDouble(frame.rig_from_tool.t(i));
+  }
+  for (int i = 0; i < 3; ++i) {
+    truth_ << "," << FormatDouble(frame.tip_in_rig(i));
+  }
+  truth_ << "\n";
+}
+
 namespace {
 std::string CameraLabel(const Rig& rig, size_t c) {
   const std::string& name = rig.cameras[c].intrinsics.name;
@@ -536,16 +619,12 @@ int RenderSession(const Rig& rig, const Target& target,
   }
   StereoRenderer renderer(rig, target, options);
   std::mt19937_64 rng(seed);
-  std::ostringstream truth, corners;
-  const std::string header =
-      "# written by " + ToolVersion() + ": " + CommandLine() + "\n";
-  truth << header << "# seed " << seed
-        << "; rig_from_tool (R row-major, t mm), tip in rig (mm)\n"
-        << "frame,r00,r01,r02,r10,r11,r12,r20,r21,r22,tx,ty,tz,tip_x,tip_y,"
-           "tip_z\n";
-  corners << header
-          << "# tag corners in px (OpenCV pixel centres, libapriltag order)\n"
-          << "frame,camera,tag,corner,u,v,visible\n";
+  std::vector<std::string> labels;
+  for (size_t c = 0; c < rig.cameras.size(); ++c) {
+    labels.push_back(CameraLabel(rig, c));
+  }
+  TruthTables tables(
+      "# written by " + ToolVersion() + ": " + CommandLine() + "\n", seed);
   for (size_t f = 0; f < rig_from_tool.size(); ++f) {
     const StereoFrameTruth frame = renderer.Render(rig_from_tool[f], &rng);
     char index[32];
@@ -553,30 +632,13 @@ int RenderSession(const Rig& rig, const Target& target,
     for (size_t c = 0; c < frame.views.size(); ++c) {
       std::vector<uchar> png;
       cv::imencode(".png", frame.views[c].image, png);
-      WriteFileAtomic(folder + "/" + CameraLabel(rig, c) + "_" + index + ".png",
+      WriteFileAtomic(folder + "/" + labels[c] + "_" + index + ".png",
                       std::string(png.begin(), png.end()));
-      for (const TagTruth& t : frame.views[c].tags) {
-        for (int k = 0; k < 4; ++k) {
-          corners << f << "," << CameraLabel(rig, c) << "," << t.id << "," << k
-                  << "," << FormatDouble(t.corners[k].x()) << ","
-                  << FormatDouble(t.corners[k].y()) << ","
-                  << (t.visible ? 1 : 0) << "\n";
-        }
-      }
     }
-    truth << f;
-    for (int i = 0; i < 9; ++i) {
-      truth << "," << FormatDouble(frame.rig_from_tool.R(i / 3, i % 3));
-    }
-    for (int i = 0; i < 3; ++i) {
-      truth << "," << FormatDouble(frame.rig_from_tool.t(i));
-    }
-    for (int i = 0; i < 3; ++i)
-      truth << "," << FormatDouble(frame.tip_in_rig(i));
-    truth << "\n";
+    tables.Add(f, frame, labels);
   }
-  WriteFileAtomic(folder + "/truth.csv", truth.str());
-  WriteFileAtomic(folder + "/corners.csv", corners.str());
+  WriteFileAtomic(folder + "/truth.csv", tables.TruthCsv());
+  WriteFileAtomic(folder + "/corners.csv", tables.CornersCsv());
   WriteRigYaml(folder + "/rig.yaml", rig);
   WriteTargetYaml(folder + "/target.yaml", target);
   return static_cast<int>(rig_from_tool.size());

@@ -18,6 +18,7 @@
 #include <Eigen/Core>
 #include <opencv2/core.hpp>
 #include <random>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -144,6 +145,24 @@ class StereoRenderer {
   Target target_;
   RenderOptions options_;
   std::vector<ViewRenderer> views_;
+};
+
+// The truth.csv and corners.csv tables of rendered frames (the layout below
+// and in synth/recorded_session.h), for every writer of rendered sessions.
+class TruthTables {
+ public:
+  // `header`: the comment line(s) that open both files ("# written by ...").
+  // `seed`: the render noise seed, recorded in truth.csv.
+  TruthTables(const std::string& header, uint64_t seed);
+  // Frame `frame_index`: its rig_from_tool and tip (truth.csv), and the tag
+  // corners of every view, view c under `camera_labels[c]` (corners.csv).
+  void Add(size_t frame_index, const StereoFrameTruth& frame,
+           const std::vector<std::string>& camera_labels);
+  std::string TruthCsv() const { return truth_.str(); }
+  std::string CornersCsv() const { return corners_.str(); }
+
+ private:
+  std::ostringstream truth_, corners_;
 };
 
 // Renders a whole session into `folder` (created if missing):

@@ -3,4 +3,4 @@
 # JPEG, tagStandard41h12) against plain libapriltag corners.
 kincal_test(e2e_track_render_test
   SOURCES ${CMAKE_CURRENT_LIST_DIR}/track_render_test.cc
-  DEPS kincal_bundle kincal_vision kincal_synth)
+  DEPS kincal_bundle_synthetic kincal_bundle kincal_vision kincal_synth)

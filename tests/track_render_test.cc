@@ -14,7 +14,7 @@
 #include <cstdio>
 #include <random>
 
-#include "bundle/synthetic.h"
+#include "bundle/testing/synthetic.h"
 #include "synth/render.h"
 #include "vision/apriltag_detector.h"
 #include "vision/tool_pose.h"

@@ -11,65 +11,13 @@
 #include <opencv2/core/eigen.hpp>
 #include <sstream>
 
+#include "camcal/cost_functions.h"
 #include "data/error.h"
 #include "vision/triangulate.h"
 
 namespace kincal {
 
 namespace {
-
-// Reprojection of one tag corner of the tool into one camera:
-//   r = pi(K, cam_from_rig * (rig_from_tool * p_in_tool)) - px_measured
-// with rig_from_tool = (q, t), q a unit quaternion in Ceres' order
-// (w, x, y, z; ceres::QuaternionManifold), t in mm. Returns false (no
-// exception) when the point is behind the camera.
-class ToolCornerReprojectionCost {
- public:
-  ToolCornerReprojectionCost(const Eigen::Vector2d& px_measured,
-                             const Eigen::Vector3d& p_in_tool,
-                             const Camera& camera)
-      : px_measured_(px_measured),
-        p_in_tool_(p_in_tool),
-        intrinsics_(camera.intrinsics.ToArray()),
-        cam_from_rig_(camera.cam_from_rig) {}
-
-  template <typename T>
-  bool operator()(const T* rig_from_tool_q, const T* rig_from_tool_t,
-                  T* residuals) const {
-    const T p_in_tool[3] = {T(p_in_tool_.x()), T(p_in_tool_.y()),
-                            T(p_in_tool_.z())};
-    T p_in_rig[3];
-    ceres::UnitQuaternionRotatePoint(rig_from_tool_q, p_in_tool, p_in_rig);
-    for (int i = 0; i < 3; ++i) p_in_rig[i] += rig_from_tool_t[i];
-    T p_in_cam[3];
-    for (int i = 0; i < 3; ++i) {
-      p_in_cam[i] = T(cam_from_rig_.t(i));
-      for (int j = 0; j < 3; ++j) {
-        p_in_cam[i] += T(cam_from_rig_.R(i, j)) * p_in_rig[j];
-      }
-    }
-    T intrinsics[kNumIntrinsics];
-    for (int i = 0; i < kNumIntrinsics; ++i) intrinsics[i] = T(intrinsics_[i]);
-    T px[2];
-    if (!ProjectPoint(intrinsics, p_in_cam, px)) return false;
-    residuals[0] = px[0] - T(px_measured_.x());
-    residuals[1] = px[1] - T(px_measured_.y());
-    return true;
-  }
-
-  static ceres::CostFunction* Create(const Eigen::Vector2d& px_measured,
-                                     const Eigen::Vector3d& p_in_tool,
-                                     const Camera& camera) {
-    return new ceres::AutoDiffCostFunction<ToolCornerReprojectionCost, 2, 4, 3>(
-        new ToolCornerReprojectionCost(px_measured, p_in_tool, camera));
-  }
-
- private:
-  const Eigen::Vector2d px_measured_;
-  const Eigen::Vector3d p_in_tool_;
-  const std::array<double, kNumIntrinsics> intrinsics_;
-  const Rigid3 cam_from_rig_;
-};
 
 // One tag seen by one camera, with its target placement.
 struct TagObs {

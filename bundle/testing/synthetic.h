@@ -1,5 +1,5 @@
-#ifndef KINCAL_BUNDLE_SYNTHETIC_H_
-#define KINCAL_BUNDLE_SYNTHETIC_H_
+#ifndef KINCAL_BUNDLE_TESTING_SYNTHETIC_H_
+#define KINCAL_BUNDLE_TESTING_SYNTHETIC_H_
 
 // Synthetic bundle observations for tests and the bench, without rendering:
 // a simulated robot (synth/simulate.h) carries a tag holder on its flange,
@@ -60,4 +60,4 @@ double TipRmsAgainstTruth(const SyntheticBundle& s, const Robot& robot,
 
 }  // namespace kincal
 
-#endif  // KINCAL_BUNDLE_SYNTHETIC_H_
+#endif  // KINCAL_BUNDLE_TESTING_SYNTHETIC_H_

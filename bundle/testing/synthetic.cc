@@ -1,4 +1,4 @@
-#include "bundle/synthetic.h"
+#include "bundle/testing/synthetic.h"
 
 #include <Eigen/Geometry>
 #include <algorithm>

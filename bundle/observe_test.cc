@@ -1,0 +1,70 @@
+#include "bundle/observe.h"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+
+#include "data/session.h"
+#include "synth/recorded_session.h"
+#include "synth/render.h"
+
+namespace kincal {
+namespace {
+
+// A rendered three-frame session: the second frame has no joint readings.
+TEST(ObserveSession, DetectsTheToolInEveryFrameWithJoints) {
+  const Rig rig = ExampleStereoRig(640, 512);
+  const Target target = ExampleTarget();
+  RecordedSessionInput in;
+  in.rig_from_tool = {ExampleToolPose(0), ExampleToolPose(1),
+                      ExampleToolPose(2)};
+  in.joint_names = {"j1", "j2"};
+  in.joints = {{10, 20}, {}, {30, 40}};
+  const std::string dir =
+      (std::filesystem::temp_directory_path() /
+       ("kincal_observe_" +
+        std::to_string(::testing::UnitTest::GetInstance()->random_seed())))
+          .string();
+  std::filesystem::remove_all(dir);
+  RenderRecordedSession(rig, target, in, RenderOptions(), 1, dir);
+  SessionReadOptions so;
+  so.joint_names = in.joint_names;
+  const Session session = ReadSession(dir, so);
+  std::vector<int> progress;
+  ObserveOptions oo;
+  oo.progress = [&](int done, int total) {
+    EXPECT_EQ(total, 2);
+    progress.push_back(done);
+  };
+  const SessionObservations obs = ObserveSession(session, rig, target, oo);
+  std::filesystem::remove_all(dir);
+
+  EXPECT_EQ(obs.session_frames, 3);
+  EXPECT_EQ(obs.without_joints, 1);
+  EXPECT_EQ(obs.without_tags, 0);
+  EXPECT_EQ(progress.back(), 2);
+  ASSERT_EQ(obs.frames.size(), 2u);
+  const int truth_index[2] = {0, 2};
+  for (int k = 0; k < 2; ++k) {
+    const BundleFrame& f = obs.frames[k];
+    EXPECT_EQ(f.frame, truth_index[k]);
+    EXPECT_EQ(f.q_reading, in.joints[truth_index[k]]);
+    ASSERT_TRUE(f.tracked) << k;
+    const Rigid3& truth = in.rig_from_tool[truth_index[k]];
+    EXPECT_LT((f.rig_from_tool.t - truth.t).norm(), 1.0) << k;
+    EXPECT_LT(f.tracked_rms_px, 0.5) << k;
+    // At least a camera's worth of corners, each near its projection.
+    EXPECT_GE(f.corners.size(), 4 * target.tags.size()) << k;
+    for (const BundleCorner& c : f.corners) {
+      const Camera& cam = rig.cameras[c.camera];
+      const Eigen::Vector2d expected =
+          Project(cam.intrinsics,
+                  cam.cam_from_rig *
+                      (truth * target.tags[c.tag].CornerInTool(c.corner)));
+      EXPECT_LT((c.px - expected).norm(), 0.5);
+    }
+  }
+}
+
+}  // namespace
+}  // namespace kincal
