@@ -38,15 +38,6 @@ nlohmann::json StatsJson(const ErrorStats& s) {
           {"std_mm", Number(s.std_mm)}};
 }
 
-std::string ParamUnit(const ParamInfo& p) {
-  if (p.kind == ParamKind::kJointError && p.index == kGain) return "1";
-  if (p.kind == ParamKind::kJointError && p.index == kCompliance) {
-    return p.angle ? "deg/mm" : "mm/mm";
-  }
-  if (p.kind == ParamKind::kDrift) return "mm/h";
-  return p.angle ? "deg" : "mm";
-}
-
 nlohmann::json ParametersJson(const FitSummary& fit,
                               const ModelState& nominal) {
   nlohmann::json out = nlohmann::json::array();
@@ -55,7 +46,7 @@ nlohmann::json ParametersJson(const FitSummary& fit,
     nlohmann::json j = {{"name", p.name},
                         {"value", Number(fit.values[i])},
                         {"sigma", Number(fit.sigmas[i])},
-                        {"unit", ParamUnit(p)}};
+                        {"unit", p.InterfaceUnit()}};
     if (p.kind == ParamKind::kRow) {
       j["nominal"] = Number(p.ToInterface(ParamValue(nominal, p)));
     }

@@ -25,9 +25,6 @@ nlohmann::json Number(double v);
 // {"n", "rms_mm", "mean_mm", "max_mm", "std_mm"}
 nlohmann::json StatsJson(const ErrorStats& s);
 
-// "mm", "deg", "1", "deg/mm", "mm/h": the interface unit of a parameter.
-std::string ParamUnit(const ParamInfo& p);
-
 // Per free parameter: name, value, sigma (interface units), nominal.
 nlohmann::json ParametersJson(const FitSummary& fit, const ModelState& nominal);
 

@@ -9,6 +9,7 @@
 #include <set>
 
 #include "data/error.h"
+#include "data/rigid3.h"
 
 namespace kincal {
 namespace {
@@ -562,14 +563,8 @@ void InitializeFrameAndPoints(const std::vector<Measurement>& measurements,
         "base-to-measuring-frame transform cannot be determined");
   }
   const Eigen::Matrix4d meas_from_base = Eigen::umeyama(a, b, false);
-  const Eigen::AngleAxisd aa(Eigen::Matrix3d(meas_from_base.block<3, 3>(0, 0)));
-  const Eigen::Vector3d w = aa.axis() * aa.angle();
-  state->meas_from_base = {w.x(),
-                           w.y(),
-                           w.z(),
-                           meas_from_base(0, 3),
-                           meas_from_base(1, 3),
-                           meas_from_base(2, 3)};
+  state->meas_from_base =
+      PoseBlockFromRigid3(Rigid3::FromMatrix(meas_from_base));
 }
 
 int DistinctPoses(const std::vector<Measurement>& measurements) {

@@ -33,6 +33,28 @@ double ParamInfo::FromInterface(double value) const {
   return angle ? value / kRadToDeg : value;
 }
 
+std::string ParamInfo::InterfaceUnit() const {
+  const std::string base = angle ? "deg" : "mm";
+  if (kind == ParamKind::kDrift) {
+    return index == kMountIso || index == kMountCos || index == kMountSin
+               ? "deg/(N m)"
+               : "mm/h";
+  }
+  if (kind != ParamKind::kJointError) return base;
+  switch (index) {
+    case kGain:
+      return "1";
+    case kThermal:
+      return "1/K or 1/h";
+    case kCompliance:
+      return base + "/mm";
+    case kElastostatic:
+      return angle ? "deg/(N m)" : "mm/N";
+    default:
+      return base;
+  }
+}
+
 double* ParamAddress(ModelState* s, const ParamInfo& p) {
   switch (p.kind) {
     case ParamKind::kRow:

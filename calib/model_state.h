@@ -38,6 +38,11 @@ struct ParamInfo {
 
   double ToInterface(double internal) const;  // rad -> deg for angles
   double FromInterface(double value) const;
+  // The unit of ToInterface's value: "deg" or "mm" for geometry, frame and
+  // points; per family for the error model ("1" for a gain, "deg/mm" for a
+  // compliance per mm of unit-mass torque, "deg/(N m)" for elastostatic and
+  // mount compliances, "1/K or 1/h" for thermal growth, "mm/h" for drift).
+  std::string InterfaceUnit() const;
 };
 
 double* ParamAddress(ModelState* state, const ParamInfo& p);

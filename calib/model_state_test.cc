@@ -50,6 +50,30 @@ TEST(ModelStateTest, AddressesReachTheState) {
   EXPECT_EQ(ParamValue(s, PointParams(s)[5]), 6.0);
 }
 
+// Each family's unit matches what ToInterface gives (docs/CONVENTIONS.md).
+TEST(ModelStateTest, InterfaceUnitPerFamily) {
+  const ModelState s = Bh7State();
+  EXPECT_EQ(FindParam(s, s.chain.rows[2].name + ".a").InterfaceUnit(), "mm");
+  EXPECT_EQ(FrameParams()[0].InterfaceUnit(), "deg");
+  EXPECT_EQ(PointParams(s)[0].InterfaceUnit(), "mm");
+  const auto unit = [&](int index) {
+    return JointErrorParam(s.chain, 2, index).InterfaceUnit();
+  };
+  EXPECT_EQ(unit(kGain), "1");
+  EXPECT_EQ(unit(kBacklash), "deg");
+  EXPECT_EQ(unit(kCompliance), "deg/mm");
+  EXPECT_EQ(unit(kElastostatic), "deg/(N m)");
+  EXPECT_EQ(unit(kThermal), "1/K or 1/h");
+  EXPECT_EQ(unit(kTransmission0), "deg");
+  // j1 is prismatic: its errors are lengths.
+  EXPECT_EQ(JointErrorParam(s.chain, 0, kBacklash).InterfaceUnit(), "mm");
+  EXPECT_EQ(JointErrorParam(s.chain, 0, kCompliance).InterfaceUnit(), "mm/mm");
+  EXPECT_EQ(JointErrorParam(s.chain, 0, kElastostatic).InterfaceUnit(), "mm/N");
+  EXPECT_EQ(DriftParams()[0].InterfaceUnit(), "mm/h");
+  for (const ParamInfo& p : MountParams())
+    EXPECT_EQ(p.InterfaceUnit(), "deg/(N m)");
+}
+
 TEST(ModelStateTest, UnknownNameIsInputError) {
   const ModelState s = Bh7State();
   EXPECT_THROW(FindParam(s, "j99.theta"), InputError);

@@ -30,7 +30,6 @@ std::string JointUnit(const Robot& r, int j) {
 }
 
 // Parameter unit shown in tables.
-std::string Unit(const ParamInfo& p) { return p.angle ? "deg" : "mm"; }
 
 // Equal-count bins of the trend lines: 12, fewer so that each holds 8 poses
 // or more, none (0) below 3 bins: a mean of one or two poses is no trend.
@@ -505,12 +504,9 @@ void AddParametersSection(const ReportInputs& in, const ReportAnalysis& an,
     const bool row = p.kind == ParamKind::kRow;
     const double n0 = row ? p.ToInterface(ParamValue(nom, p)) : NAN;
     const double v = c.fit.values[i];
-    std::vector<std::string> r = {p.name,
-                                  Unit(p),
-                                  Fmt(n0, 6),
-                                  Fmt(v, 6),
-                                  Fmt(c.fit.sigmas[i], 2),
-                                  row ? Fmt(v - n0, 3) : "-"};
+    std::vector<std::string> r = {
+        p.name,    p.InterfaceUnit(),       Fmt(n0, 6),
+        Fmt(v, 6), Fmt(c.fit.sigmas[i], 2), row ? Fmt(v - n0, 3) : "-"};
     if (in.has_cal) {
       r.push_back(row && in.has_robot
                       ? Fmt(p.ToInterface(ParamValue(file_state, p)), 6)
