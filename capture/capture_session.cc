@@ -386,6 +386,47 @@ void RecordSettings(const CaptureOptions& options, bool stream,
   info->settings["writers"] = std::to_string(options.writers);
 }
 
+// What session.yaml records about how the recording ended.
+SessionSummary Summarize(const Recording& rec, const std::string& failure,
+                         const std::string& stream_bad_input,
+                         const StereoGrabber& grabber,
+                         const AsyncRecorder& writer) {
+  SessionSummary summary;
+  summary.complete = failure.empty() && stream_bad_input.empty();
+  summary.stop_reason = !failure.empty()            ? failure
+                        : !stream_bad_input.empty() ? stream_bad_input
+                                                    : rec.stop_reason;
+  summary.dropped_left = grabber.dropped_left();
+  summary.dropped_right = grabber.dropped_right();
+  summary.dropped_pairs = writer.dropped_pairs();
+  summary.length_mismatch = grabber.length_mismatch();
+  summary.seconds = rec.seconds;
+  return summary;
+}
+
+// The figures of a finished recording, into `result`.
+void DescribeRecording(const Inputs& in, const StereoGrabber& grabber,
+                       const AsyncRecorder& writer,
+                       const SessionRecorder& recorder, const Recording& rec,
+                       const SessionSummary& summary,
+                       const std::string& pairing, CaptureResult* result) {
+  result->recorded = true;
+  result->frames = recorder.frames();
+  result->seconds = rec.seconds;
+  result->bytes = recorder.bytes_written();
+  result->left_description = in.left->Describe();
+  result->right_description = in.right->Describe();
+  result->pairing = pairing;
+  result->dropped_left = grabber.dropped_left();
+  result->dropped_right = grabber.dropped_right();
+  result->dropped_pairs = writer.dropped_pairs();
+  result->max_queue_depth = writer.max_queue_depth();
+  result->fast_pairs = writer.fast_pairs();
+  result->length_mismatch = grabber.length_mismatch();
+  result->transient_failures = rec.transient_failures;
+  result->stop_reason = summary.stop_reason;
+}
+
 // The outcome of a finished recording: bad input from the stream, then a
 // joint log that could not be merged, then a camera, disk or robot failure.
 CaptureResult Conclude(CaptureResult result, const std::string& out,
@@ -488,16 +529,8 @@ CaptureResult RunCaptureSession(const CaptureOptions& options) {
     }
   }
 
-  SessionSummary summary;
-  summary.complete = failure.empty() && stream_bad_input.empty();
-  summary.stop_reason = !failure.empty()            ? failure
-                        : !stream_bad_input.empty() ? stream_bad_input
-                                                    : rec.stop_reason;
-  summary.dropped_left = grabber.dropped_left();
-  summary.dropped_right = grabber.dropped_right();
-  summary.dropped_pairs = writer.dropped_pairs();
-  summary.length_mismatch = grabber.length_mismatch();
-  summary.seconds = rec.seconds;
+  const SessionSummary summary =
+      Summarize(rec, failure, stream_bad_input, grabber, writer);
   // Joint readings are merged before finalizing. A log that cannot be
   // merged is bad input: the session is kept without joint columns.
   std::string joint_error;
@@ -522,21 +555,8 @@ CaptureResult RunCaptureSession(const CaptureOptions& options) {
     failure = "finalize: " + finalized.ToString();
   }
 
-  result.recorded = true;
-  result.frames = recorder.frames();
-  result.seconds = rec.seconds;
-  result.bytes = recorder.bytes_written();
-  result.left_description = in.left->Describe();
-  result.right_description = in.right->Describe();
-  result.pairing = info.pairing;
-  result.dropped_left = grabber.dropped_left();
-  result.dropped_right = grabber.dropped_right();
-  result.dropped_pairs = writer.dropped_pairs();
-  result.max_queue_depth = writer.max_queue_depth();
-  result.fast_pairs = writer.fast_pairs();
-  result.length_mismatch = grabber.length_mismatch();
-  result.transient_failures = rec.transient_failures;
-  result.stop_reason = summary.stop_reason;
+  DescribeRecording(in, grabber, writer, recorder, rec, summary, info.pairing,
+                    &result);
   result.complete = failure.empty();
   return Conclude(result, options.out, stream_bad_input, joint_error, failure);
 }
