@@ -11,6 +11,23 @@
 
 namespace kincal::app {
 
+CLI::Option* AddRobotOptions(CLI::App* sub, std::string* robot,
+                             std::string* root, std::string* tip,
+                             const std::string& robot_help,
+                             const std::string& root_help,
+                             const std::string& tip_help) {
+  CLI::Option* robot_option = sub->add_option("--robot", *robot, robot_help);
+  sub->add_option("--root", *root, root_help);
+  sub->add_option("--tip", *tip, tip_help);
+  return robot_option;
+}
+
+std::string HelpFooter(const std::string& example,
+                       const std::string& units_note) {
+  return example + "\nUnits: lengths mm, angles deg, time s (pixels px)" +
+         units_note + ". Defaults are shown beside each option.";
+}
+
 void MakeDirs(const std::string& dir) {
   std::string path;
   for (size_t i = 0; i <= dir.size(); ++i) {

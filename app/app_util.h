@@ -4,6 +4,7 @@
 // Small helpers shared by the subcommands: reading inputs, writing outputs
 // atomically, JSON conversions. No algorithms here.
 
+#include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
@@ -15,6 +16,20 @@
 #include "data/robot.h"
 
 namespace kincal::app {
+
+// The robot-input option group: --robot FILE (robot.yaml or .urdf, with
+// `robot_help`), then --root and --tip, the URDF links the chain runs
+// between. Returns the --robot option (callers add ->required()).
+CLI::Option* AddRobotOptions(CLI::App* sub, std::string* robot,
+                             std::string* root, std::string* tip,
+                             const std::string& robot_help,
+                             const std::string& root_help = "URDF root link",
+                             const std::string& tip_help = "URDF tip link");
+
+// A command's --help footer: `example`, then the units line (with
+// `units_note` before its full stop) and where the defaults are shown.
+std::string HelpFooter(const std::string& example,
+                       const std::string& units_note = "");
 
 // Creates `dir` (and parents) if needed; InputError when it cannot.
 void MakeDirs(const std::string& dir);

@@ -449,14 +449,13 @@ void AddBundleCommand(CLI::App& app, Runner* run) {
       ->capture_default_str();
   sub->add_flag("--quiet", args->quiet, "no progress on stderr");
   sub->add_flag("--json", args->json, "print one JSON object");
-  sub->footer(
-      "Example (a rendered session with a hidden backlash, then the "
-      "bundle):\n  kincal simulate --robot data/robots/bh7.yaml --out sim "
-      "--poses 160 --noise 0 --render --effect backlash:j3:0.05\n  kincal "
-      "bundle --robot sim/robot.yaml --rig sim/rig.yaml --target "
-      "sim/target.yaml --session sim/session --out cal.yaml --out-obs "
-      "tips.csv --extensions backlash --json\nUnits: lengths mm, angles "
-      "deg, time s (pixels px). Defaults are shown beside each option.");
+  sub->footer(HelpFooter(
+      "Example (a rendered session with a hidden backlash, then the bundle):\n "
+      " kincal simulate --robot data/robots/bh7.yaml --out sim --poses 160 "
+      "--noise 0 --render --effect backlash:j3:0.05\n  kincal bundle --robot "
+      "sim/robot.yaml --rig sim/rig.yaml --target sim/target.yaml --session "
+      "sim/session --out cal.yaml --out-obs tips.csv --extensions backlash "
+      "--json"));
   sub->callback(
       [run, args] { *run = [args] { return RunBundleCommand(*args); }; });
 }

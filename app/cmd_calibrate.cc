@@ -41,51 +41,57 @@ FixedDistance ParseDistance(const std::string& text) {
   return d;
 }
 
-int RunCalibrate(CalibrateArgs args) {
+// The nominal robot, with --bound-length / --bound-angle applied.
+Robot ReadNominal(const CalibrateArgs& args) {
   Robot nominal = ReadRobot(args.robot, args.root, args.tip);
   if (args.bound_length_mm > 0) nominal.bound_length_mm = args.bound_length_mm;
   if (args.bound_angle_deg > 0) nominal.bound_angle_deg = args.bound_angle_deg;
   if (args.bound_length_mm > 0 || args.bound_angle_deg > 0) {
     nominal.bounds_stated = true;
   }
-  const Observations obs = ReadObservationsCsv(args.obs, nominal.JointNames());
+  return nominal;
+}
+
+// The fit options: --method, --loss and --fixed-distance checked and added.
+CalibrateOptions FitOptions(const CalibrateArgs& args) {
+  CalibrateOptions options = args.options;
   if (args.method == "paper") {
-    args.options.method = CalibrateOptions::kPaper;
+    options.method = CalibrateOptions::kPaper;
   } else if (args.method == "lsq") {
-    args.options.method = CalibrateOptions::kLeastSquares;
+    options.method = CalibrateOptions::kLeastSquares;
   } else {
     throw InputError("--method: expected 'lsq' or 'paper', got '" +
                      args.method + "'");
   }
-  if (args.options.loss != "none" && args.options.loss != "huber" &&
-      args.options.loss != "cauchy") {
+  if (options.loss != "none" && options.loss != "huber" &&
+      options.loss != "cauchy") {
     throw InputError("--loss: expected none, huber or cauchy");
   }
   for (const auto& d : args.distances) {
-    args.options.distances.push_back(ParseDistance(d));
+    options.distances.push_back(ParseDistance(d));
   }
-  args.options.extra_params = args.free;
-  Progress progress("kincal calibrate", args.json || obs.rows.size() < 500);
-  progress.Stage("fitting " + std::to_string(obs.rows.size()) +
-                 " poses (Ceres LM, identifiability, covariance)");
-  const CalibrateResult r = Calibrate(nominal, obs, args.options);
-  progress.Done();
+  options.extra_params = args.free;
+  return options;
+}
 
-  if (!args.out.empty()) {
-    std::ostringstream note;
-    note << "calibrated by " << r.method << " from " << args.obs
-         << ": train RMS " << r.train.rms_mm << " mm (" << r.train.n
-         << " poses), held-out RMS " << r.heldout.rms_mm << " mm ("
-         << r.heldout.n << " poses)";
-    std::vector<std::string> comment = {note.str()};
-    std::string held;
-    for (const auto& name : r.identifiability.UnidentifiableNames()) {
-      held += (held.empty() ? "" : ", ") + name;
-    }
-    if (!held.empty()) comment.push_back("held (not identifiable): " + held);
-    WriteFileAtomic(args.out, FormatRobotYaml(r.calibrated, comment));
+// The calibrated robot.yaml, with the figures and the held parameters in
+// its header comment.
+void WriteCalibrated(const CalibrateArgs& args, const CalibrateResult& r) {
+  std::ostringstream note;
+  note << "calibrated by " << r.method << " from " << args.obs << ": train RMS "
+       << r.train.rms_mm << " mm (" << r.train.n << " poses), held-out RMS "
+       << r.heldout.rms_mm << " mm (" << r.heldout.n << " poses)";
+  std::vector<std::string> comment = {note.str()};
+  std::string held;
+  for (const auto& name : r.identifiability.UnidentifiableNames()) {
+    held += (held.empty() ? "" : ", ") + name;
   }
+  if (!held.empty()) comment.push_back("held (not identifiable): " + held);
+  WriteFileAtomic(args.out, FormatRobotYaml(r.calibrated, comment));
+}
 
+nlohmann::json CalibrateJson(const CalibrateArgs& args,
+                             const CalibrateResult& r, const Robot& nominal) {
   const Identifiability& id = r.identifiability;
   nlohmann::json j;
   j["method"] = r.method;
@@ -145,10 +151,12 @@ int RunCalibrate(CalibrateArgs args) {
   j["outliers"] = OutliersJson(r.outliers);
   j["outliers_too_many"] = r.outliers_too_many;
   if (!args.out.empty()) j["out"] = args.out;
-  if (args.json) {
-    PrintJson(j);
-    return 0;
-  }
+  return j;
+}
+
+void PrintCalibrate(const CalibrateArgs& args, const CalibrateResult& r,
+                    const Robot& nominal, const nlohmann::json& j) {
+  const Identifiability& id = r.identifiability;
   std::printf("kincal calibrate (%s): %d training poses, %d held out\n",
               r.method.c_str(), r.train.n, r.heldout.n);
   std::printf("  train RMS    %.4f mm   (mean %.4f, max %.4f)\n",
@@ -215,6 +223,24 @@ int RunCalibrate(CalibrateArgs args) {
   }
   if (!args.out.empty()) std::printf("  wrote %s\n", args.out.c_str());
   std::printf("  %.3f s\n", r.seconds);
+}
+
+int RunCalibrate(CalibrateArgs args) {
+  const Robot nominal = ReadNominal(args);
+  const Observations obs = ReadObservationsCsv(args.obs, nominal.JointNames());
+  args.options = FitOptions(args);
+  Progress progress("kincal calibrate", args.json || obs.rows.size() < 500);
+  progress.Stage("fitting " + std::to_string(obs.rows.size()) +
+                 " poses (Ceres LM, identifiability, covariance)");
+  const CalibrateResult r = Calibrate(nominal, obs, args.options);
+  progress.Done();
+  if (!args.out.empty()) WriteCalibrated(args, r);
+  const nlohmann::json j = CalibrateJson(args, r, nominal);
+  if (args.json) {
+    PrintJson(j);
+    return 0;
+  }
+  PrintCalibrate(args, r, nominal, j);
   return 0;
 }
 
@@ -226,10 +252,9 @@ void AddCalibrateCommand(CLI::App& app, Runner* run) {
       "calibrate",
       "Fit robot geometry and the base-to-measuring-frame transform to "
       "measured tip points (Ceres LM), or the seed's single-point objective");
-  sub->add_option("--robot", args->robot, "nominal robot.yaml or .urdf")
+  AddRobotOptions(sub, &args->robot, &args->root, &args->tip,
+                  "nominal robot.yaml or .urdf")
       ->required();
-  sub->add_option("--root", args->root, "URDF root link");
-  sub->add_option("--tip", args->tip, "URDF tip link");
   sub->add_option("--obs", args->obs, "observations.csv")->required();
   sub->add_option("--out", args->out, "calibrated robot.yaml to write");
   sub->add_option("--method", args->method,
@@ -292,14 +317,13 @@ void AddCalibrateCommand(CLI::App& app, Runner* run) {
                   "extra parameters to fit, e.g. j2.beta, or a joint-error "
                   "family for every joint, e.g. compliance (repeatable)");
   sub->add_flag("--json", args->json, "print one JSON object");
-  sub->footer(
+  sub->footer(HelpFooter(
       "Example (the demo session):\n  kincal calibrate --robot "
       "data/sessions/bh7_demo/robot.yaml --obs "
       "data/sessions/bh7_demo/observations.csv --out cal.yaml --json\n  "
       "Single-point data with a known 50 mm between two sockets:\n  kincal "
       "calibrate --robot panda.urdf --tip ball_link --obs panda.csv "
-      "--fixed-distance hole_0,hole_1,50 --out cal.yaml\nUnits: lengths mm, "
-      "angles deg, time s (pixels px). Defaults are shown beside each option.");
+      "--fixed-distance hole_0,hole_1,50 --out cal.yaml"));
   sub->callback([run, args] { *run = [args] { return RunCalibrate(*args); }; });
 }
 

@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "app/app_util.h"
 #include "app/command.h"
 #include "app/front_end.h"
 #include "camcal/calibrate_cameras.h"
@@ -328,12 +329,11 @@ void AddCamcalCommand(CLI::App& app, Runner* run) {
   sub->add_option("--loss-scale", args->loss_scale_px,
                   "robust loss scale, px (default 3)");
   sub->add_flag("--json", args->json, "print one JSON object");
-  sub->footer(
+  sub->footer(HelpFooter(
       "Example: stereo rig from a 9x6 chessboard with 25 mm squares:\n  kincal "
       "camcal --left 'calib/left*.png' --right 'calib/right*.png' --target "
       "chessboard:9x6:25 --out rig.yaml --json > rig.json\n  (rig.json beside "
-      "rig.yaml feeds the camera section of kincal report)\nUnits: lengths mm, "
-      "angles deg, time s (pixels px). Defaults are shown beside each option.");
+      "rig.yaml feeds the camera section of kincal report)"));
   sub->callback([run, args] { *run = [args] { return RunCamcal(*args); }; });
 }
 

@@ -209,9 +209,9 @@ void AddDiagnoseCommand(CLI::App& app, Runner* run) {
       "cyclic, gain, axis_tilt, drift, elastostatic, thermal, "
       "mount_compliance, transmission) against held-out poses, report "
       "findings");
-  model->add_option("--robot", margs->robot, "robot.yaml or .urdf")->required();
-  model->add_option("--root", margs->root, "URDF root link");
-  model->add_option("--tip", margs->tip, "URDF tip link");
+  AddRobotOptions(model, &margs->robot, &margs->root, &margs->tip,
+                  "robot.yaml or .urdf")
+      ->required();
   model->add_option("--obs", margs->obs, "observations.csv")->required();
   model->add_option(
       "--out", margs->out,
@@ -249,15 +249,13 @@ void AddDiagnoseCommand(CLI::App& app, Runner* run) {
                     "other series of the same robot for cross-series "
                     "validation (observations.csv; repeatable)");
   model->add_flag("--json", margs->json, "print one JSON object");
-  model->footer(
+  model->footer(HelpFooter(
       "Example (the demo session):\n  kincal diagnose model --robot "
       "data/sessions/bh7_demo/robot.yaml --obs "
       "data/sessions/bh7_demo/observations.csv --out extended.yaml --json > "
       "diag.json\n  kincal report --robot data/sessions/bh7_demo/robot.yaml "
       "--obs data/sessions/bh7_demo/observations.csv --calibrated "
-      "extended.yaml --diagnosis diag.json --out report.html\nUnits: lengths "
-      "mm, angles deg, time s (pixels px). Defaults are shown beside each "
-      "option.");
+      "extended.yaml --diagnosis diag.json --out report.html"));
   model->callback([run, margs, model] {
     margs->options.folds_given = model->get_option("--folds")->count() > 0;
     *run = [margs] { return RunModel(*margs); };
@@ -268,10 +266,9 @@ void AddDiagnoseCommand(CLI::App& app, Runner* run) {
       "clearance",
       "The seed's Section 4 joint motion error test: sweep each joint at the "
       "worst poses");
-  clear->add_option("--robot", cargs->robot, "robot.yaml (calibrated) or .urdf")
+  AddRobotOptions(clear, &cargs->robot, &cargs->root, &cargs->tip,
+                  "robot.yaml (calibrated) or .urdf")
       ->required();
-  clear->add_option("--root", cargs->root, "URDF root link");
-  clear->add_option("--tip", cargs->tip, "URDF tip link");
   clear->add_option("--obs", cargs->obs, "observations.csv")->required();
   clear
       ->add_option("--gamma", cargs->options.gamma,
@@ -290,11 +287,10 @@ void AddDiagnoseCommand(CLI::App& app, Runner* run) {
   clear->add_option("--csv", cargs->csv, "write deviations and curves as CSV");
   clear->add_flag("--json", cargs->json, "print one JSON object");
   clear->footer(
-      "Example (seed Section 4, sweep +-3 deg | mm):\n  kincal diagnose "
-      "clearance --robot cal.yaml --obs "
-      "data/sessions/bh7_demo/observations.csv --gamma 3 --plot clearance.svg "
-      "--csv clearance.csv\nUnits: lengths mm, angles deg, time s (pixels px). "
-      "Defaults are shown beside each option.");
+      HelpFooter("Example (seed Section 4, sweep +-3 deg | mm):\n  kincal "
+                 "diagnose clearance --robot cal.yaml --obs "
+                 "data/sessions/bh7_demo/observations.csv --gamma 3 --plot "
+                 "clearance.svg --csv clearance.csv"));
   clear->callback(
       [run, cargs] { *run = [cargs] { return RunClearance(*cargs); }; });
 
@@ -305,15 +301,13 @@ void AddDiagnoseCommand(CLI::App& app, Runner* run) {
   cmp->add_option("before", pargs->before, "observations.csv before")
       ->required();
   cmp->add_option("after", pargs->after, "observations.csv after")->required();
-  cmp->add_option("--robot", pargs->robot, "robot.yaml or .urdf")->required();
-  cmp->add_option("--root", pargs->root, "URDF root link");
-  cmp->add_option("--tip", pargs->tip, "URDF tip link");
+  AddRobotOptions(cmp, &pargs->robot, &pargs->root, &pargs->tip,
+                  "robot.yaml or .urdf")
+      ->required();
   cmp->add_flag("--json", pargs->json, "print one JSON object");
-  cmp->footer(
+  cmp->footer(HelpFooter(
       "Example: errors before and after a repair, same poses:\n  kincal "
-      "diagnose compare before.csv after.csv --robot cal.yaml --json\nUnits: "
-      "lengths mm, angles deg, time s (pixels px). Defaults are shown beside "
-      "each option.");
+      "diagnose compare before.csv after.csv --robot cal.yaml --json"));
   cmp->callback(
       [run, pargs] { *run = [pargs] { return RunCompare(*pargs); }; });
 }

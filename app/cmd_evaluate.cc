@@ -118,10 +118,9 @@ void AddEvaluateCommand(CLI::App& app, Runner* run) {
       "evaluate",
       "Register only the measuring frame and report the tip position error "
       "of a robot model (with its extensions) on observations");
-  sub->add_option("--robot", args->robot, "robot.yaml (calibrated) or .urdf")
+  AddRobotOptions(sub, &args->robot, &args->root, &args->tip,
+                  "robot.yaml (calibrated) or .urdf")
       ->required();
-  sub->add_option("--root", args->root, "URDF root link");
-  sub->add_option("--tip", args->tip, "URDF tip link");
   sub->add_option("--obs", args->obs, "observations.csv")->required();
   sub->add_option("--residuals", args->residuals,
                   "write per-pose errors to this CSV");
@@ -132,10 +131,9 @@ void AddEvaluateCommand(CLI::App& app, Runner* run) {
       ->check(CLI::Range(0.0, 1e6))
       ->capture_default_str();
   sub->add_flag("--json", args->json, "print one JSON object");
-  sub->footer(
+  sub->footer(HelpFooter(
       "Example: the calibrated model on new poses:\n  kincal evaluate --robot "
-      "cal.yaml --obs new_poses.csv --residuals errors.csv\nUnits: lengths mm, "
-      "angles deg, time s (pixels px). Defaults are shown beside each option.");
+      "cal.yaml --obs new_poses.csv --residuals errors.csv"));
   sub->callback([run, args] { *run = [args] { return RunEvaluate(*args); }; });
 }
 

@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <memory>
 
+#include "app/app_util.h"
 #include "app/command.h"
 #include "calib/urdf_export.h"
 #include "data/atomic_file.h"
@@ -63,13 +64,12 @@ int RunExportDh(const ExportArgs& args) {
 }
 
 void AddCommon(CLI::App* sub, ExportArgs* args, const char* out_help) {
-  sub->add_option("--robot", args->robot,
-                  "robot.yaml (dh, mdh or urdf rows; calibrated or not) or "
-                  ".urdf")
+  AddRobotOptions(
+      sub, &args->robot, &args->root, &args->tip,
+      "robot.yaml (dh, mdh or urdf rows; calibrated or not) or .urdf",
+      "URDF root link (default: the root)",
+      "URDF tip link (default: the deepest leaf of a chain)")
       ->required();
-  sub->add_option("--root", args->root, "URDF root link (default: the root)");
-  sub->add_option("--tip", args->tip,
-                  "URDF tip link (default: the deepest leaf of a chain)");
   sub->add_option("--out", args->out, out_help)->required();
   sub->add_flag("--json", args->json, "print one JSON object on stdout");
 }

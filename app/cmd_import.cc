@@ -6,6 +6,7 @@
 #include <memory>
 #include <sstream>
 
+#include "app/app_util.h"
 #include "app/command.h"
 #include "data/atomic_file.h"
 #include "data/error.h"
@@ -84,10 +85,8 @@ int RunMukca(const ImportArgs& args) {
 
 void CommonOptions(CLI::App* sub, ImportArgs* args) {
   sub->add_option("--out", args->out, "observations.csv to write")->required();
-  sub->add_option("--robot", args->robot,
+  AddRobotOptions(sub, &args->robot, &args->root, &args->tip,
                   "robot file whose joint names the columns map to (in order)");
-  sub->add_option("--root", args->root, "URDF root link");
-  sub->add_option("--tip", args->tip, "URDF tip link");
   sub->add_option("--every", args->every, "keep every N-th row")
       ->capture_default_str();
   sub->add_flag("--json", args->json, "print one JSON object");
@@ -107,11 +106,10 @@ void AddImportCommand(CLI::App& app, Runner* run) {
   s1->add_option("--in", ipa->in, "Series_X/measurements_*.csv")->required();
   CommonOptions(s1, ipa.get());
   s1->footer(
-      "Example:\n  kincal import ipa-ur10 --in "
-      "../shared/data/ipa-robot-accuracy/Series_C/"
-      "measurements_random_poses.csv --robot data/robots/ur10.yaml --out "
-      "ur10_C.csv\nUnits: lengths mm, angles deg, time s (pixels px). Defaults "
-      "are shown beside each option.");
+      HelpFooter("Example:\n  kincal import ipa-ur10 --in "
+                 "../shared/data/ipa-robot-accuracy/Series_C/"
+                 "measurements_random_poses.csv --robot data/robots/ur10.yaml "
+                 "--out ur10_C.csv"));
   s1->callback([run, ipa] { *run = [ipa] { return RunIpa(*ipa); }; });
 
   auto mukca = std::make_shared<ImportArgs>();
@@ -120,11 +118,9 @@ void AddImportCommand(CLI::App& app, Runner* run) {
   s2->add_option("--dir", mukca->dir, "folder with hole_0.csv and hole_1.csv")
       ->required();
   CommonOptions(s2, mukca.get());
-  s2->footer(
+  s2->footer(HelpFooter(
       "Example:\n  kincal import mukca --dir "
-      "../shared/data/mukca/data/panda_6/front --out panda_front.csv\nUnits: "
-      "lengths mm, angles deg, time s (pixels px). Defaults are shown beside "
-      "each option.");
+      "../shared/data/mukca/data/panda_6/front --out panda_front.csv"));
   s2->callback([run, mukca] { *run = [mukca] { return RunMukca(*mukca); }; });
 }
 

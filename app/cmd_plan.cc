@@ -179,10 +179,9 @@ void AddPlanCommand(CLI::App& app, Runner* run) {
       "Choose N robot poses that best determine the identifiable parameters "
       "(D-optimal design within joint limits, tags visible when a rig is "
       "given), ordered for short joint motions");
-  sub->add_option("--robot", args->robot, "robot.yaml or .urdf with limits")
+  AddRobotOptions(sub, &args->robot, &args->root, &args->tip,
+                  "robot.yaml or .urdf with limits")
       ->required();
-  sub->add_option("--root", args->root, "URDF root link");
-  sub->add_option("--tip", args->tip, "URDF tip link");
   sub->add_option("--n", args->options.n, "number of poses")->required();
   sub->add_option("--out", args->out, "POSES.csv to write")->required();
   sub->add_option("--random-out", args->random_out,
@@ -221,14 +220,12 @@ void AddPlanCommand(CLI::App& app, Runner* run) {
                   "random poses, calibrate them and report the actual errors")
       ->check(CLI::Range(0, 1000));
   sub->add_flag("--json", args->json, "print one JSON object");
-  sub->footer(
-      "Example (60 poses for a UR10 seen by a stereo rig, and the gain over "
-      "60 random poses confirmed on simulated sessions):\n  kincal plan "
-      "--robot data/robots/ur10.yaml --n 60 --rig rig.yaml --target "
-      "target.yaml --out poses.csv --random-out random.csv --confirm 5 "
-      "--json\nUnits: lengths mm, angles deg, time s (pixels px); poses.csv "
-      "in the robot's joint units (deg | mm). Defaults are shown beside each "
-      "option.");
+  sub->footer(HelpFooter(
+      "Example (60 poses for a UR10 seen by a stereo rig, and the gain over 60 "
+      "random poses confirmed on simulated sessions):\n  kincal plan --robot "
+      "data/robots/ur10.yaml --n 60 --rig rig.yaml --target target.yaml --out "
+      "poses.csv --random-out random.csv --confirm 5 --json",
+      "; poses.csv in the robot's joint units (deg | mm)"));
   sub->callback([run, args] { *run = [args] { return RunPlan(*args); }; });
 }
 

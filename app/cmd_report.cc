@@ -6,6 +6,7 @@
 #include <memory>
 #include <nlohmann/json.hpp>
 
+#include "app/app_util.h"
 #include "app/command.h"
 #include "data/atomic_file.h"
 #include "data/error.h"
@@ -118,14 +119,11 @@ void AddReportCommand(CLI::App& app, Runner* run) {
       ->capture_default_str();
   sub->add_flag("--json", args->json,
                 "print one JSON object (out, sections, seconds)");
-  sub->footer(
-      "Example (the demo's session):\n"
-      "  kincal diagnose model --robot R.yaml --obs O.csv --out ext.yaml "
-      "--json > diag.json\n"
-      "  kincal report --robot R.yaml --obs O.csv --calibrated ext.yaml "
-      "--diagnosis diag.json --out report.html\n"
-      "Units: lengths mm, angles deg, time s (pixels px). Defaults are shown "
-      "beside each option.");
+  sub->footer(HelpFooter(
+      "Example (the demo's session):\n  kincal diagnose model --robot R.yaml "
+      "--obs O.csv --out ext.yaml --json > diag.json\n  kincal report --robot "
+      "R.yaml --obs O.csv --calibrated ext.yaml --diagnosis diag.json --out "
+      "report.html"));
   sub->callback([run, args] { *run = [args] { return RunReport(*args); }; });
 }
 

@@ -132,10 +132,9 @@ void AddSensitivityCommand(CLI::App& app, Runner* run) {
       "sensitivity",
       "The seed's optimality criterion (Section 3): eps of each parameter "
       "over +-range around the calibrated value, valleys and verdict");
-  sub->add_option("--robot", args->robot, "calibrated robot.yaml or .urdf")
+  AddRobotOptions(sub, &args->robot, &args->root, &args->tip,
+                  "calibrated robot.yaml or .urdf")
       ->required();
-  sub->add_option("--root", args->root, "URDF root link");
-  sub->add_option("--tip", args->tip, "URDF tip link");
   sub->add_option("--obs", args->obs, "observations.csv with fixed_point rows")
       ->required();
   sub->add_option("--range", args->options.range, "+- units (mm or deg)")
@@ -149,13 +148,12 @@ void AddSensitivityCommand(CLI::App& app, Runner* run) {
   sub->add_option("--out-csv", args->out_csv, "curves as CSV");
   sub->add_option("--plot", args->plot, "curves as an SVG image");
   sub->add_flag("--json", args->json, "print one JSON object");
-  sub->footer(
+  sub->footer(HelpFooter(
       "Example (seed Section 3 on fixed-point data):\n  kincal simulate "
       "--robot data/robots/bh7.yaml --out fp --mode fixed-point\n  kincal "
       "calibrate --robot data/robots/bh7.yaml --obs fp/observations.csv "
       "--method paper --out cal.yaml\n  kincal sensitivity --robot cal.yaml "
-      "--obs fp/observations.csv --plot curves.svg\nUnits: lengths mm, angles "
-      "deg, time s (pixels px). Defaults are shown beside each option.");
+      "--obs fp/observations.csv --plot curves.svg"));
   sub->callback(
       [run, args] { *run = [args] { return RunSensitivity(*args); }; });
 }

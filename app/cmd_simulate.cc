@@ -235,10 +235,9 @@ void AddSimulateCommand(CLI::App& app, Runner* run) {
       "simulate",
       "Seeded synthetic session: true robot = nominal + random deviations, "
       "poses, measured tip points with noise, optional injected effects");
-  sub->add_option("--robot", args->robot, "robot.yaml or .urdf (nominal)")
+  AddRobotOptions(sub, &args->robot, &args->root, &args->tip,
+                  "robot.yaml or .urdf (nominal)")
       ->required();
-  sub->add_option("--root", args->root, "URDF root link");
-  sub->add_option("--tip", args->tip, "URDF tip link");
   sub->add_option("--out", args->out, "output folder")->required();
   sub->add_option("--mode", args->mode, "random | fixed-point")
       ->capture_default_str();
@@ -308,13 +307,11 @@ void AddSimulateCommand(CLI::App& app, Runner* run) {
                   "lossless)")
       ->capture_default_str();
   sub->add_flag("--json", args->json, "print a JSON summary");
-  sub->footer(
+  sub->footer(HelpFooter(
       "Example: a BH-7 session with a hidden 0.15 deg backlash in j3, 240 "
       "random poses:\n  kincal simulate --robot data/robots/bh7.yaml --out sim "
       "--poses 240 --noise 0.03 --effect backlash:j3:0.15 --seed 7\n  -> "
-      "sim/observations.csv, sim/robot.yaml, sim/truth.json\nUnits: lengths "
-      "mm, angles deg, time s (pixels px). Defaults are shown beside each "
-      "option.");
+      "sim/observations.csv, sim/robot.yaml, sim/truth.json"));
   sub->callback([run, args] { *run = [args] { return RunSimulate(*args); }; });
 }
 

@@ -7,6 +7,7 @@
 #include <memory>
 #include <sstream>
 
+#include "app/app_util.h"
 #include "app/command.h"
 #include "app/front_end.h"
 #include "camcal/rig.h"
@@ -55,16 +56,14 @@ std::string PosesPath(const std::string& out) {
   return out + ".poses.csv";
 }
 
-int RunTrack(const TrackArgs& args) {
-  const auto start = std::chrono::steady_clock::now();
-  const Rig rig = ReadRigYaml(args.rig);
-  const Target target = ReadTargetYaml(args.target);
-  if (rig.cameras.size() < 2) {
-    throw InputError(args.rig + ": track needs a stereo rig (2 cameras), got " +
-                     std::to_string(rig.cameras.size()));
-  }
+// The image pairs to track, from a session folder or two globs.
+struct FramePairs {
   std::vector<std::string> left, right;
-  Session session;
+  Session session;  // when --session
+};
+
+FramePairs ListFramePairs(const TrackArgs& args) {
+  FramePairs pairs;
   if (!args.session.empty()) {
     if (!args.left.empty() || !args.right.empty()) {
       throw InputError(
@@ -76,31 +75,43 @@ int RunTrack(const TrackArgs& args) {
       so.joint_names = ReadRobot(args.robot).JointNames();
       so.require_joint_readings = !args.out_obs.empty();
     }
-    session = ReadSession(args.session, so);
-    for (const SessionFrame& f : session.frames) {
-      left.push_back(f.left_image);
-      right.push_back(f.right_image);
+    pairs.session = ReadSession(args.session, so);
+    for (const SessionFrame& f : pairs.session.frames) {
+      pairs.left.push_back(f.left_image);
+      pairs.right.push_back(f.right_image);
     }
-    if (left.empty()) {
+    if (pairs.left.empty()) {
       throw InputError(args.session + ": the session has no complete frame");
     }
   } else {
     if (args.left.empty() || args.right.empty()) {
       throw InputError("give --left and --right (image globs) or --session");
     }
-    left = GlobSortedOrThrow(args.left, "--left");
-    right = GlobSortedOrThrow(args.right, "--right");
+    pairs.left = GlobSortedOrThrow(args.left, "--left");
+    pairs.right = GlobSortedOrThrow(args.right, "--right");
   }
-  if (left.size() != right.size()) {
-    throw InputError("--left matches " + std::to_string(left.size()) +
+  if (pairs.left.size() != pairs.right.size()) {
+    throw InputError("--left matches " + std::to_string(pairs.left.size()) +
                      " images but --right matches " +
-                     std::to_string(right.size()) + "; frames pair in order");
+                     std::to_string(pairs.right.size()) +
+                     "; frames pair in order");
   }
-  // Validate the merge inputs before any work, so bad input writes nothing.
+  return pairs;
+}
+
+// The joint readings the tracked tips are merged into (--out-obs).
+struct Merge {
   Observations merged;
   // merged row of each frame pair, -1 = none (session frames without joint
   // readings).
-  std::vector<int> merged_row(left.size(), -1);
+  std::vector<int> merged_row;
+};
+
+// Validates the merge inputs before any work, so bad input writes nothing.
+Merge PrepareMerge(const TrackArgs& args, const FramePairs& pairs) {
+  Merge merge;
+  Observations& merged = merge.merged;
+  merge.merged_row.assign(pairs.left.size(), -1);
   if (!args.session.empty() && args.obs.empty() &&
       (!args.robot.empty() || !args.out_obs.empty())) {
     if (args.robot.empty() || args.out_obs.empty()) {
@@ -108,17 +119,17 @@ int RunTrack(const TrackArgs& args) {
           "--robot and --out-obs go together (with --session: merge tracked "
           "tips into the session's joint readings)");
     }
-    merged.source = session.frames_csv;
+    merged.source = pairs.session.frames_csv;
     merged.joint_names = ReadRobot(args.robot).JointNames();
-    for (size_t f = 0; f < session.frames.size(); ++f) {
-      const SessionFrame& sf = session.frames[f];
+    for (size_t f = 0; f < pairs.session.frames.size(); ++f) {
+      const SessionFrame& sf = pairs.session.frames[f];
       if (!sf.HasJoints()) continue;
       Observation o;
       o.pose = std::to_string(sf.frame);
       o.q = sf.q;
       o.t_s = sf.t_left;
       o.line = sf.line;
-      merged_row[f] = static_cast<int>(merged.rows.size());
+      merge.merged_row[f] = static_cast<int>(merged.rows.size());
       merged.rows.push_back(o);
     }
   } else if (!args.obs.empty() || !args.out_obs.empty()) {
@@ -128,14 +139,50 @@ int RunTrack(const TrackArgs& args) {
           "into the joint readings of the same frames)");
     }
     merged = ReadObservationsCsv(args.obs, ReadRobot(args.robot).JointNames());
-    if (merged.rows.size() != left.size()) {
+    if (merged.rows.size() != pairs.left.size()) {
       throw InputError(args.obs + ": " + std::to_string(merged.rows.size()) +
-                       " observation rows but " + std::to_string(left.size()) +
+                       " observation rows but " +
+                       std::to_string(pairs.left.size()) +
                        " frame pairs; rows must match frames in order");
     }
-    for (size_t f = 0; f < left.size(); ++f)
-      merged_row[f] = static_cast<int>(f);
+    for (size_t f = 0; f < pairs.left.size(); ++f) {
+      merge.merged_row[f] = static_cast<int>(f);
+    }
   }
+  return merge;
+}
+
+// What tracking every pair produced: the two CSV texts and the counts.
+struct Tracked {
+  std::string points, poses;
+  int found = 0, merged_count = 0;
+  std::vector<int> failed_gate;  // found, but not good
+  std::vector<double> rms_values;
+  int full_searches[2] = {0, 0};
+};
+
+std::string PosesHeader(const std::string& header) {
+  return header + "# rig_from_tool: R row-major, t in mm; tip in rig, mm\n" +
+         "# good = 1: the tip passes the quality gate (>= --min-tags tag "
+         "observations, reprojection RMS <= --max-reproj px); a found tip "
+         "with good = 0 is the tracker's best guess, not a measurement\n" +
+         "frame,found,r00,r01,r02,r10,r11,r12,r20,r21,r22,tx,ty,tz,"
+         "reproj_px,tags,left_image,right_image,good\n";
+}
+
+// The quality gate: enough tags, a tight fit, and both cameras (one camera
+// leaves the depth weak: tens of mm at 2 m).
+bool PassesGate(const TrackArgs& args, const ToolPoseResult& r) {
+  bool cameras[2] = {false, false};
+  for (const TagObservationResult& t : r.tags) {
+    if (t.used && t.camera >= 0 && t.camera < 2) cameras[t.camera] = true;
+  }
+  return r.found && r.tags_used >= args.min_tags &&
+         r.rms_px <= args.max_reproj_px && cameras[0] && cameras[1];
+}
+
+Tracked TrackFrames(const TrackArgs& args, const Rig& rig, const Target& target,
+                    const FramePairs& pairs, Merge* merge) {
   TrackerOptions topt;
   topt.detector.family = target.family;
   topt.detector.quad_decimate = args.decimate;
@@ -145,25 +192,18 @@ int RunTrack(const TrackArgs& args) {
   for (int c = 0; c < 2; ++c)
     trackers.push_back(std::make_unique<TagTracker>(topt));
 
-  const size_t n = left.size();
+  const size_t n = pairs.left.size();
+  Tracked out;
   std::ostringstream points, poses;
   const std::string header =
       "# written by " + ToolVersion() + ": " + CommandLine() + "\n";
   points << header << "frame,x,y,z,reproj_px,tags\n";
-  poses << header << "# rig_from_tool: R row-major, t in mm; tip in rig, mm\n"
-        << "# good = 1: the tip passes the quality gate (>= --min-tags tag "
-           "observations, reprojection RMS <= --max-reproj px); a found tip "
-           "with good = 0 is the tracker's best guess, not a measurement\n"
-        << "frame,found,r00,r01,r02,r10,r11,r12,r20,r21,r22,tx,ty,tz,"
-           "reproj_px,tags,left_image,right_image,good\n";
-  int found = 0, merged_count = 0;
-  std::vector<int> failed_gate;  // found, but not good
-  std::vector<double> rms_values;
+  poses << PosesHeader(header);
   // On a terminal only; silent with --json, --quiet or when piped.
   Progress progress("kincal track", args.json || args.quiet);
   for (size_t f = 0; f < n; ++f) {
     std::vector<std::vector<TagDetection>> dets(2);
-    const std::string* files[2] = {&left[f], &right[f]};
+    const std::string* files[2] = {&pairs.left[f], &pairs.right[f]};
     ForBothCameras([&](int c) {
       dets[c] = trackers[c]->Track(
           ReadCameraImage(*files[c], rig.cameras[c].intrinsics));
@@ -171,27 +211,19 @@ int RunTrack(const TrackArgs& args) {
     const ToolPoseResult r = EstimateToolPose(rig, target, dets);
     points << f;
     poses << f << "," << (r.found ? 1 : 0);
-    // The quality gate: enough tags, a tight fit, and both cameras (one
-    // camera leaves the depth weak: tens of mm at 2 m).
-    bool cameras[2] = {false, false};
-    for (const TagObservationResult& t : r.tags) {
-      if (t.used && t.camera >= 0 && t.camera < 2) cameras[t.camera] = true;
-    }
-    const bool good = r.found && r.tags_used >= args.min_tags &&
-                      r.rms_px <= args.max_reproj_px && cameras[0] &&
-                      cameras[1];
-    if (merged_row[f] >= 0) {
-      Observation& row = merged.rows[merged_row[f]];
+    const bool good = PassesGate(args, r);
+    if (merge->merged_row[f] >= 0) {
+      Observation& row = merge->merged.rows[merge->merged_row[f]];
       row.has_point = good;
       if (good) row.p_in_meas = r.tip_in_rig;
-      merged_count += good ? 1 : 0;
+      out.merged_count += good ? 1 : 0;
     }
     if (r.found) {
-      ++found;
-      rms_values.push_back(r.rms_px);
+      ++out.found;
+      out.rms_values.push_back(r.rms_px);
       for (int i = 0; i < 3; ++i)
         points << "," << FormatDouble(r.tip_in_rig(i));
-      if (!good) failed_gate.push_back(static_cast<int>(f));
+      if (!good) out.failed_gate.push_back(static_cast<int>(f));
       points << "," << FormatDouble(r.rms_px) << "," << r.tags_used << "\n";
       for (int i = 0; i < 9; ++i) {
         poses << "," << FormatDouble(r.rig_from_tool.R(i / 3, i % 3));
@@ -204,73 +236,100 @@ int RunTrack(const TrackArgs& args) {
       points << ",,,,,0\n";
       poses << ",,,,,,,,,,,,,,0";
     }
-    poses << "," << CsvQuote(left[f]) << "," << CsvQuote(right[f]) << ","
-          << (good ? 1 : 0) << "\n";
+    poses << "," << CsvQuote(pairs.left[f]) << "," << CsvQuote(pairs.right[f])
+          << "," << (good ? 1 : 0) << "\n";
     progress.Update(static_cast<long>(f + 1), static_cast<long>(n),
-                    "frames (" + std::to_string(found) + " with a tip)");
+                    "frames (" + std::to_string(out.found) + " with a tip)");
   }
-  WriteFileAtomic(args.out, points.str());
-  const std::string poses_path = PosesPath(args.out);
-  WriteFileAtomic(poses_path, poses.str());
-  if (!merged.rows.empty()) {
-    WriteFileAtomic(args.out_obs,
-                    FormatObservationsCsv(
-                        merged, {"joint readings from " + merged.source +
-                                 "; x,y,z = needle tip tracked in the rig "
-                                 "frame (empty where the tool was not found, "
-                                 "seen by one camera only, or with fewer "
-                                 "than " +
-                                 std::to_string(args.min_tags) +
-                                 " tags or a reprojection RMS over " +
-                                 FormatDouble(args.max_reproj_px) + " px)"}));
-  }
-  const double seconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start)
-          .count();
-  double median_rms = 0;
-  if (!rms_values.empty()) {
-    std::nth_element(rms_values.begin(),
-                     rms_values.begin() + rms_values.size() / 2,
-                     rms_values.end());
-    median_rms = rms_values[rms_values.size() / 2];
-  }
-  const int full0 = trackers[0]->full_searches();
-  const int full1 = trackers[1]->full_searches();
+  out.points = points.str();
+  out.poses = poses.str();
+  out.full_searches[0] = trackers[0]->full_searches();
+  out.full_searches[1] = trackers[1]->full_searches();
+  return out;
+}
+
+void WriteMergedObservations(const TrackArgs& args,
+                             const Observations& merged) {
+  WriteFileAtomic(args.out_obs,
+                  FormatObservationsCsv(
+                      merged, {"joint readings from " + merged.source +
+                               "; x,y,z = needle tip tracked in the rig "
+                               "frame (empty where the tool was not found, "
+                               "seen by one camera only, or with fewer "
+                               "than " +
+                               std::to_string(args.min_tags) +
+                               " tags or a reprojection RMS over " +
+                               FormatDouble(args.max_reproj_px) + " px)"}));
+}
+
+double MedianOf(std::vector<double> values) {
+  if (values.empty()) return 0;
+  std::nth_element(values.begin(), values.begin() + values.size() / 2,
+                   values.end());
+  return values[values.size() / 2];
+}
+
+void PrintTrack(const TrackArgs& args, size_t n, const Tracked& t, bool merged,
+                const std::string& poses_path, double seconds) {
+  const double median_rms = MedianOf(t.rms_values);
+  const int full0 = t.full_searches[0], full1 = t.full_searches[1];
   if (args.json) {
     nlohmann::json j;
     j["frames"] = n;
-    j["found"] = found;
-    j["good"] = found - static_cast<int>(failed_gate.size());
-    j["failed_gate"] = failed_gate;
+    j["found"] = t.found;
+    j["good"] = t.found - static_cast<int>(t.failed_gate.size());
+    j["failed_gate"] = t.failed_gate;
     j["seconds"] = seconds;
     j["out"] = args.out;
     j["poses"] = poses_path;
     j["median_reproj_px"] = median_rms;
     j["full_searches"] = {full0, full1};
-    if (!merged.rows.empty()) {
+    if (merged) {
       j["out_obs"] = args.out_obs;
-      j["merged"] = merged_count;
+      j["merged"] = t.merged_count;
     }
     PrintJson(j);
-    return 0;
+    return;
   }
   std::printf("kincal track: %zu frame pairs, tip found in %d (%.1f s)\n", n,
-              found, seconds);
+              t.found, seconds);
   std::printf("  median reprojection RMS %.3f px; full-frame searches %d/%d\n",
               median_rms, full0, full1);
-  if (!failed_gate.empty()) {
+  if (!t.failed_gate.empty()) {
     std::printf(
         "  %zu found tips fail the quality gate (< %d tags, > %.2f px or "
         "one camera; "
         "good = 0 in %s): frames",
-        failed_gate.size(), args.min_tags, args.max_reproj_px,
+        t.failed_gate.size(), args.min_tags, args.max_reproj_px,
         poses_path.c_str());
-    for (size_t k = 0; k < failed_gate.size() && k < 20; ++k) {
-      std::printf(" %d", failed_gate[k]);
+    for (size_t k = 0; k < t.failed_gate.size() && k < 20; ++k) {
+      std::printf(" %d", t.failed_gate[k]);
     }
-    std::printf(failed_gate.size() > 20 ? " ...\n" : "\n");
+    std::printf(t.failed_gate.size() > 20 ? " ...\n" : "\n");
   }
   std::printf("  wrote %s and %s\n", args.out.c_str(), poses_path.c_str());
+}
+
+int RunTrack(const TrackArgs& args) {
+  const auto start = std::chrono::steady_clock::now();
+  const Rig rig = ReadRigYaml(args.rig);
+  const Target target = ReadTargetYaml(args.target);
+  if (rig.cameras.size() < 2) {
+    throw InputError(args.rig + ": track needs a stereo rig (2 cameras), got " +
+                     std::to_string(rig.cameras.size()));
+  }
+  const FramePairs pairs = ListFramePairs(args);
+  Merge merge = PrepareMerge(args, pairs);
+  const Tracked tracked = TrackFrames(args, rig, target, pairs, &merge);
+  WriteFileAtomic(args.out, tracked.points);
+  const std::string poses_path = PosesPath(args.out);
+  WriteFileAtomic(poses_path, tracked.poses);
+  const bool merged = !merge.merged.rows.empty();
+  if (merged) WriteMergedObservations(args, merge.merged);
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start)
+          .count();
+  PrintTrack(args, pairs.left.size(), tracked, merged, poses_path, seconds);
   return 0;
 }
 
@@ -309,11 +368,10 @@ void AddTrackCommand(CLI::App& app, Runner* run) {
       ->capture_default_str();
   sub->add_flag("--json", args->json, "print one JSON object");
   sub->footer(
-      "Example:\n  kincal track --rig rig.yaml --target target.yaml --left "
-      "'session/left/*.png' --right 'session/right/*.png' --out "
-      "session/points.csv\n  kincal report --rig rig.yaml --session session "
-      "--out tracking.html\nUnits: lengths mm, angles deg, time s (pixels px). "
-      "Defaults are shown beside each option.");
+      HelpFooter("Example:\n  kincal track --rig rig.yaml --target target.yaml "
+                 "--left 'session/left/*.png' --right 'session/right/*.png' "
+                 "--out session/points.csv\n  kincal report --rig rig.yaml "
+                 "--session session --out tracking.html"));
   sub->callback([run, args] { *run = [args] { return RunTrack(*args); }; });
 }
 

@@ -75,20 +75,14 @@ int ExecImageBinary() {
   return 1;
 }
 
-void AddCamcalCommand(CLI::App& app, Runner* run) {
-  AddImageCommand(app, run, "camcal", kCamcalDescription);
-}
-
-void AddTrackCommand(CLI::App& app, Runner* run) {
-  AddImageCommand(app, run, "track", kTrackDescription);
-}
-
-void AddCaptureCommand(CLI::App& app, Runner* run) {
-  AddImageCommand(app, run, "capture", kCaptureDescription);
-}
-
-void AddBundleCommand(CLI::App& app, Runner* run) {
-  AddImageCommand(app, run, "bundle", kBundleDescription);
-}
+// AddCamcalCommand, AddTrackCommand, ...: one per name in
+// KINCAL_IMAGE_COMMANDS (app/CMakeLists.txt), each listed with its
+// k<Name>Description.
+#define KINCAL_IMAGE_COMMAND(name, Name)                    \
+  void Add##Name##Command(CLI::App& app, Runner* run) {     \
+    AddImageCommand(app, run, #name, k##Name##Description); \
+  }
+#include "app/image_commands.inc"
+#undef KINCAL_IMAGE_COMMAND
 
 }  // namespace kincal::app

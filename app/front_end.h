@@ -10,8 +10,9 @@
 //                      imgcodecs and videoio alone bring GDAL, HDF5,
 //                      GStreamer...: ~270 shared libraries, 0.2-0.3 s to load)
 //
-// In bin/kincal, the image commands (camcal, track, capture, bundle) are
-// registered by app/front_end.cc with their names and descriptions only (so
+// In bin/kincal, the image commands (KINCAL_IMAGE_COMMANDS in
+// app/CMakeLists.txt: camcal, track, capture, bundle) are registered by
+// app/front_end.cc with their names and descriptions only (so
 // `kincal --help` lists them) and accept any arguments; once CLI11 selects
 // one, or `simulate` is given --render, kincal replaces itself by
 // kincal-vision with the same argv (exec), so output, exit codes, provenance

@@ -171,6 +171,202 @@ JointLog ReadJointLog(const std::string& path,
   return ParseJointLog(ReadFile(path), path, expected, max_gap_s);
 }
 
+namespace {
+
+// The robot's stops as seen in the images and in the log, for the offset.
+struct Stops {
+  std::vector<double> img_times;  // image motion times (half a frame early)
+  std::vector<char> img_moving;   // per frame: the image moves
+  std::vector<double> img_stops, log_stops;
+  double period = 0;  // mean frame period, s
+};
+
+Stops FindStops(const JointLog& log, const std::vector<double>& speeds,
+                const std::vector<double>& frame_times,
+                const std::vector<double>& image_motion,
+                const JointMergeOptions& options) {
+  Stops stops;
+  const double first = frame_times.front(), last = frame_times.back();
+  // Image moving/still: between the still level and the moving level.
+  const double p10 = Percentile(image_motion, 0.1);
+  const double p90 = Percentile(image_motion, 0.9);
+  const double threshold = p10 + 0.3 * (p90 - p10);
+  stops.img_moving.resize(frame_times.size());
+  for (size_t k = 0; k < frame_times.size(); ++k) {
+    stops.img_moving[k] = image_motion[k] > threshold;
+  }
+  std::vector<char> log_moving(log.t.size());
+  for (size_t i = 0; i < log.t.size(); ++i) {
+    log_moving[i] = SpeedAt(log, speeds, log.t[i]) > options.still_speed;
+  }
+  // Image motion k is the change from frame k-1 to frame k: it shows the
+  // robot's motion half a frame period before frame k.
+  stops.period = (last - first) / std::max<size_t>(1, frame_times.size() - 1);
+  stops.img_times = frame_times;
+  for (double& t : stops.img_times) t -= 0.5 * stops.period;
+  stops.img_stops = StopEvents(stops.img_times, stops.img_moving);
+  stops.log_stops = StopEvents(log.t, log_moving);
+  if (stops.img_stops.empty() || stops.log_stops.empty() || p90 <= p10) {
+    throw InputError(
+        log.source, 0, 0,
+        "cannot estimate the clock offset: the " +
+            std::string(stops.img_stops.empty() || p90 <= p10 ? "images"
+                                                              : "joint log") +
+            " show no stop of the robot; give --joints-offset");
+  }
+  return stops;
+}
+
+// The offset in [lo, hi] that best matches image stops to log stops;
+// InputError when none matches or a distinct one fits as well.
+double MatchStops(const JointLog& log, const Stops& stops, double lo,
+                  double hi) {
+  const std::vector<double>& img_stops = stops.img_stops;
+  const std::vector<double>& log_stops = stops.log_stops;
+  const double period = stops.period;
+  auto event_cost = [&](double offset) {
+    double cost = 0;
+    for (double e : img_stops) {
+      const double x = e - offset;
+      auto it = std::lower_bound(log_stops.begin(), log_stops.end(), x);
+      double d = 1e9;
+      if (it != log_stops.end()) d = std::min(d, *it - x);
+      if (it != log_stops.begin()) d = std::min(d, x - *(it - 1));
+      cost += std::min(d, 5 * period);
+    }
+    return cost;
+  };
+  double best = 0, best_cost = std::numeric_limits<double>::infinity();
+  for (double ei : img_stops) {
+    for (double el : log_stops) {
+      const double offset = ei - el;
+      if (offset < lo || offset > hi) continue;
+      const double c = event_cost(offset);
+      if (c < best_cost) {
+        best_cost = c;
+        best = offset;
+      }
+    }
+  }
+  // A second, distinct offset (more than a second away) that fits about
+  // as well means the stops repeat periodically: refuse to guess.
+  double second_cost = std::numeric_limits<double>::infinity();
+  for (double ei : img_stops) {
+    for (double el : log_stops) {
+      const double offset = ei - el;
+      if (offset < lo || offset > hi || std::abs(offset - best) < 1.0) {
+        continue;
+      }
+      second_cost = std::min(second_cost, event_cost(offset));
+    }
+  }
+  if (std::isfinite(best_cost) &&
+      second_cost <= 1.2 * best_cost + 0.5 * period) {
+    throw InputError(log.source, 0, 0,
+                     "the clock offset is ambiguous: offsets " + Num(best) +
+                         " s and "
+                         "others fit the robot's stops equally well (a "
+                         "periodic program?); "
+                         "give --joints-offset or vary the dwell times");
+  }
+  if (!std::isfinite(best_cost)) {
+    throw InputError(log.source, 0, 0,
+                     "cannot estimate the clock offset: no stop of the "
+                     "robot in the images matches one in the joint log "
+                     "within its coverage; give --joints-offset");
+  }
+  return best;
+}
+
+// Estimates merge->offset_s from when the robot stops in the images and in
+// the log, then refines it by the agreement of the moving indicators.
+void EstimateOffset(const JointLog& log, const std::vector<double>& speeds,
+                    const std::vector<double>& frame_times,
+                    const std::vector<double>& image_motion, double lo,
+                    double hi, const JointMergeOptions& options,
+                    JointMerge* merge) {
+  const double first = frame_times.front(), last = frame_times.back();
+  if (lo > hi) {
+    throw InputError(log.source, 0, 0,
+                     "the joint log spans " +
+                         Num(log.t.back() - log.t.front()) +
+                         " s but the session " + Num(last - first) +
+                         " s: it cannot cover the session");
+  }
+  if (image_motion.size() != frame_times.size()) {
+    throw InputError(
+        "cannot estimate the joint log's clock offset without "
+        "image motion: give --joints-offset");
+  }
+  const Stops stops =
+      FindStops(log, speeds, frame_times, image_motion, options);
+  const double period = stops.period;
+  double best = MatchStops(log, stops, lo, hi);
+  // Refine: agreement of the moving indicators, 1 ms grid, +-2 periods;
+  // the middle of the best plateau.
+  auto agreement = [&](double offset) {
+    int agree = 0;
+    for (size_t k = 0; k < frame_times.size(); ++k) {
+      const double x = std::max(stops.img_times[k] - offset, log.t.front());
+      const bool m = SpeedAt(log, speeds, x) > options.still_speed;
+      agree += m == static_cast<bool>(stops.img_moving[k]);
+    }
+    return static_cast<double>(agree) / frame_times.size();
+  };
+  double best_agree = -1;
+  std::vector<double> plateau;
+  for (double d = -2 * period; d <= 2 * period + 1e-12; d += 0.001) {
+    const double offset = best + d;
+    if (offset < lo || offset > hi) continue;
+    const double a = agreement(offset);
+    if (a > best_agree + 1e-12) {
+      best_agree = a;
+      plateau = {offset};
+    } else if (a > best_agree - 1e-12) {
+      plateau.push_back(offset);
+    }
+  }
+  if (!plateau.empty()) best = 0.5 * (plateau.front() + plateau.back());
+  merge->offset_s = best;
+  merge->estimated = true;
+  merge->agreement = best_agree;
+  int matched = 0;
+  for (double e : stops.img_stops) {
+    for (double l : stops.log_stops) matched += std::abs(e - best - l) < period;
+  }
+  merge->stops_matched = matched;
+}
+
+// Per frame, the log's reading interpolated at the frame's time on the log
+// clock; NaN while a joint moves faster than max_speed (or, uncovered_ok,
+// outside the log).
+void InterpolateReadings(const JointLog& log, const std::vector<double>& speeds,
+                         const std::vector<double>& frame_times,
+                         const JointMergeOptions& options, JointMerge* merge) {
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  for (double tf : frame_times) {
+    const double x = tf - merge->offset_s;
+    std::vector<double> q(log.names.size(), nan);
+    if (x < log.t.front() || x > log.t.back()) {  // uncovered_ok only
+      merge->joints.push_back(q);
+      continue;
+    }
+    const size_t i = Segment(log.t, x);
+    const double w = (x - log.t[i]) / (log.t[i + 1] - log.t[i]);
+    if (SpeedAt(log, speeds, x) > options.max_speed) {
+      ++merge->too_fast;
+    } else {
+      for (size_t j = 0; j < q.size(); ++j) {
+        q[j] = (1 - w) * log.q[i][j] + w * log.q[i + 1][j];
+      }
+      ++merge->with_reading;
+    }
+    merge->joints.push_back(q);
+  }
+}
+
+}  // namespace
+
 JointMerge MergeJointLog(const JointLog& log,
                          const std::vector<double>& frame_times,
                          const std::vector<double>& image_motion,
@@ -186,130 +382,8 @@ JointMerge MergeJointLog(const JointLog& log,
     merge.offset_s = *options.offset_s;
     merge.agreement = std::numeric_limits<double>::quiet_NaN();
   } else {
-    if (lo > hi) {
-      throw InputError(log.source, 0, 0,
-                       "the joint log spans " +
-                           Num(log.t.back() - log.t.front()) +
-                           " s but the session " + Num(last - first) +
-                           " s: it cannot cover the session");
-    }
-    if (image_motion.size() != frame_times.size()) {
-      throw InputError(
-          "cannot estimate the joint log's clock offset without "
-          "image motion: give --joints-offset");
-    }
-    // Image moving/still: between the still level and the moving level.
-    const double p10 = Percentile(image_motion, 0.1);
-    const double p90 = Percentile(image_motion, 0.9);
-    const double threshold = p10 + 0.3 * (p90 - p10);
-    std::vector<char> img_moving(frame_times.size());
-    for (size_t k = 0; k < frame_times.size(); ++k) {
-      img_moving[k] = image_motion[k] > threshold;
-    }
-    std::vector<char> log_moving(log.t.size());
-    for (size_t i = 0; i < log.t.size(); ++i) {
-      log_moving[i] = SpeedAt(log, speeds, log.t[i]) > options.still_speed;
-    }
-    // Image motion k is the change from frame k-1 to frame k: it shows the
-    // robot's motion half a frame period before frame k.
-    const double period =
-        (last - first) / std::max<size_t>(1, frame_times.size() - 1);
-    std::vector<double> img_times(frame_times);
-    for (double& t : img_times) t -= 0.5 * period;
-    const std::vector<double> img_stops = StopEvents(img_times, img_moving);
-    const std::vector<double> log_stops = StopEvents(log.t, log_moving);
-    if (img_stops.empty() || log_stops.empty() || p90 <= p10) {
-      throw InputError(
-          log.source, 0, 0,
-          "cannot estimate the clock offset: the " +
-              std::string(img_stops.empty() || p90 <= p10 ? "images"
-                                                          : "joint log") +
-              " show no stop of the robot; give --joints-offset");
-    }
-    auto event_cost = [&](double offset) {
-      double cost = 0;
-      for (double e : img_stops) {
-        const double x = e - offset;
-        auto it = std::lower_bound(log_stops.begin(), log_stops.end(), x);
-        double d = 1e9;
-        if (it != log_stops.end()) d = std::min(d, *it - x);
-        if (it != log_stops.begin()) d = std::min(d, x - *(it - 1));
-        cost += std::min(d, 5 * period);
-      }
-      return cost;
-    };
-    double best = 0, best_cost = std::numeric_limits<double>::infinity();
-    for (double ei : img_stops) {
-      for (double el : log_stops) {
-        const double offset = ei - el;
-        if (offset < lo || offset > hi) continue;
-        const double c = event_cost(offset);
-        if (c < best_cost) {
-          best_cost = c;
-          best = offset;
-        }
-      }
-    }
-    // A second, distinct offset (more than a second away) that fits about
-    // as well means the stops repeat periodically: refuse to guess.
-    double second_cost = std::numeric_limits<double>::infinity();
-    for (double ei : img_stops) {
-      for (double el : log_stops) {
-        const double offset = ei - el;
-        if (offset < lo || offset > hi || std::abs(offset - best) < 1.0) {
-          continue;
-        }
-        second_cost = std::min(second_cost, event_cost(offset));
-      }
-    }
-    if (std::isfinite(best_cost) &&
-        second_cost <= 1.2 * best_cost + 0.5 * period) {
-      throw InputError(log.source, 0, 0,
-                       "the clock offset is ambiguous: offsets " + Num(best) +
-                           " s and "
-                           "others fit the robot's stops equally well (a "
-                           "periodic program?); "
-                           "give --joints-offset or vary the dwell times");
-    }
-    if (!std::isfinite(best_cost)) {
-      throw InputError(log.source, 0, 0,
-                       "cannot estimate the clock offset: no stop of the "
-                       "robot in the images matches one in the joint log "
-                       "within its coverage; give --joints-offset");
-    }
-    // Refine: agreement of the moving indicators, 1 ms grid, +-2 periods;
-    // the middle of the best plateau.
-    auto agreement = [&](double offset) {
-      int agree = 0;
-      for (size_t k = 0; k < frame_times.size(); ++k) {
-        const double x = std::max(img_times[k] - offset, log.t.front());
-        const bool m = SpeedAt(log, speeds, x) > options.still_speed;
-        agree += m == static_cast<bool>(img_moving[k]);
-      }
-      return static_cast<double>(agree) / frame_times.size();
-    };
-    double best_agree = -1;
-    std::vector<double> plateau;
-    for (double d = -2 * period; d <= 2 * period + 1e-12; d += 0.001) {
-      const double offset = best + d;
-      if (offset < lo || offset > hi) continue;
-      const double a = agreement(offset);
-      if (a > best_agree + 1e-12) {
-        best_agree = a;
-        plateau = {offset};
-      } else if (a > best_agree - 1e-12) {
-        plateau.push_back(offset);
-      }
-    }
-    if (!plateau.empty()) best = 0.5 * (plateau.front() + plateau.back());
-    merge.offset_s = best;
-    merge.estimated = true;
-    merge.agreement = best_agree;
-    int matched = 0;
-    for (double e : img_stops) {
-      for (double l : log_stops) matched += std::abs(e - best - l) < period;
-    }
-    merge.stops_matched = matched;
+    EstimateOffset(log, speeds, frame_times, image_motion, lo, hi, options,
+                   &merge);
   }
   // Coverage with the chosen offset.
   if (!options.uncovered_ok && (first - merge.offset_s < log.t.front() - 1e-9 ||
@@ -322,26 +396,7 @@ JointMerge MergeJointLog(const JointLog& log,
                          Num(merge.offset_s) + " s), the frames " + Num(first) +
                          " .. " + Num(last) + " s");
   }
-  const double nan = std::numeric_limits<double>::quiet_NaN();
-  for (double tf : frame_times) {
-    const double x = tf - merge.offset_s;
-    std::vector<double> q(log.names.size(), nan);
-    if (x < log.t.front() || x > log.t.back()) {  // uncovered_ok only
-      merge.joints.push_back(q);
-      continue;
-    }
-    const size_t i = Segment(log.t, x);
-    const double w = (x - log.t[i]) / (log.t[i + 1] - log.t[i]);
-    if (SpeedAt(log, speeds, x) > options.max_speed) {
-      ++merge.too_fast;
-    } else {
-      for (size_t j = 0; j < q.size(); ++j) {
-        q[j] = (1 - w) * log.q[i][j] + w * log.q[i + 1][j];
-      }
-      ++merge.with_reading;
-    }
-    merge.joints.push_back(q);
-  }
+  InterpolateReadings(log, speeds, frame_times, options, &merge);
   return merge;
 }
 

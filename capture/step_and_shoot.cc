@@ -47,108 +47,188 @@ StereoFrame AveragePairs(const std::vector<StereoFrame>& pairs) {
   return out;
 }
 
-StepAndShootResult RunStepAndShoot(StereoGrabber* grabber, bool live,
-                                   const StepAndShootOptions& options) {
-  StepAndShootResult result;
-  auto fail = [&](StepAndShootResult::Outcome outcome, std::string message) {
-    result.outcome = outcome;
-    result.message = std::move(message);
-    return result;
-  };
-  auto interrupted = [&] {
-    return options.interrupted != nullptr && options.interrupted->load();
-  };
-  const std::vector<std::string>& names = options.joint_names;
-  RobotLink link;
-  Status s = link.Listen(options.listen);
+namespace {
+
+using Outcome = StepAndShootResult::Outcome;
+
+bool Interrupted(const StepAndShootOptions& options) {
+  return options.interrupted != nullptr && options.interrupted->load();
+}
+
+void SetOutcome(StepAndShootResult* result, Outcome outcome,
+                std::string message) {
+  result->outcome = outcome;
+  result->message = std::move(message);
+}
+
+// Waits for the robot and checks its HELLO (nothing is written before it
+// passes); `order` maps HELLO positions to robot joint indices. False with
+// the result's outcome set when it does not pass.
+bool ConnectRobot(const StepAndShootOptions& options, RobotLink* link,
+                  std::vector<int>* order, StepAndShootResult* result) {
+  Status s = link->Listen(options.listen);
   if (!s.ok()) {
-    return fail(s.kind() == Status::Kind::kUnsupported
-                    ? StepAndShootResult::kBadInput
-                    : StepAndShootResult::kFailure,
-                "--robot-listen: " + s.message());
+    SetOutcome(result,
+               s.kind() == Status::Kind::kUnsupported
+                   ? StepAndShootResult::kBadInput
+                   : StepAndShootResult::kFailure,
+               "--robot-listen: " + s.message());
+    return false;
   }
   if (options.announce) {
-    std::cerr << "kincal capture: waiting for the robot on port " << link.port()
-              << "\n";
+    std::cerr << "kincal capture: waiting for the robot on port "
+              << link->port() << "\n";
   }
-  s = link.Accept(options.timeout_s);
-  if (!s.ok()) return fail(StepAndShootResult::kFailure, s.ToString());
-  // HELLO: validated before anything is written.
-  std::vector<int> order;  // HELLO position -> robot joint index
-  s = ReceiveHello(&link, names, options.robot_file, options.timeout_s, &order,
-                   &result.robot_name);
+  s = link->Accept(options.timeout_s);
   if (!s.ok()) {
-    return fail(s.kind() == Status::Kind::kUnsupported
-                    ? StepAndShootResult::kBadInput
-                    : StepAndShootResult::kFailure,
-                s.message() + " (nothing written)");
+    SetOutcome(result, StepAndShootResult::kFailure, s.ToString());
+    return false;
   }
-
-  SessionInfo info = options.info;
-  info.joint_names = names;
-  info.settings["mode"] = "step_and_shoot";
-  info.settings["shots_per_pose"] = std::to_string(options.shots);
-  info.settings["robot"] = result.robot_name;
-  SessionRecorder recorder(options.recorder);
-  s = recorder.Open(options.out, info);
+  s = ReceiveHello(link, options.joint_names, options.robot_file,
+                   options.timeout_s, order, &result->robot_name);
   if (!s.ok()) {
-    link.WriteLine("ERROR cannot create the session");
-    return fail(StepAndShootResult::kFailure, s.ToString());
+    SetOutcome(result,
+               s.kind() == Status::Kind::kUnsupported
+                   ? StepAndShootResult::kBadInput
+                   : StepAndShootResult::kFailure,
+               s.message() + " (nothing written)");
+    return false;
   }
-  result.session_created = true;
-  link.WriteLine("OK kincal 1");
+  return true;
+}
 
-  const auto start = std::chrono::steady_clock::now();
-  std::string line, error, failure, bad_input;
+// Short reads so Ctrl-C is seen; the total wait is timeout_s.
+Status ReadMessageLine(const StepAndShootOptions& options, RobotLink* link,
+                       std::string* line) {
+  Status s;
+  double waited = 0;
+  do {
+    s = link->ReadLine(0.25, line);
+    waited += 0.25;
+  } while (s.kind() == Status::Kind::kTimeout && !Interrupted(options) &&
+           waited < options.timeout_s);
+  return s;
+}
+
+// `shots` pairs taken after `settled_at` (live sources; replay: the next
+// pairs).
+Status GrabSettledPairs(StereoGrabber* grabber, bool live, int shots,
+                        double settled_at, std::vector<StereoFrame>* pairs) {
+  while (static_cast<int>(pairs->size()) < shots) {
+    StereoFrame pair;
+    const Status s = grabber->Grab(&pair);
+    if (!s.ok()) return s;
+    if (live &&
+        std::max(pair.left.timestamp_s, pair.right.timestamp_s) < settled_at) {
+      continue;  // taken before the robot had settled
+    }
+    pairs->push_back(std::move(pair));
+  }
+  return Status();
+}
+
+// What the pose loop leaves behind: the CSV texts and why it stopped.
+struct PoseLoop {
+  std::string stream_csv;  // joints.csv: the robot's J lines
+  std::string obs_csv;     // observations.csv: one row per recorded pose
+  std::string failure;     // robot, camera or disk failure
+  std::string bad_input;   // a malformed robot message
+};
+
+PoseLoop StartPoseLoop(const std::vector<std::string>& names) {
+  PoseLoop loop;
+  loop.stream_csv = "t";
+  loop.obs_csv = "# " + CommandLine() + "\npose";
+  for (const std::string& n : names) {
+    loop.stream_csv += "," + n;
+    loop.obs_csv += "," + n;
+  }
+  loop.stream_csv += "\n";
+  loop.obs_csv += "\n";
+  return loop;
+}
+
+// SETTLED: grab, average and record one pair with the readings, answer
+// DONE. False (with loop->failure set) when the loop must stop.
+bool ShootPose(const RobotMessage& m, const std::vector<double>& q,
+               StereoGrabber* grabber, bool live,
+               const StepAndShootOptions& options, RobotLink* link,
+               SessionRecorder* recorder, PoseLoop* loop,
+               StepAndShootResult* result, long* last_pose) {
+  std::vector<StereoFrame> shots;
+  Status s = GrabSettledPairs(grabber, live, options.shots, MonotonicSeconds(),
+                              &shots);
+  if (!s.ok()) {
+    loop->failure =
+        "grab at pose " + std::to_string(m.pose) + ": " + s.ToString();
+    link->WriteLine("ERROR camera: " + s.message());
+    return false;
+  }
+  s = recorder->Write(AveragePairs(shots), q);
+  if (!s.ok()) {
+    loop->failure = "write: " + s.ToString();
+    link->WriteLine("ERROR recording: " + s.message());
+    return false;
+  }
+  ++result->poses;
+  *last_pose = m.pose;
+  loop->obs_csv += std::to_string(m.pose);
+  AppendValues(q, &loop->obs_csv);
+  s = link->WriteLine("DONE " + std::to_string(m.pose) + " " +
+                      std::to_string(shots.size()));
+  if (!s.ok()) {
+    loop->failure = "robot link lost after pose " + std::to_string(m.pose) +
+                    ": " + s.message();
+    return false;
+  }
+  return true;
+}
+
+// Reads the robot's messages until BYE, Ctrl-C, a malformed message or a
+// failure: J lines go to joints.csv, each SETTLED records one pose.
+PoseLoop RecordPoses(StereoGrabber* grabber, bool live,
+                     const StepAndShootOptions& options,
+                     const std::vector<int>& order, RobotLink* link,
+                     SessionRecorder* recorder, StepAndShootResult* result) {
+  const std::vector<std::string>& names = options.joint_names;
+  PoseLoop loop = StartPoseLoop(names);
+  std::string line, error;
   long last_pose = -1;
   int line_number = 1;
-  std::string stream_csv = "t", obs_csv = "# " + CommandLine() + "\npose";
-  for (const std::string& n : names) {
-    stream_csv += "," + n;
-    obs_csv += "," + n;
-  }
-  stream_csv += "\n";
-  obs_csv += "\n";
   for (;;) {
-    if (interrupted()) {
-      result.stop_reason = "interrupted";
+    if (Interrupted(options)) {
+      result->stop_reason = "interrupted";
       break;
     }
-    // Short reads so Ctrl-C is seen; the total wait is timeout_s.
-    double waited = 0;
-    do {
-      s = link.ReadLine(0.25, &line);
-      waited += 0.25;
-    } while (s.kind() == Status::Kind::kTimeout && !interrupted() &&
-             waited < options.timeout_s);
-    if (interrupted()) continue;
+    const Status s = ReadMessageLine(options, link, &line);
+    if (Interrupted(options)) continue;
     if (s.kind() == Status::Kind::kTimeout) {
-      failure = "no message from the robot for " +
-                std::to_string(static_cast<int>(options.timeout_s)) + " s";
+      loop.failure = "no message from the robot for " +
+                     std::to_string(static_cast<int>(options.timeout_s)) + " s";
       break;
     }
     if (!s.ok()) {
-      failure = "robot link lost after " + std::to_string(result.poses) +
-                " poses (last pose " + std::to_string(last_pose) +
-                ") without BYE: " + s.message();
+      loop.failure = "robot link lost after " + std::to_string(result->poses) +
+                     " poses (last pose " + std::to_string(last_pose) +
+                     ") without BYE: " + s.message();
       break;
     }
     ++line_number;
     RobotMessage m;
     if (!ParseRobotMessage(line, static_cast<int>(names.size()), &m, &error)) {
-      bad_input = "robot link, line " + std::to_string(line_number) + " '" +
-                  line + "': " + error;
-      link.WriteLine("ERROR " + error);
+      loop.bad_input = "robot link, line " + std::to_string(line_number) +
+                       " '" + line + "': " + error;
+      link->WriteLine("ERROR " + error);
       break;
     }
     if (m.kind == RobotMessage::kBye) {
-      result.stop_reason = "robot_bye";
+      result->stop_reason = "robot_bye";
       break;
     }
     if (m.kind == RobotMessage::kHello) {
-      bad_input = "robot link, line " + std::to_string(line_number) +
-                  ": a second HELLO";
-      link.WriteLine("ERROR a second HELLO");
+      loop.bad_input = "robot link, line " + std::to_string(line_number) +
+                       ": a second HELLO";
+      link->WriteLine("ERROR a second HELLO");
       break;
     }
     std::vector<double> q(names.size());
@@ -156,51 +236,51 @@ StepAndShootResult RunStepAndShoot(StereoGrabber* grabber, bool live,
     if (m.kind == RobotMessage::kJoints) {
       char buf[64];
       std::snprintf(buf, sizeof(buf), "%.6f", m.t);
-      stream_csv += buf;
-      AppendValues(q, &stream_csv);
-      result.joint_stream = true;
+      loop.stream_csv += buf;
+      AppendValues(q, &loop.stream_csv);
+      result->joint_stream = true;
       continue;
     }
-    // SETTLED: `shots` pairs taken after the message arrived.
-    const double settled_at = MonotonicSeconds();
-    std::vector<StereoFrame> shots;
-    while (static_cast<int>(shots.size()) < options.shots) {
-      StereoFrame pair;
-      s = grabber->Grab(&pair);
-      if (!s.ok()) break;
-      if (live && std::max(pair.left.timestamp_s, pair.right.timestamp_s) <
-                      settled_at) {
-        continue;  // taken before the robot had settled
-      }
-      shots.push_back(std::move(pair));
-    }
-    if (!s.ok()) {
-      failure = "grab at pose " + std::to_string(m.pose) + ": " + s.ToString();
-      link.WriteLine("ERROR camera: " + s.message());
-      break;
-    }
-    s = recorder.Write(AveragePairs(shots), q);
-    if (!s.ok()) {
-      failure = "write: " + s.ToString();
-      link.WriteLine("ERROR recording: " + s.message());
-      break;
-    }
-    ++result.poses;
-    last_pose = m.pose;
-    obs_csv += std::to_string(m.pose);
-    AppendValues(q, &obs_csv);
-    s = link.WriteLine("DONE " + std::to_string(m.pose) + " " +
-                       std::to_string(shots.size()));
-    if (!s.ok()) {
-      failure = "robot link lost after pose " + std::to_string(m.pose) + ": " +
-                s.message();
+    if (!ShootPose(m, q, grabber, live, options, link, recorder, &loop, result,
+                   &last_pose)) {
       break;
     }
   }
+  return loop;
+}
+
+}  // namespace
+
+StepAndShootResult RunStepAndShoot(StereoGrabber* grabber, bool live,
+                                   const StepAndShootOptions& options) {
+  StepAndShootResult result;
+  RobotLink link;
+  std::vector<int> order;  // HELLO position -> robot joint index
+  if (!ConnectRobot(options, &link, &order, &result)) return result;
+
+  SessionInfo info = options.info;
+  info.joint_names = options.joint_names;
+  info.settings["mode"] = "step_and_shoot";
+  info.settings["shots_per_pose"] = std::to_string(options.shots);
+  info.settings["robot"] = result.robot_name;
+  SessionRecorder recorder(options.recorder);
+  const Status opened = recorder.Open(options.out, info);
+  if (!opened.ok()) {
+    link.WriteLine("ERROR cannot create the session");
+    SetOutcome(&result, StepAndShootResult::kFailure, opened.ToString());
+    return result;
+  }
+  result.session_created = true;
+  link.WriteLine("OK kincal 1");
+
+  const auto start = std::chrono::steady_clock::now();
+  PoseLoop loop =
+      RecordPoses(grabber, live, options, order, &link, &recorder, &result);
   link.Close();
   result.seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start)
           .count();
+  std::string& failure = loop.failure;
   auto write = [&](const std::string& name, const std::string& text) {
     try {
       WriteFileAtomic(options.out + "/" + name, text);
@@ -208,13 +288,13 @@ StepAndShootResult RunStepAndShoot(StereoGrabber* grabber, bool live,
       if (failure.empty()) failure = e.what();
     }
   };
-  write("observations.csv", obs_csv);
-  if (result.joint_stream) write("joints.csv", stream_csv);
+  write("observations.csv", loop.obs_csv);
+  if (result.joint_stream) write("joints.csv", loop.stream_csv);
   SessionSummary summary;
-  summary.complete = failure.empty() && bad_input.empty();
-  summary.stop_reason = !failure.empty()     ? failure
-                        : !bad_input.empty() ? bad_input
-                                             : result.stop_reason;
+  summary.complete = failure.empty() && loop.bad_input.empty();
+  summary.stop_reason = !failure.empty()          ? failure
+                        : !loop.bad_input.empty() ? loop.bad_input
+                                                  : result.stop_reason;
   summary.dropped_left = grabber->dropped_left();
   summary.dropped_right = grabber->dropped_right();
   summary.seconds = result.seconds;
@@ -222,15 +302,14 @@ StepAndShootResult RunStepAndShoot(StereoGrabber* grabber, bool live,
   if (!fin.ok() && failure.empty()) failure = "finalize: " + fin.ToString();
   result.frames = recorder.frames();
   result.stop_reason = summary.stop_reason;
-  result.complete = failure.empty() && bad_input.empty();
+  result.complete = failure.empty() && loop.bad_input.empty();
   const std::string kept = " (the " + std::to_string(result.frames) +
                            " poses recorded so far are kept in " + options.out +
                            ")";
-  if (!bad_input.empty()) {
-    return fail(StepAndShootResult::kBadInput, bad_input + kept);
-  }
-  if (!failure.empty()) {
-    return fail(StepAndShootResult::kFailure, failure + kept);
+  if (!loop.bad_input.empty()) {
+    SetOutcome(&result, StepAndShootResult::kBadInput, loop.bad_input + kept);
+  } else if (!failure.empty()) {
+    SetOutcome(&result, StepAndShootResult::kFailure, failure + kept);
   }
   return result;
 }

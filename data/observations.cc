@@ -45,27 +45,57 @@ std::string JoinNames(const std::vector<std::string>& names) {
   for (const auto& n : names) s += (s.empty() ? "" : ", ") + n;
   return s;
 }
-}  // namespace
 
-Observations ParseObservationsCsv(const std::string& text,
-                                  const std::string& file,
-                                  const std::vector<std::string>& joint_names) {
-  const std::vector<CsvLine> lines = TokenizeCsv(text, file);
-  if (lines.empty()) {
-    throw InputError(file, 0, 0,
-                     "empty file: expected a header line 'pose," +
-                         JoinNames(joint_names) + ",x,y,z' and rows");
+// What a column of observations.csv holds.
+enum Role { kPose, kJoint, kX, kY, kZ, kFixed, kTime, kTemp };
+struct Column {
+  Role role;
+  int joint = -1;
+  std::string name;
+};
+
+// The role of one header cell; InputError for an unknown column.
+Column HeaderColumn(const CsvField& f, const CsvLine& header,
+                    const std::string& file,
+                    const std::vector<std::string>& joint_names) {
+  const std::string& name = f.text;
+  Column c;
+  c.name = name;
+  if (name == "pose") {
+    c.role = kPose;
+  } else if (name == "x") {
+    c.role = kX;
+  } else if (name == "y") {
+    c.role = kY;
+  } else if (name == "z") {
+    c.role = kZ;
+  } else if (name == "fixed_point") {
+    c.role = kFixed;
+  } else if (name == "t") {
+    c.role = kTime;
+  } else if (name == "temp_c") {
+    c.role = kTemp;
+  } else {
+    c.role = kJoint;
+    for (size_t j = 0; j < joint_names.size(); ++j) {
+      if (joint_names[j] == name) c.joint = static_cast<int>(j);
+    }
+    if (c.joint < 0) {
+      throw InputError(
+          file, header.line, f.column,
+          "unknown column '" + name + "': expected pose, the robot's joints (" +
+              JoinNames(joint_names) + "), x, y, z, fixed_point, t or temp_c");
+    }
   }
-  // Header: map each column to its role.
-  enum Role { kPose, kJoint, kX, kY, kZ, kFixed, kTime, kTemp };
-  struct Column {
-    Role role;
-    int joint = -1;
-    std::string name;
-  };
+  return c;
+}
+
+// The header: each column's role, checked for a pose column, every joint,
+// and all or none of x, y, z.
+std::vector<Column> ParseHeader(const CsvLine& header, const std::string& file,
+                                const std::vector<std::string>& joint_names) {
   std::vector<Column> columns;
   std::set<std::string> seen;
-  const CsvLine& header = lines[0];
   for (const CsvField& f : header.fields) {
     const std::string& name = f.text;
     if (name.empty()) {
@@ -76,36 +106,7 @@ Observations ParseObservationsCsv(const std::string& text,
       throw InputError(file, header.line, f.column,
                        "duplicate column '" + name + "'");
     }
-    Column c;
-    c.name = name;
-    if (name == "pose") {
-      c.role = kPose;
-    } else if (name == "x") {
-      c.role = kX;
-    } else if (name == "y") {
-      c.role = kY;
-    } else if (name == "z") {
-      c.role = kZ;
-    } else if (name == "fixed_point") {
-      c.role = kFixed;
-    } else if (name == "t") {
-      c.role = kTime;
-    } else if (name == "temp_c") {
-      c.role = kTemp;
-    } else {
-      c.role = kJoint;
-      for (size_t j = 0; j < joint_names.size(); ++j) {
-        if (joint_names[j] == name) c.joint = static_cast<int>(j);
-      }
-      if (c.joint < 0) {
-        throw InputError(file, header.line, f.column,
-                         "unknown column '" + name +
-                             "': expected pose, the robot's joints (" +
-                             JoinNames(joint_names) +
-                             "), x, y, z, fixed_point, t or temp_c");
-      }
-    }
-    columns.push_back(c);
+    columns.push_back(HeaderColumn(f, header, file, joint_names));
   }
   if (!seen.count("pose")) {
     throw InputError(file, header.line, 1, "header has no 'pose' column");
@@ -122,116 +123,158 @@ Observations ParseObservationsCsv(const std::string& text,
     throw InputError(file, header.line, header.end_column,
                      "header has only some of x, y, z: give all three or none");
   }
+  return columns;
+}
 
-  Observations obs;
-  obs.source = file;
-  obs.joint_names = joint_names;
-  std::set<std::string> pose_ids;
-  for (size_t li = 1; li < lines.size(); ++li) {
-    const CsvLine& line = lines[li];
-    if (line.fields.size() != columns.size()) {
-      throw InputError(file, line.line,
-                       line.fields.size() > columns.size()
-                           ? line.fields[columns.size()].column
+// The rows of observations.csv, one at a time (pose ids unique across them).
+class RowParser {
+ public:
+  RowParser(const std::string& file, const std::vector<Column>& columns,
+            size_t joints)
+      : file_(file), columns_(columns), joints_(joints) {}
+
+  Observation Parse(const CsvLine& line) {
+    if (line.fields.size() != columns_.size()) {
+      throw InputError(file_, line.line,
+                       line.fields.size() > columns_.size()
+                           ? line.fields[columns_.size()].column
                            : line.end_column,
-                       "expected " + std::to_string(columns.size()) +
+                       "expected " + std::to_string(columns_.size()) +
                            " columns as in the header, got " +
                            std::to_string(line.fields.size()));
     }
     Observation o;
     o.line = line.line;
-    o.q.assign(joint_names.size(), 0.0);
-    int xyz_given = 0;
-    int first_xyz_column = 0;
-    for (size_t c = 0; c < columns.size(); ++c) {
-      const CsvField& f = line.fields[c];
-      const Column& col = columns[c];
-      double v = 0.0;
-      switch (col.role) {
-        case kPose:
-          if (f.text.empty()) {
-            throw InputError(file, line.line, f.column, "empty pose id");
-          }
-          if (!pose_ids.insert(f.text).second) {
-            throw InputError(file, line.line, f.column,
-                             "duplicate pose id '" + f.text + "'");
-          }
-          o.pose = f.text;
-          break;
-        case kJoint:
-          if (!ParseFiniteDouble(f.text, &v)) {
-            throw InputError(file, line.line, f.column,
-                             "column '" + col.name +
-                                 "': expected a finite number (joint reading), "
-                                 "got '" +
-                                 f.text + "'");
-          }
-          // Physical range: deg (revolute, a few turns) or mm (prismatic).
-          if (!(std::abs(v) <= 1e5)) {
-            throw InputError(file, line.line, f.column,
-                             "column '" + col.name +
-                                 "': joint reading out of range (|q| <= "
-                                 "1e5 deg or mm), got '" +
-                                 f.text + "'");
-          }
-          o.q[col.joint] = v;
-          break;
-        case kX:
-        case kY:
-        case kZ:
-          if (f.text.empty()) {
-            if (first_xyz_column == 0) first_xyz_column = f.column;
-            break;
-          }
-          if (!ParseFiniteDouble(f.text, &v)) {
-            throw InputError(file, line.line, f.column,
-                             "column '" + col.name +
-                                 "': expected a finite number (mm) or empty, "
-                                 "got '" +
-                                 f.text + "'");
-          }
-          if (!(std::abs(v) <= 1e6)) {
-            throw InputError(file, line.line, f.column,
-                             "column '" + col.name +
-                                 "': point out of range (|x| <= 1e6 mm, "
-                                 "1 km), got '" +
-                                 f.text + "'");
-          }
-          o.p_in_meas[col.role - kX] = v;
-          ++xyz_given;
-          if (first_xyz_column == 0) first_xyz_column = f.column;
-          break;
-        case kFixed:
-          o.fixed_point = f.text;
-          break;
-        case kTime:
-          if (f.text.empty()) break;
-          if (!ParseFiniteDouble(f.text, &v)) {
-            throw InputError(file, line.line, f.column,
-                             "column 't': expected a finite number (s) or "
-                             "empty, got '" +
-                                 f.text + "'");
-          }
-          o.t_s = v;
-          break;
-        case kTemp:
-          if (f.text.empty()) break;
-          if (!ParseFiniteDouble(f.text, &v) || v < -273.15 || v > 1000.0) {
-            throw InputError(file, line.line, f.column,
-                             "column 'temp_c': expected a temperature in deg "
-                             "C (-273.15..1000) or empty, got '" +
-                                 f.text + "'");
-          }
-          o.temp_c = v;
-          break;
-      }
+    o.q.assign(joints_, 0.0);
+    xyz_given_ = 0;
+    first_xyz_column_ = 0;
+    for (size_t c = 0; c < columns_.size(); ++c) {
+      Cell(line, line.fields[c], columns_[c], &o);
     }
-    if (xyz_given != 0 && xyz_given != 3) {
-      throw InputError(file, line.line, first_xyz_column,
+    if (xyz_given_ != 0 && xyz_given_ != 3) {
+      throw InputError(file_, line.line, first_xyz_column_,
                        "x, y, z: give all three or leave all three empty");
     }
-    o.has_point = xyz_given == 3;
-    obs.rows.push_back(o);
+    o.has_point = xyz_given_ == 3;
+    return o;
+  }
+
+ private:
+  void Cell(const CsvLine& line, const CsvField& f, const Column& col,
+            Observation* o) {
+    double v = 0.0;
+    switch (col.role) {
+      case kPose:
+        if (f.text.empty()) {
+          throw InputError(file_, line.line, f.column, "empty pose id");
+        }
+        if (!pose_ids_.insert(f.text).second) {
+          throw InputError(file_, line.line, f.column,
+                           "duplicate pose id '" + f.text + "'");
+        }
+        o->pose = f.text;
+        break;
+      case kJoint:
+        if (!ParseFiniteDouble(f.text, &v)) {
+          throw InputError(file_, line.line, f.column,
+                           "column '" + col.name +
+                               "': expected a finite number (joint reading), "
+                               "got '" +
+                               f.text + "'");
+        }
+        // Physical range: deg (revolute, a few turns) or mm (prismatic).
+        if (!(std::abs(v) <= 1e5)) {
+          throw InputError(file_, line.line, f.column,
+                           "column '" + col.name +
+                               "': joint reading out of range (|q| <= "
+                               "1e5 deg or mm), got '" +
+                               f.text + "'");
+        }
+        o->q[col.joint] = v;
+        break;
+      case kX:
+      case kY:
+      case kZ:
+        PointCell(line, f, col, o);
+        break;
+      case kFixed:
+        o->fixed_point = f.text;
+        break;
+      case kTime:
+        if (f.text.empty()) break;
+        if (!ParseFiniteDouble(f.text, &v)) {
+          throw InputError(file_, line.line, f.column,
+                           "column 't': expected a finite number (s) or "
+                           "empty, got '" +
+                               f.text + "'");
+        }
+        o->t_s = v;
+        break;
+      case kTemp:
+        if (f.text.empty()) break;
+        if (!ParseFiniteDouble(f.text, &v) || v < -273.15 || v > 1000.0) {
+          throw InputError(file_, line.line, f.column,
+                           "column 'temp_c': expected a temperature in deg "
+                           "C (-273.15..1000) or empty, got '" +
+                               f.text + "'");
+        }
+        o->temp_c = v;
+        break;
+    }
+  }
+
+  void PointCell(const CsvLine& line, const CsvField& f, const Column& col,
+                 Observation* o) {
+    if (f.text.empty()) {
+      if (first_xyz_column_ == 0) first_xyz_column_ = f.column;
+      return;
+    }
+    double v = 0.0;
+    if (!ParseFiniteDouble(f.text, &v)) {
+      throw InputError(file_, line.line, f.column,
+                       "column '" + col.name +
+                           "': expected a finite number (mm) or empty, "
+                           "got '" +
+                           f.text + "'");
+    }
+    if (!(std::abs(v) <= 1e6)) {
+      throw InputError(file_, line.line, f.column,
+                       "column '" + col.name +
+                           "': point out of range (|x| <= 1e6 mm, "
+                           "1 km), got '" +
+                           f.text + "'");
+    }
+    o->p_in_meas[col.role - kX] = v;
+    ++xyz_given_;
+    if (first_xyz_column_ == 0) first_xyz_column_ = f.column;
+  }
+
+  const std::string& file_;
+  const std::vector<Column>& columns_;
+  const size_t joints_;
+  std::set<std::string> pose_ids_;
+  int xyz_given_ = 0;
+  int first_xyz_column_ = 0;
+};
+
+}  // namespace
+
+Observations ParseObservationsCsv(const std::string& text,
+                                  const std::string& file,
+                                  const std::vector<std::string>& joint_names) {
+  const std::vector<CsvLine> lines = TokenizeCsv(text, file);
+  if (lines.empty()) {
+    throw InputError(file, 0, 0,
+                     "empty file: expected a header line 'pose," +
+                         JoinNames(joint_names) + ",x,y,z' and rows");
+  }
+  const std::vector<Column> columns = ParseHeader(lines[0], file, joint_names);
+  Observations obs;
+  obs.source = file;
+  obs.joint_names = joint_names;
+  RowParser rows(file, columns, joint_names.size());
+  for (size_t li = 1; li < lines.size(); ++li) {
+    obs.rows.push_back(rows.Parse(lines[li]));
   }
   if (obs.rows.empty()) {
     throw InputError(file, lines[0].line, 0,

@@ -136,6 +136,171 @@ void ReadGeometry(const YamlReader& r, const YAML::Node& node,
   }
 }
 
+// The file's header keys: format version, name, convention, gravity.
+void ReadRobotHeader(const YamlReader& r, const YAML::Node& root,
+                     Robot* robot) {
+  const YAML::Node version = r.Required(root, "kincal_robot", "robot file");
+  if (r.Integer(version, "kincal_robot") != 1) {
+    r.Fail(version, "kincal_robot: unsupported format version " +
+                        version.Scalar() + " (this tool reads version 1)");
+  }
+  robot->name = root["name"] ? r.String(root["name"], "name") : "robot";
+  const YAML::Node conv = root["convention"];
+  if (conv) {
+    const std::string c = r.String(conv, "convention");
+    if (c == "dh")
+      robot->convention = Convention::kDh;
+    else if (c == "mdh")
+      robot->convention = Convention::kMdh;
+    else if (c == "urdf")
+      robot->convention = Convention::kUrdf;
+    else
+      r.Fail(conv,
+             "convention: expected 'dh', 'mdh' or 'urdf', got '" + c + "'");
+  }
+  if (root["gravity"]) {
+    const auto g = r.Numbers(root["gravity"], "gravity", 3, 3);
+    Eigen::Vector3d gv(g[0], g[1], g[2]);
+    if (gv.norm() < 1e-12) r.Fail(root["gravity"], "gravity: must not be zero");
+    robot->gravity = gv.normalized();
+  }
+}
+
+// A joint's limits, mass and centre of mass.
+void ReadJointExtras(const YamlReader& r, const YAML::Node& j,
+                     const std::string& what, RobotRow* row) {
+  if (j["limits"]) {
+    const auto lim = r.Numbers(j["limits"], what + ".limits", 2, 2);
+    CheckRange(r, j["limits"], what + ".limits", lim, kMaxLengthMm,
+               "(mm or deg)");
+    if (!(lim[0] < lim[1])) {
+      r.Fail(j["limits"],
+             what + ".limits: expected [lower, upper] with lower < upper");
+    }
+    row->lower = lim[0];
+    row->upper = lim[1];
+  }
+  if (j["mass"]) {
+    row->mass_kg = r.Number(j["mass"], what + ".mass");
+    if (!(row->mass_kg >= 0.0 && row->mass_kg <= 1e4)) {
+      r.Fail(j["mass"], what + ".mass: expected a link mass in kg, 0..10000");
+    }
+  }
+  if (j["com"]) {
+    if (!j["mass"]) r.Fail(j["com"], what + ".com: given without mass");
+    const auto c = r.Numbers(j["com"], what + ".com", 3, 3);
+    row->com_mm = Eigen::Vector3d(c[0], c[1], c[2]);
+    if (!(row->com_mm.norm() <= 1e5)) {
+      r.Fail(j["com"], what +
+                           ".com: expected a centre of mass in mm, "
+                           "within 100 m of the link frame");
+    }
+  }
+}
+
+// joints[i]; `names` collects the joint names so far.
+RobotRow ReadJoint(const YamlReader& r, const YAML::Node& j, size_t i,
+                   Convention convention, std::set<std::string>* names) {
+  const std::string what = "joints[" + std::to_string(i) + "]";
+  r.ExpectMap(j, what);
+  r.CheckKeys(j,
+              {"name", "type", "d", "alpha", "a", "theta", "beta", "xyz", "rpy",
+               "axis", "limits", "mass", "com"},
+              what);
+  RobotRow row;
+  row.name = r.String(r.Required(j, "name", what), what + ".name");
+  if (row.name == "tool" || row.name == "frame" || row.name == "drift" ||
+      row.name == "point") {
+    r.Fail(j["name"], what + ".name: '" + row.name + "' is reserved");
+  }
+  if (!names->insert(row.name).second) {
+    r.Fail(j["name"], what + ".name: duplicate joint name '" + row.name + "'");
+  }
+  const std::string type =
+      r.String(r.Required(j, "type", what), what + ".type");
+  if (type == "revolute")
+    row.type = JointType::kRevolute;
+  else if (type == "prismatic")
+    row.type = JointType::kPrismatic;
+  else
+    r.Fail(
+        j["type"],
+        what + ".type: expected 'revolute' or 'prismatic', got '" + type + "'");
+  ReadGeometry(r, j, convention, what, &row);
+  ReadJointExtras(r, j, what, &row);
+  return row;
+}
+
+// The tool row (fixed) and the admissible deviation bounds.
+void ReadToolAndBounds(const YamlReader& r, const YAML::Node& root,
+                       Robot* robot) {
+  robot->tool.name = "tool";
+  robot->tool.type = JointType::kFixed;
+  if (root["tool"]) {
+    const YAML::Node t = root["tool"];
+    r.ExpectMap(t, "tool");
+    r.CheckKeys(t, {"d", "alpha", "a", "theta", "beta", "xyz", "rpy"}, "tool");
+    ReadGeometry(r, t, robot->convention, "tool", &robot->tool);
+  }
+  if (root["bounds"]) {
+    const YAML::Node b = root["bounds"];
+    r.ExpectMap(b, "bounds");
+    r.CheckKeys(b, {"length", "angle"}, "bounds");
+    robot->bound_length_mm = r.NumberOr(b, "length", 5.0, "bounds");
+    robot->bound_angle_deg = r.NumberOr(b, "angle", 5.0, "bounds");
+    robot->bounds_stated = true;
+    if (!(robot->bound_length_mm > 0 && robot->bound_length_mm <= 1e4 &&
+          robot->bound_angle_deg > 0 && robot->bound_angle_deg <= 180)) {
+      r.Fail(b,
+             "bounds: expected length in (0, 10000] mm and angle in "
+             "(0, 180] deg");
+    }
+  }
+}
+
+// extensions[i]: a known cause, its joint, and exactly its fields.
+Extension ReadExtension(const YamlReader& r, const YAML::Node& e, size_t i,
+                        const Robot& robot) {
+  const std::string what = "extensions[" + std::to_string(i) + "]";
+  r.ExpectMap(e, what);
+  Extension x;
+  x.cause = r.String(r.Required(e, "cause", what), what + ".cause");
+  const auto it = ExtensionFields().find(x.cause);
+  if (it == ExtensionFields().end()) {
+    r.Fail(e["cause"], what + ".cause: unknown cause '" + x.cause +
+                           "' (expected backlash, compliance, cyclic, gain, "
+                           "elastostatic, thermal, transmission, drift or "
+                           "mount_compliance; axis tilt is a row's beta)");
+  }
+  if (x.cause != "drift" && x.cause != "mount_compliance") {
+    x.joint = r.String(r.Required(e, "joint", what), what + ".joint");
+    if (robot.JointIndex(x.joint) < 0) {
+      r.Fail(e["joint"], what + ".joint: no joint named '" + x.joint + "'");
+    }
+  }
+  for (const auto& kv : e) {
+    const std::string key = kv.first.Scalar();
+    if (key == "cause" || key == "joint") continue;
+    bool known = false;
+    for (const auto& f : it->second) known = known || f == key;
+    for (const auto& f : OptionalFields(x.cause)) known = known || f == key;
+    if (!known) {
+      r.Fail(kv.first,
+             what + ": unknown field '" + key + "' for cause " + x.cause);
+    }
+    x.values[key] = r.Number(kv.second, what + "." + key);
+  }
+  for (const auto& f : it->second) {
+    if (!x.values.count(f)) r.Fail(e, what + ": missing field '" + f + "'");
+  }
+  if (x.cause == "transmission" && !(x.values.at("hi") > x.values.at("lo"))) {
+    r.Fail(e["hi"], what + ": transmission travel needs hi > lo, got lo " +
+                        FormatDouble(x.values.at("lo")) + ", hi " +
+                        FormatDouble(x.values.at("hi")));
+  }
+  return x;
+}
+
 }  // namespace
 
 Robot ParseRobotYaml(const std::string& text, const std::string& file) {
@@ -149,163 +314,22 @@ Robot ParseRobotYaml(const std::string& text, const std::string& file) {
               {"kincal_robot", "name", "convention", "gravity", "joints",
                "tool", "bounds", "extensions"},
               "robot file");
-  const YAML::Node version = r.Required(root, "kincal_robot", "robot file");
-  if (r.Integer(version, "kincal_robot") != 1) {
-    r.Fail(version, "kincal_robot: unsupported format version " +
-                        version.Scalar() + " (this tool reads version 1)");
-  }
   Robot robot;
-  robot.name = root["name"] ? r.String(root["name"], "name") : "robot";
-  const YAML::Node conv = root["convention"];
-  if (conv) {
-    const std::string c = r.String(conv, "convention");
-    if (c == "dh")
-      robot.convention = Convention::kDh;
-    else if (c == "mdh")
-      robot.convention = Convention::kMdh;
-    else if (c == "urdf")
-      robot.convention = Convention::kUrdf;
-    else
-      r.Fail(conv,
-             "convention: expected 'dh', 'mdh' or 'urdf', got '" + c + "'");
-  }
-  if (root["gravity"]) {
-    const auto g = r.Numbers(root["gravity"], "gravity", 3, 3);
-    Eigen::Vector3d gv(g[0], g[1], g[2]);
-    if (gv.norm() < 1e-12) r.Fail(root["gravity"], "gravity: must not be zero");
-    robot.gravity = gv.normalized();
-  }
-
+  ReadRobotHeader(r, root, &robot);
   const YAML::Node joints = r.Required(root, "joints", "robot file");
   r.ExpectSequence(joints, "joints");
   if (joints.size() == 0) r.Fail(joints, "joints: expected at least one joint");
   std::set<std::string> names;
   for (size_t i = 0; i < joints.size(); ++i) {
-    const YAML::Node j = joints[i];
-    const std::string what = "joints[" + std::to_string(i) + "]";
-    r.ExpectMap(j, what);
-    r.CheckKeys(j,
-                {"name", "type", "d", "alpha", "a", "theta", "beta", "xyz",
-                 "rpy", "axis", "limits", "mass", "com"},
-                what);
-    RobotRow row;
-    row.name = r.String(r.Required(j, "name", what), what + ".name");
-    if (row.name == "tool" || row.name == "frame" || row.name == "drift" ||
-        row.name == "point") {
-      r.Fail(j["name"], what + ".name: '" + row.name + "' is reserved");
-    }
-    if (!names.insert(row.name).second) {
-      r.Fail(j["name"],
-             what + ".name: duplicate joint name '" + row.name + "'");
-    }
-    const std::string type =
-        r.String(r.Required(j, "type", what), what + ".type");
-    if (type == "revolute")
-      row.type = JointType::kRevolute;
-    else if (type == "prismatic")
-      row.type = JointType::kPrismatic;
-    else
-      r.Fail(j["type"], what +
-                            ".type: expected 'revolute' or 'prismatic', got '" +
-                            type + "'");
-    ReadGeometry(r, j, robot.convention, what, &row);
-    if (j["limits"]) {
-      const auto lim = r.Numbers(j["limits"], what + ".limits", 2, 2);
-      CheckRange(r, j["limits"], what + ".limits", lim, kMaxLengthMm,
-                 "(mm or deg)");
-      if (!(lim[0] < lim[1])) {
-        r.Fail(j["limits"],
-               what + ".limits: expected [lower, upper] with lower < upper");
-      }
-      row.lower = lim[0];
-      row.upper = lim[1];
-    }
-    if (j["mass"]) {
-      row.mass_kg = r.Number(j["mass"], what + ".mass");
-      if (!(row.mass_kg >= 0.0 && row.mass_kg <= 1e4)) {
-        r.Fail(j["mass"], what + ".mass: expected a link mass in kg, 0..10000");
-      }
-    }
-    if (j["com"]) {
-      if (!j["mass"]) r.Fail(j["com"], what + ".com: given without mass");
-      const auto c = r.Numbers(j["com"], what + ".com", 3, 3);
-      row.com_mm = Eigen::Vector3d(c[0], c[1], c[2]);
-      if (!(row.com_mm.norm() <= 1e5)) {
-        r.Fail(j["com"], what +
-                             ".com: expected a centre of mass in mm, "
-                             "within 100 m of the link frame");
-      }
-    }
-    robot.joints.push_back(row);
+    robot.joints.push_back(
+        ReadJoint(r, joints[i], i, robot.convention, &names));
   }
-
-  robot.tool.name = "tool";
-  robot.tool.type = JointType::kFixed;
-  if (root["tool"]) {
-    const YAML::Node t = root["tool"];
-    r.ExpectMap(t, "tool");
-    r.CheckKeys(t, {"d", "alpha", "a", "theta", "beta", "xyz", "rpy"}, "tool");
-    ReadGeometry(r, t, robot.convention, "tool", &robot.tool);
-  }
-  if (root["bounds"]) {
-    const YAML::Node b = root["bounds"];
-    r.ExpectMap(b, "bounds");
-    r.CheckKeys(b, {"length", "angle"}, "bounds");
-    robot.bound_length_mm = r.NumberOr(b, "length", 5.0, "bounds");
-    robot.bound_angle_deg = r.NumberOr(b, "angle", 5.0, "bounds");
-    robot.bounds_stated = true;
-    if (!(robot.bound_length_mm > 0 && robot.bound_length_mm <= 1e4 &&
-          robot.bound_angle_deg > 0 && robot.bound_angle_deg <= 180)) {
-      r.Fail(b,
-             "bounds: expected length in (0, 10000] mm and angle in "
-             "(0, 180] deg");
-    }
-  }
+  ReadToolAndBounds(r, root, &robot);
   if (root["extensions"] && !root["extensions"].IsNull()) {
     const YAML::Node ext = root["extensions"];
     r.ExpectSequence(ext, "extensions");
     for (size_t i = 0; i < ext.size(); ++i) {
-      const YAML::Node e = ext[i];
-      const std::string what = "extensions[" + std::to_string(i) + "]";
-      r.ExpectMap(e, what);
-      Extension x;
-      x.cause = r.String(r.Required(e, "cause", what), what + ".cause");
-      const auto it = ExtensionFields().find(x.cause);
-      if (it == ExtensionFields().end()) {
-        r.Fail(e["cause"],
-               what + ".cause: unknown cause '" + x.cause +
-                   "' (expected backlash, compliance, cyclic, gain, "
-                   "elastostatic, thermal, transmission, drift or "
-                   "mount_compliance; axis tilt is a row's beta)");
-      }
-      if (x.cause != "drift" && x.cause != "mount_compliance") {
-        x.joint = r.String(r.Required(e, "joint", what), what + ".joint");
-        if (robot.JointIndex(x.joint) < 0) {
-          r.Fail(e["joint"], what + ".joint: no joint named '" + x.joint + "'");
-        }
-      }
-      for (const auto& kv : e) {
-        const std::string key = kv.first.Scalar();
-        if (key == "cause" || key == "joint") continue;
-        bool known = false;
-        for (const auto& f : it->second) known = known || f == key;
-        for (const auto& f : OptionalFields(x.cause)) known = known || f == key;
-        if (!known) {
-          r.Fail(kv.first,
-                 what + ": unknown field '" + key + "' for cause " + x.cause);
-        }
-        x.values[key] = r.Number(kv.second, what + "." + key);
-      }
-      for (const auto& f : it->second) {
-        if (!x.values.count(f)) r.Fail(e, what + ": missing field '" + f + "'");
-      }
-      if (x.cause == "transmission" &&
-          !(x.values.at("hi") > x.values.at("lo"))) {
-        r.Fail(e["hi"], what + ": transmission travel needs hi > lo, got lo " +
-                            FormatDouble(x.values.at("lo")) + ", hi " +
-                            FormatDouble(x.values.at("hi")));
-      }
-      robot.extensions.push_back(x);
+      robot.extensions.push_back(ReadExtension(r, ext[i], i, robot));
     }
   }
   return robot;

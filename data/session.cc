@@ -72,6 +72,185 @@ const std::string* FindImage(const std::map<std::string, std::string>& images,
   return it == images.end() ? nullptr : &it->second;
 }
 
+constexpr int kFixed = 5;  // frame,t_left,t_right,seq_left,seq_right
+
+// The header: the five fixed columns, then the joint columns (returned).
+std::vector<std::string> ParseFramesHeader(const CsvLine& header,
+                                           const std::string& file) {
+  for (int i = 0; i < kFixed; ++i) {
+    const int column = i < static_cast<int>(header.fields.size())
+                           ? header.fields[i].column
+                           : header.end_column;
+    if (i >= static_cast<int>(header.fields.size()) ||
+        header.fields[i].text != kFixedColumns[i]) {
+      throw InputError(
+          file, header.line, column,
+          std::string("header: expected column ") + std::to_string(i + 1) +
+              " to be '" + kFixedColumns[i] +
+              "' (frames.csv starts frame,t_left,t_right,seq_left,seq_right)" +
+              (i < static_cast<int>(header.fields.size())
+                   ? ", got '" + header.fields[i].text + "'"
+                   : ""));
+    }
+  }
+  std::vector<std::string> joint_columns;
+  std::set<std::string> seen;
+  for (size_t i = kFixed; i < header.fields.size(); ++i) {
+    const CsvField& f = header.fields[i];
+    if (f.text.empty()) {
+      throw InputError(file, header.line, f.column, "empty column name");
+    }
+    if (!seen.insert(f.text).second) {
+      throw InputError(file, header.line, f.column,
+                       "duplicate column '" + f.text + "'");
+    }
+    joint_columns.push_back(f.text);
+  }
+  return joint_columns;
+}
+
+// Per robot joint, its field index; InputError unless the joint columns are
+// exactly the robot's joints. Empty without joint names.
+std::vector<int> MapJointColumns(const std::vector<std::string>& joint_columns,
+                                 const std::vector<std::string>& joint_names,
+                                 const CsvLine& header,
+                                 const std::string& file) {
+  std::vector<int> column_of;
+  if (joint_names.empty()) return column_of;
+  std::vector<std::string> missing, foreign;
+  for (const std::string& name : joint_names) {
+    auto it = std::find(joint_columns.begin(), joint_columns.end(), name);
+    if (it == joint_columns.end()) {
+      missing.push_back(name);
+    } else {
+      column_of.push_back(kFixed +
+                          static_cast<int>(it - joint_columns.begin()));
+    }
+  }
+  for (const std::string& c : joint_columns) {
+    if (std::find(joint_names.begin(), joint_names.end(), c) ==
+        joint_names.end()) {
+      foreign.push_back(c);
+    }
+  }
+  if (missing.empty() && foreign.empty()) return column_of;
+  std::string msg;
+  if (joint_columns.empty()) {
+    msg = "no joint columns: the robot's joints (" + Join(joint_names) +
+          ") need one column each after seq_right (joint readings at "
+          "each frame)";
+  } else {
+    msg = "joint columns (" + Join(joint_columns) +
+          ") do not match the robot's joints (" + Join(joint_names) + ")";
+    if (!missing.empty()) msg += "; missing: " + Join(missing);
+    if (!foreign.empty()) {
+      msg += "; not joints of this robot: " + Join(foreign) +
+             " (a session of another robot?)";
+    }
+  }
+  throw InputError(file, header.line, header.end_column, msg);
+}
+
+// Times and sequence numbers may be empty (unknown); anything else in them
+// must be a number.
+void ParseTimesAndSequences(const CsvLine& line, const std::string& file,
+                            SessionFrame* f) {
+  double* times[2] = {&f->t_left, &f->t_right};
+  for (int k = 0; k < 2; ++k) {
+    const CsvField& c = line.fields[1 + k];
+    if (c.text.empty()) continue;
+    if (!ParseFiniteDouble(c.text, times[k])) {
+      throw InputError(file, line.line, c.column,
+                       std::string(kFixedColumns[1 + k]) +
+                           ": expected a time in seconds, got '" + c.text +
+                           "'");
+    }
+  }
+  long long* seqs[2] = {&f->seq_left, &f->seq_right};
+  for (int k = 0; k < 2; ++k) {
+    const CsvField& c = line.fields[3 + k];
+    if (c.text.empty()) continue;
+    if (!ParseInteger(c.text, seqs[k])) {
+      throw InputError(file, line.line, c.column,
+                       std::string(kFixedColumns[3 + k]) +
+                           ": expected an integer sequence number, got '" +
+                           c.text + "'");
+    }
+  }
+}
+
+// Joint cells: all empty (no reading) or all numbers; the robot's joints
+// (column_of) go to f->q.
+void ParseJointCells(const CsvLine& line, const CsvLine& header,
+                     const std::string& file, const std::vector<int>& column_of,
+                     SessionFrame* f) {
+  const size_t ncols = header.fields.size();
+  int empty = 0;
+  for (size_t i = kFixed; i < ncols; ++i) {
+    empty += line.fields[i].text.empty() ? 1 : 0;
+  }
+  if (empty != 0 && empty != static_cast<int>(ncols - kFixed)) {
+    for (size_t i = kFixed; i < ncols; ++i) {
+      if (line.fields[i].text.empty()) {
+        throw InputError(file, line.line, line.fields[i].column,
+                         "joint '" + header.fields[i].text +
+                             "' is empty but other joints of this frame "
+                             "have readings (all or none)");
+      }
+    }
+  }
+  if (empty != 0) return;
+  for (size_t i = kFixed; i < ncols; ++i) {
+    double v = 0;
+    if (!ParseFiniteDouble(line.fields[i].text, &v)) {
+      throw InputError(file, line.line, line.fields[i].column,
+                       "joint '" + header.fields[i].text +
+                           "': expected a finite number (mm or deg), "
+                           "got '" +
+                           line.fields[i].text + "'");
+    }
+  }
+  for (int c : column_of) {
+    double v = 0;
+    ParseFiniteDouble(line.fields[c].text, &v);
+    f->q.push_back(v);
+  }
+}
+
+// One frame row; `frames_seen` collects the frame numbers so far.
+SessionFrame ParseFrameRow(const CsvLine& line, const CsvLine& header,
+                           const std::string& file,
+                           const std::vector<int>& column_of,
+                           std::set<long long>* frames_seen) {
+  const size_t ncols = header.fields.size();
+  if (line.fields.size() != ncols) {
+    throw InputError(
+        file, line.line,
+        line.fields.size() < ncols ? line.end_column
+                                   : line.fields[ncols].column,
+        "expected " + std::to_string(ncols) + " cells (" +
+            std::to_string(kFixed) + " + " + std::to_string(ncols - kFixed) +
+            " joint columns), got " + std::to_string(line.fields.size()));
+  }
+  SessionFrame f;
+  f.line = line.line;
+  long long frame = 0;
+  if (!ParseInteger(line.fields[0].text, &frame) || frame < 0 ||
+      frame > 99999999) {
+    throw InputError(file, line.line, line.fields[0].column,
+                     "frame: expected a non-negative integer, got '" +
+                         line.fields[0].text + "'");
+  }
+  if (!frames_seen->insert(frame).second) {
+    throw InputError(file, line.line, line.fields[0].column,
+                     "frame " + std::to_string(frame) + " appears twice");
+  }
+  f.frame = static_cast<int>(frame);
+  ParseTimesAndSequences(line, file, &f);
+  ParseJointCells(line, header, file, column_of, &f);
+  return f;
+}
+
 }  // namespace
 
 void ParseSessionFramesCsv(const std::string& text_in, const std::string& file,
@@ -90,163 +269,14 @@ void ParseSessionFramesCsv(const std::string& text_in, const std::string& file,
                      "'frame,t_left,t_right,seq_left,seq_right[,<joints>]'");
   }
   const CsvLine& header = lines[0];
-  const int fixed = 5;
-  for (int i = 0; i < fixed; ++i) {
-    const int column = i < static_cast<int>(header.fields.size())
-                           ? header.fields[i].column
-                           : header.end_column;
-    if (i >= static_cast<int>(header.fields.size()) ||
-        header.fields[i].text != kFixedColumns[i]) {
-      throw InputError(
-          file, header.line, column,
-          std::string("header: expected column ") + std::to_string(i + 1) +
-              " to be '" + kFixedColumns[i] +
-              "' (frames.csv starts frame,t_left,t_right,seq_left,seq_right)" +
-              (i < static_cast<int>(header.fields.size())
-                   ? ", got '" + header.fields[i].text + "'"
-                   : ""));
-    }
-  }
-  session->joint_columns.clear();
-  std::set<std::string> seen;
-  for (size_t i = fixed; i < header.fields.size(); ++i) {
-    const CsvField& f = header.fields[i];
-    if (f.text.empty()) {
-      throw InputError(file, header.line, f.column, "empty column name");
-    }
-    if (!seen.insert(f.text).second) {
-      throw InputError(file, header.line, f.column,
-                       "duplicate column '" + f.text + "'");
-    }
-    session->joint_columns.push_back(f.text);
-  }
-  // Map the robot's joints to columns.
-  std::vector<int> column_of;  // per robot joint: field index
-  if (!options.joint_names.empty()) {
-    std::vector<std::string> missing, foreign;
-    for (const std::string& name : options.joint_names) {
-      auto it = std::find(session->joint_columns.begin(),
-                          session->joint_columns.end(), name);
-      if (it == session->joint_columns.end()) {
-        missing.push_back(name);
-      } else {
-        column_of.push_back(
-            fixed + static_cast<int>(it - session->joint_columns.begin()));
-      }
-    }
-    for (const std::string& c : session->joint_columns) {
-      if (std::find(options.joint_names.begin(), options.joint_names.end(),
-                    c) == options.joint_names.end()) {
-        foreign.push_back(c);
-      }
-    }
-    if (!missing.empty() || !foreign.empty()) {
-      std::string msg;
-      if (session->joint_columns.empty()) {
-        msg = "no joint columns: the robot's joints (" +
-              Join(options.joint_names) +
-              ") need one column each after seq_right (joint readings at "
-              "each frame)";
-      } else {
-        msg = "joint columns (" + Join(session->joint_columns) +
-              ") do not match the robot's joints (" +
-              Join(options.joint_names) + ")";
-        if (!missing.empty()) msg += "; missing: " + Join(missing);
-        if (!foreign.empty()) {
-          msg += "; not joints of this robot: " + Join(foreign) +
-                 " (a session of another robot?)";
-        }
-      }
-      throw InputError(file, header.line, header.end_column, msg);
-    }
-  }
+  session->joint_columns = ParseFramesHeader(header, file);
+  const std::vector<int> column_of = MapJointColumns(
+      session->joint_columns, options.joint_names, header, file);
   session->frames.clear();
   std::set<long long> frames_seen;
-  const size_t ncols = header.fields.size();
   for (size_t li = 1; li < lines.size(); ++li) {
-    const CsvLine& line = lines[li];
-    if (line.fields.size() != ncols) {
-      throw InputError(
-          file, line.line,
-          line.fields.size() < ncols ? line.end_column
-                                     : line.fields[ncols].column,
-          "expected " + std::to_string(ncols) + " cells (" +
-              std::to_string(fixed) + " + " + std::to_string(ncols - fixed) +
-              " joint columns), got " + std::to_string(line.fields.size()));
-    }
-    SessionFrame f;
-    f.line = line.line;
-    long long frame = 0;
-    if (!ParseInteger(line.fields[0].text, &frame) || frame < 0 ||
-        frame > 99999999) {
-      throw InputError(file, line.line, line.fields[0].column,
-                       "frame: expected a non-negative integer, got '" +
-                           line.fields[0].text + "'");
-    }
-    if (!frames_seen.insert(frame).second) {
-      throw InputError(file, line.line, line.fields[0].column,
-                       "frame " + std::to_string(frame) + " appears twice");
-    }
-    f.frame = static_cast<int>(frame);
-    // Times and sequence numbers may be empty (unknown); anything else in
-    // them must be a number.
-    double* times[2] = {&f.t_left, &f.t_right};
-    for (int k = 0; k < 2; ++k) {
-      const CsvField& c = line.fields[1 + k];
-      if (c.text.empty()) continue;
-      if (!ParseFiniteDouble(c.text, times[k])) {
-        throw InputError(file, line.line, c.column,
-                         std::string(kFixedColumns[1 + k]) +
-                             ": expected a time in seconds, got '" + c.text +
-                             "'");
-      }
-    }
-    long long* seqs[2] = {&f.seq_left, &f.seq_right};
-    for (int k = 0; k < 2; ++k) {
-      const CsvField& c = line.fields[3 + k];
-      if (c.text.empty()) continue;
-      if (!ParseInteger(c.text, seqs[k])) {
-        throw InputError(file, line.line, c.column,
-                         std::string(kFixedColumns[3 + k]) +
-                             ": expected an integer sequence number, got '" +
-                             c.text + "'");
-      }
-    }
-    // Joint cells: all empty (no reading) or all numbers.
-    int empty = 0;
-    for (size_t i = fixed; i < ncols; ++i) {
-      empty += line.fields[i].text.empty() ? 1 : 0;
-    }
-    if (empty != 0 && empty != static_cast<int>(ncols - fixed)) {
-      for (size_t i = fixed; i < ncols; ++i) {
-        if (line.fields[i].text.empty()) {
-          throw InputError(file, line.line, line.fields[i].column,
-                           "joint '" + header.fields[i].text +
-                               "' is empty but other joints of this frame "
-                               "have readings (all or none)");
-        }
-      }
-    }
-    if (empty == 0) {
-      for (size_t i = fixed; i < ncols; ++i) {
-        double v = 0;
-        if (!ParseFiniteDouble(line.fields[i].text, &v)) {
-          throw InputError(file, line.line, line.fields[i].column,
-                           "joint '" + header.fields[i].text +
-                               "': expected a finite number (mm or deg), "
-                               "got '" +
-                               line.fields[i].text + "'");
-        }
-      }
-      if (!column_of.empty()) {
-        for (int c : column_of) {
-          double v = 0;
-          ParseFiniteDouble(line.fields[c].text, &v);
-          f.q.push_back(v);
-        }
-      }
-    }
-    session->frames.push_back(std::move(f));
+    session->frames.push_back(
+        ParseFrameRow(lines[li], header, file, column_of, &frames_seen));
   }
 }
 

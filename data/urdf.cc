@@ -447,88 +447,66 @@ const char* TypeName(int type) {
   }
 }
 
-}  // namespace
-
-Robot ParseUrdfChain(const std::string& xml, const std::string& file,
-                     const std::string& root_link,
-                     const std::string& tip_link) {
-  const Locator loc{xml, file};
-  tinyxml2::XMLDocument doc;
-  if (doc.Parse(xml.c_str(), xml.size()) != tinyxml2::XML_SUCCESS) {
-    throw InputError(file, doc.ErrorLineNum(), 0,
-                     std::string("invalid XML: ") + doc.ErrorStr());
-  }
-  Lines lines;
-  PrePass(loc, doc, &lines);
-  const urdf::ModelInterfaceSharedPtr model = ParseWithUrdfdom(loc, lines);
-  auto joint_el = [&](const std::string& name) {
-    return lines.joints.count(name) ? lines.joints.at(name) : lines.robot;
-  };
-
-  const std::string root =
-      root_link.empty() ? model->getRoot()->name : root_link;
-  if (!model->getLink(root)) {
-    throw InputError(file, 0, 0, "no link named '" + root + "'");
-  }
-  std::string tip = tip_link;
-  if (tip.empty()) {
-    // Down from the root; at a branch, follow the one child whose subtree
-    // holds a movable joint (a ROS-Industrial `base` frame beside link_1
-    // does not count).
-    tip = root;
-    for (auto link = model->getLink(tip); !link->child_links.empty();
-         link = model->getLink(tip)) {
-      std::vector<std::string> moving;
-      for (const auto& c : link->child_links) {
-        if (c->parent_joint->type != urdf::Joint::FIXED ||
-            HasMovableJoint(*model, c->name)) {
-          moving.push_back(c->name);
-        }
-      }
-      if (link->child_links.size() == 1) {
-        tip = link->child_links[0]->name;
-      } else if (moving.size() == 1) {
-        tip = moving[0];
-      } else if (moving.empty() && LeafCount(*model, tip, "tool0") == 1) {
-        // Only fixed frames left (ROS-I: flange, tool0, ee_link): tool0 is
-        // REP 199's attachment frame.
-        tip = "tool0";
-        break;
-      } else {
-        throw InputError(file, 0, 0,
-                         "link '" + tip +
-                             "' branches: name the tip link with --tip (leaf "
-                             "links: " +
-                             JoinLeaves(*model, tip) + ")");
+// The tip when none is named: down from the root; at a branch, follow the
+// one child whose subtree holds a movable joint (a ROS-Industrial `base`
+// frame beside link_1 does not count).
+std::string DefaultTip(const urdf::ModelInterface& model,
+                       const std::string& root, const std::string& file) {
+  std::string tip = root;
+  for (auto link = model.getLink(tip); !link->child_links.empty();
+       link = model.getLink(tip)) {
+    std::vector<std::string> moving;
+    for (const auto& c : link->child_links) {
+      if (c->parent_joint->type != urdf::Joint::FIXED ||
+          HasMovableJoint(model, c->name)) {
+        moving.push_back(c->name);
       }
     }
+    if (link->child_links.size() == 1) {
+      tip = link->child_links[0]->name;
+    } else if (moving.size() == 1) {
+      tip = moving[0];
+    } else if (moving.empty() && LeafCount(model, tip, "tool0") == 1) {
+      // Only fixed frames left (ROS-I: flange, tool0, ee_link): tool0 is
+      // REP 199's attachment frame.
+      tip = "tool0";
+      break;
+    } else {
+      throw InputError(file, 0, 0,
+                       "link '" + tip +
+                           "' branches: name the tip link with --tip (leaf "
+                           "links: " +
+                           JoinLeaves(model, tip) + ")");
+    }
   }
-  if (!model->getLink(tip)) {
-    throw InputError(file, 0, 0, "no link named '" + tip + "'");
-  }
+  return tip;
+}
 
-  // Joints from the root to the tip.
+// The joints from the root to the tip.
+std::vector<urdf::JointConstSharedPtr> ChainPath(
+    const urdf::ModelInterface& model, const std::string& root,
+    const std::string& tip, const std::string& file) {
   std::vector<urdf::JointConstSharedPtr> path;
-  for (auto link = model->getLink(tip); link->name != root;) {
+  for (auto link = model.getLink(tip); link->name != root;) {
     if (!link->parent_joint) {
       throw InputError(file, 0, 0,
                        "link '" + tip + "' is not below '" + root + "'");
     }
     path.insert(path.begin(), link->parent_joint);
-    link = model->getLink(link->parent_joint->parent_link_name);
+    link = model.getLink(link->parent_joint->parent_link_name);
   }
+  return path;
+}
 
-  Robot robot;
-  robot.name = model->getName().empty() ? "urdf" : model->getName();
-  robot.convention = Convention::kUrdf;
-  // A URDF carries no admissible deviation. Its nominal values come from
-  // CAD, and the tool at its end (a ball, a probe, a gripper finger) is
-  // often mounted several millimetres off: MUKCa's Panda balls sit 7 mm
-  // from the nominal one. 20 mm / 10 deg keeps the fit physical without
-  // pinning such a tool to the bound.
-  robot.bound_length_mm = 20.0;
-  robot.bound_angle_deg = 10.0;
-  // Row index of each movable joint on the chain.
+// One robot.yaml row per movable joint of `path`, fixed joints folded into
+// the next row (the rest into robot->tool); returns each movable joint's
+// row index.
+std::map<std::string, int> ChainRows(
+    const Locator& loc, const Lines& lines,
+    const std::vector<urdf::JointConstSharedPtr>& path, Robot* robot) {
+  auto joint_el = [&](const std::string& name) {
+    return lines.joints.count(name) ? lines.joints.at(name) : lines.robot;
+  };
   std::map<std::string, int> row_of_joint;
   Eigen::Isometry3d pending = Eigen::Isometry3d::Identity();
   for (const auto& j : path) {
@@ -569,37 +547,37 @@ Robot ParseUrdfChain(const std::string& xml, const std::string& file,
         row.upper = j->limits->upper * scale;
       }
     }
-    row_of_joint[j->name] = static_cast<int>(robot.joints.size());
-    robot.joints.push_back(row);
+    row_of_joint[j->name] = static_cast<int>(robot->joints.size());
+    robot->joints.push_back(row);
     pending = Eigen::Isometry3d::Identity();
   }
-  if (robot.joints.empty()) {
-    throw InputError(
-        file, 0, 0,
-        "no movable joint between '" + root + "' and '" + tip + "'");
-  }
-  robot.tool.name = "tool";
-  robot.tool.type = JointType::kFixed;
-  SetOrigin(pending, &robot.tool);
+  robot->tool.name = "tool";
+  robot->tool.type = JointType::kFixed;
+  SetOrigin(pending, &robot->tool);
+  return row_of_joint;
+}
 
-  // Inertials: every link whose way up to the root meets a movable joint of
-  // the chain rides on that joint's row. Its mass is lumped into the row
-  // (sum of masses, mass-weighted centre of mass in the frame after the
-  // row = that joint's child link). Joints off the chain (a gripper's
-  // fingers) count at their zero position; links that reach the root
-  // without a movable chain joint (the base) carry no row and are left out.
-  std::vector<double> mass(robot.joints.size(), 0.0);
-  std::vector<Eigen::Vector3d> moment(robot.joints.size(),
-                                      Eigen::Vector3d::Zero());
-  std::vector<bool> has(robot.joints.size(), false);
+// Inertials: every link whose way up to the root meets a movable joint of
+// the chain rides on that joint's row. Its mass is lumped into the row (sum
+// of masses, mass-weighted centre of mass in the frame after the row = that
+// joint's child link). Joints off the chain (a gripper's fingers) count at
+// their zero position; links that reach the root without a movable chain
+// joint (the base) carry no row and are left out.
+void LumpInertials(const urdf::ModelInterface& model, const std::string& root,
+                   const std::map<std::string, int>& row_of_joint,
+                   Robot* robot) {
+  const size_t rows = robot->joints.size();
+  std::vector<double> mass(rows, 0.0);
+  std::vector<Eigen::Vector3d> moment(rows, Eigen::Vector3d::Zero());
+  std::vector<bool> has(rows, false);
   std::vector<urdf::LinkSharedPtr> links;
-  model->getLinks(links);
+  model.getLinks(links);
   for (const auto& link : links) {
     if (!link->inertial) continue;
     Eigen::Vector3d com = ToIsometry(link->inertial->origin).translation();
     int row = -1;
     for (urdf::LinkConstSharedPtr l = link; l && l->parent_joint;
-         l = model->getLink(l->parent_joint->parent_link_name)) {
+         l = model.getLink(l->parent_joint->parent_link_name)) {
       const auto it = row_of_joint.find(l->parent_joint->name);
       if (it != row_of_joint.end()) {
         row = it->second;
@@ -613,13 +591,60 @@ Robot ParseUrdfChain(const std::string& xml, const std::string& file,
     moment[row] += link->inertial->mass * com;
     has[row] = true;
   }
-  for (size_t r = 0; r < robot.joints.size(); ++r) {
+  for (size_t r = 0; r < rows; ++r) {
     if (!has[r]) continue;
-    robot.joints[r].mass_kg = mass[r];
-    robot.joints[r].com_mm = mass[r] > 0
-                                 ? Eigen::Vector3d(moment[r] / mass[r] * 1000.0)
-                                 : Eigen::Vector3d::Zero();
+    robot->joints[r].mass_kg = mass[r];
+    robot->joints[r].com_mm =
+        mass[r] > 0 ? Eigen::Vector3d(moment[r] / mass[r] * 1000.0)
+                    : Eigen::Vector3d::Zero();
   }
+}
+
+}  // namespace
+
+Robot ParseUrdfChain(const std::string& xml, const std::string& file,
+                     const std::string& root_link,
+                     const std::string& tip_link) {
+  const Locator loc{xml, file};
+  tinyxml2::XMLDocument doc;
+  if (doc.Parse(xml.c_str(), xml.size()) != tinyxml2::XML_SUCCESS) {
+    throw InputError(file, doc.ErrorLineNum(), 0,
+                     std::string("invalid XML: ") + doc.ErrorStr());
+  }
+  Lines lines;
+  PrePass(loc, doc, &lines);
+  const urdf::ModelInterfaceSharedPtr model = ParseWithUrdfdom(loc, lines);
+  const std::string root =
+      root_link.empty() ? model->getRoot()->name : root_link;
+  if (!model->getLink(root)) {
+    throw InputError(file, 0, 0, "no link named '" + root + "'");
+  }
+  const std::string tip =
+      tip_link.empty() ? DefaultTip(*model, root, file) : tip_link;
+  if (!model->getLink(tip)) {
+    throw InputError(file, 0, 0, "no link named '" + tip + "'");
+  }
+  const std::vector<urdf::JointConstSharedPtr> path =
+      ChainPath(*model, root, tip, file);
+
+  Robot robot;
+  robot.name = model->getName().empty() ? "urdf" : model->getName();
+  robot.convention = Convention::kUrdf;
+  // A URDF carries no admissible deviation. Its nominal values come from
+  // CAD, and the tool at its end (a ball, a probe, a gripper finger) is
+  // often mounted several millimetres off: MUKCa's Panda balls sit 7 mm
+  // from the nominal one. 20 mm / 10 deg keeps the fit physical without
+  // pinning such a tool to the bound.
+  robot.bound_length_mm = 20.0;
+  robot.bound_angle_deg = 10.0;
+  const std::map<std::string, int> row_of_joint =
+      ChainRows(loc, lines, path, &robot);
+  if (robot.joints.empty()) {
+    throw InputError(
+        file, 0, 0,
+        "no movable joint between '" + root + "' and '" + tip + "'");
+  }
+  LumpInertials(*model, root, row_of_joint, &robot);
   return robot;
 }
 
