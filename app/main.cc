@@ -26,8 +26,8 @@ int main(int argc, char** argv) {
   // each from a fresh mmap, returns it on free, and every page faults again
   // on first touch (~95,000 page faults, a quarter of the run in the
   // kernel). Serving up to 32 MB (glibc's maximum) from the heap and keeping
-  // freed memory until exit: 20,000 page faults, `diagnose model` on series
-  // C 4.0 -> 3.0 s whole process (docs/DIAGNOSE.md). A command-line tool
+  // freed memory until exit: 20,000 page faults and `diagnose model` on series
+  // C a quarter faster (docs/DIAGNOSE.md). A command-line tool
   // that exits after one job loses nothing by holding its peak.
   mallopt(M_MMAP_THRESHOLD, 32 << 20);
   mallopt(M_TRIM_THRESHOLD, 1 << 30);

@@ -15,6 +15,7 @@
 #include <sstream>
 
 #include "calib/holdout.h"
+#include "calib/identifiability.h"
 #include "data/error.h"
 #include "data/observations.h"
 #include "data/rigid3.h"
@@ -668,62 +669,50 @@ struct IdentifiabilityScan {
   Freedom fit;                              // the accepted ones free
 };
 
-// Gram-Schmidt on the pixel Jacobian in priority order (the two frames,
-// then `candidates`): a candidate is accepted when the part of its column
-// outside the span of those before it is larger than the tolerance (sine of
-// the angle) and, for a row parameter, its conditional sigma
+// calib's identifiability scan (calib/identifiability.h) on the pixel
+// Jacobian in priority order: the two frames' 12 pose columns, then
+// `candidates`. A candidate is accepted when the part of its column outside
+// the span of those before it is larger than the tolerance (sine of the
+// angle) and, for a row parameter, its conditional sigma
 // sigma_px / (|column| sine) is below max_sigma_fraction of its bound.
-// calib/identifiability.h scans point measurements; this scan works on the
-// bundle's pixel residuals and the frames' columns.
 IdentifiabilityScan ScanIdentifiability(
     const Eigen::MatrixXd& J,
     const std::map<std::pair<int, int>, int>& column_of,
     const std::vector<ParamInfo>& candidates, const Chain& chain,
     double sigma_px, const Freedom& fixed_robot, const BundleOptions& opt) {
-  IdentifiabilityScan scan;
-  scan.fit = fixed_robot;
-  std::vector<Eigen::VectorXd> basis;
-  auto residual_part = [&](Eigen::VectorXd v) {
-    for (int pass = 0; pass < 2; ++pass) {
-      for (const Eigen::VectorXd& e : basis) v -= e.dot(v) * e;
-    }
-    return v;
-  };
-  for (int c = 0; c < 12; ++c) {
-    const Eigen::VectorXd v = J.col(c);
-    if (v.norm() == 0) continue;
-    const Eigen::VectorXd r = residual_part(v / v.norm());
-    if (r.norm() > opt.identifiability_tolerance)
-      basis.push_back(r.normalized());
+  constexpr int kPoseColumns = 12;  // rig_from_base, flange_from_target
+  std::vector<ParamInfo> ordered;
+  Eigen::MatrixXd columns(J.rows(), kPoseColumns + candidates.size());
+  for (int c = 0; c < kPoseColumns; ++c) {
+    ordered.push_back(
+        {"pose." + std::to_string(c), ParamKind::kFrame, 0, c, false});
+    columns.col(c) = J.col(c);
   }
   for (const ParamInfo& p : candidates) {
-    const int column =
-        column_of.at({p.kind == ParamKind::kRow ? 0 : 1, p.block}) + p.index;
-    const Eigen::VectorXd v = J.col(column);
-    const double norm = v.norm();
-    bool ok = norm > 0;
-    if (ok) {
-      const Eigen::VectorXd r = residual_part(v / norm);
-      const double sine = r.norm();
-      ok = sine > opt.identifiability_tolerance;
-      if (ok && p.kind == ParamKind::kRow) {
-        const double bound =
-            p.angle ? chain.bound_angle_rad : chain.bound_length_mm;
-        const double cond_sigma = sigma_px / (norm * sine);
-        ok = cond_sigma < opt.max_sigma_fraction * bound;
-      }
-      if (ok) basis.push_back(r / sine);
-    }
-    if (!ok) {
-      scan.unidentifiable.push_back(p.name);
-      continue;
-    }
+    columns.col(ordered.size()) = J.col(
+        column_of.at({p.kind == ParamKind::kRow ? 0 : 1, p.block}) + p.index);
+    ordered.push_back(p);
+  }
+  IdentifiabilityOptions options;
+  options.tolerance = opt.identifiability_tolerance;
+  options.noise_sigma_mm = sigma_px;  // the residuals' unit: pixels
+  options.max_sigma_fraction = opt.max_sigma_fraction;
+  const Identifiability id =
+      AnalyzeJacobianColumns(columns, ordered, chain, options);
+
+  IdentifiabilityScan scan;
+  scan.fit = fixed_robot;
+  for (const ParamInfo& p : id.identifiable) {
+    if (p.kind == ParamKind::kFrame) continue;
     scan.accepted.push_back(p.name);
     if (p.kind == ParamKind::kRow)
       scan.fit.row_free[p.block].push_back(p.index);
     if (p.kind == ParamKind::kJointError) {
       scan.fit.error_free[p.block].push_back(p.index);
     }
+  }
+  for (const ParamInfo& p : id.unidentifiable) {
+    if (p.kind != ParamKind::kFrame) scan.unidentifiable.push_back(p.name);
   }
   return scan;
 }

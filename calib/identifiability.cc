@@ -32,9 +32,16 @@ Identifiability AnalyzeIdentifiability(
     const std::vector<ParamInfo>& candidates,
     const IdentifiabilityOptions& options,
     const std::vector<PointDistance>& distances) {
+  return AnalyzeJacobianColumns(
+      ResidualJacobian(measurements, state, candidates, distances), candidates,
+      state.chain, options);
+}
+
+Identifiability AnalyzeJacobianColumns(const Eigen::MatrixXd& jac,
+                                       const std::vector<ParamInfo>& candidates,
+                                       const Chain& chain,
+                                       const IdentifiabilityOptions& options) {
   Identifiability out;
-  const Eigen::MatrixXd jac =
-      ResidualJacobian(measurements, state, candidates, distances);
   const int m = static_cast<int>(jac.rows());
   Eigen::MatrixXd basis(m, 0);  // orthonormal basis of accepted columns
   std::vector<int> accepted;
@@ -59,7 +66,7 @@ Identifiability AnalyzeIdentifiability(
         candidates[c].kind == ParamKind::kRow) {
       const bool angle = candidates[c].angle;
       const double bound =
-          angle ? state.chain.bound_angle_rad : state.chain.bound_length_mm;
+          angle ? chain.bound_angle_rad : chain.bound_length_mm;
       determined = sigma < options.max_sigma_fraction * bound;
     }
     if (determined) {

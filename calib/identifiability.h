@@ -12,6 +12,7 @@
 // frame and fixed points first, then rows in chain order, so redundant robot
 // parameters are the ones dropped.
 
+#include <Eigen/Core>
 #include <string>
 #include <vector>
 
@@ -66,6 +67,17 @@ Identifiability AnalyzeIdentifiability(
     const std::vector<ParamInfo>& candidates,
     const IdentifiabilityOptions& options = {},
     const std::vector<PointDistance>& distances = {});
+
+// The same scan on a Jacobian the caller computed, column c belonging to
+// candidates[c] in priority order, for residuals that are not tip points
+// (the image bundle's pixels: options.noise_sigma_mm is then the pixel
+// noise, in the residuals' unit). `chain` gives the row parameters' bounds.
+// A column that stands for no robot parameter (a frame's pose) is passed
+// as a ParamInfo of kind kFrame: it takes part in the span, without the
+// bound test.
+Identifiability AnalyzeJacobianColumns(
+    const Eigen::MatrixXd& jacobian, const std::vector<ParamInfo>& candidates,
+    const Chain& chain, const IdentifiabilityOptions& options = {});
 
 }  // namespace kincal
 

@@ -172,5 +172,36 @@ TEST(IdentifiabilityTest, Bh7GenericGeometryAddsOnlyWeakParameters) {
   EXPECT_THAT(a.id.weak, Contains("j2.theta"));
 }
 
+// The scan on a caller's Jacobian (the bundle's pixels): a column in the
+// span of earlier ones is held with its relation, a frame column takes part
+// without the bound test, and a row column too weak for its bound at the
+// given noise is held although it is independent.
+TEST(IdentifiabilityTest, JacobianColumnsScanInPriorityOrder) {
+  Chain chain;  // bounds: 5 mm, 5 deg
+  Eigen::MatrixXd jac = Eigen::MatrixXd::Zero(4, 4);
+  jac.col(0) << 1, 0, 0, 0;     // a frame pose column
+  jac.col(1) << 0, 2, 0, 0;     // a.d: independent, strong
+  jac.col(2) << 3, 4, 0, 0;     // a.a = 3 pose + 2 a.d: redundant
+  jac.col(3) << 0, 0, 1e-3, 0;  // b.a: independent, sigma 1e3 x noise
+  const std::vector<ParamInfo> candidates = {
+      {"pose.0", ParamKind::kFrame, 0, 0, false},
+      {"a.d", ParamKind::kRow, 0, 1, false},
+      {"a.a", ParamKind::kRow, 0, 2, false},
+      {"b.a", ParamKind::kRow, 1, 2, false}};
+  IdentifiabilityOptions options;
+  options.noise_sigma_mm = 0.01;  // b.a: sigma 10 mm > 0.1 x 5 mm
+  const Identifiability id =
+      AnalyzeJacobianColumns(jac, candidates, chain, options);
+  EXPECT_EQ(id.IdentifiableNames(),
+            (std::vector<std::string>{"pose.0", "a.d"}));
+  EXPECT_EQ(id.UnidentifiableNames(), (std::vector<std::string>{"a.a", "b.a"}));
+  ASSERT_EQ(id.relations.size(), 2u);
+  EXPECT_EQ(id.relations[0], "a.a = +3.000 pose.0 +2.000 a.d");
+  // Without a noise level only the sine test applies: b.a is determined.
+  const Identifiability sine_only =
+      AnalyzeJacobianColumns(jac, candidates, chain, {});
+  EXPECT_THAT(sine_only.IdentifiableNames(), Contains("b.a"));
+}
+
 }  // namespace
 }  // namespace kincal

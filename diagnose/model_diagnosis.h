@@ -77,7 +77,7 @@ struct DiagnoseOptions {
   // F-test must also lower the cross-validated RMS (instead of the single
   // held-out split's RMS, which is then only reported), and the lowest
   // cross-validated RMS wins the step (with validation series, theirs).
-  // 0 or 1 = the single held-out split, as before. Unless `folds_given`,
+  // 0 or 1 = one held-out split. Unless `folds_given`,
   // fewer folds when the training poses are few (at least
   // kMinPosesPerFold distinct poses per fold, else the single split); with
   // `folds_given` more folds than distinct training poses is bad input.
