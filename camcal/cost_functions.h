@@ -20,6 +20,19 @@
 
 namespace kincal {
 
+// The reprojection residual every functor below ends with:
+//   residual = ProjectPoint(intrinsics, p_in_cam) - pixel
+// false (no residual) for a point ProjectPoint rejects (behind the camera).
+template <typename T>
+bool PixelResidual(const T* intrinsics, const T* p_in_cam,
+                   const Eigen::Vector2d& pixel, T* residuals) {
+  T projected[2];
+  if (!ProjectPoint(intrinsics, p_in_cam, projected)) return false;
+  residuals[0] = projected[0] - T(pixel.x());
+  residuals[1] = projected[1] - T(pixel.y());
+  return true;
+}
+
 // Reprojection error of a target point seen by the reference camera (whose
 // frame is the rig frame):
 //   residual = ProjectPoint(intrinsics, rig_from_target * p_in_target) - pixel
@@ -37,11 +50,7 @@ class TargetReprojectionError {
     const Eigen::Map<const Eigen::Quaternion<T>> q(rig_from_target_q);
     const Eigen::Map<const Eigen::Matrix<T, 3, 1>> t(rig_from_target_t);
     const Eigen::Matrix<T, 3, 1> p_in_cam = q * p_in_target_.cast<T>() + t;
-    T pixel[2];
-    if (!ProjectPoint(intrinsics, p_in_cam.data(), pixel)) return false;
-    residuals[0] = pixel[0] - T(pixel_.x());
-    residuals[1] = pixel[1] - T(pixel_.y());
-    return true;
+    return PixelResidual(intrinsics, p_in_cam.data(), pixel_, residuals);
   }
 
   static ceres::CostFunction* Create(const Eigen::Vector3d& p_in_target,
@@ -76,11 +85,7 @@ class RigTargetReprojectionError {
     const Eigen::Matrix<T, 3, 1> p_in_rig =
         q_rt * p_in_target_.cast<T>() + t_rt;
     const Eigen::Matrix<T, 3, 1> p_in_cam = q_cr * p_in_rig + t_cr;
-    T pixel[2];
-    if (!ProjectPoint(intrinsics, p_in_cam.data(), pixel)) return false;
-    residuals[0] = pixel[0] - T(pixel_.x());
-    residuals[1] = pixel[1] - T(pixel_.y());
-    return true;
+    return PixelResidual(intrinsics, p_in_cam.data(), pixel_, residuals);
   }
 
   static ceres::CostFunction* Create(const Eigen::Vector3d& p_in_target,
@@ -111,11 +116,7 @@ class RotatedRayError {
     T intrinsics[kNumIntrinsics];
     for (int i = 0; i < kNumIntrinsics; ++i)
       intrinsics[i] = T(intrinsics_b_[i]);
-    T pixel[2];
-    if (!ProjectPoint(intrinsics, p_in_b, pixel)) return false;
-    residuals[0] = pixel[0] - T(pixel_.x());
-    residuals[1] = pixel[1] - T(pixel_.y());
-    return true;
+    return PixelResidual(intrinsics, p_in_b, pixel_, residuals);
   }
 
   static ceres::CostFunction* Create(
@@ -163,11 +164,7 @@ class ToolCornerReprojectionCost {
     }
     T intrinsics[kNumIntrinsics];
     for (int i = 0; i < kNumIntrinsics; ++i) intrinsics[i] = T(intrinsics_[i]);
-    T px[2];
-    if (!ProjectPoint(intrinsics, p_in_cam, px)) return false;
-    residuals[0] = px[0] - T(px_measured_.x());
-    residuals[1] = px[1] - T(px_measured_.y());
-    return true;
+    return PixelResidual(intrinsics, p_in_cam, px_measured_, residuals);
   }
 
   static ceres::CostFunction* Create(const Eigen::Vector2d& px_measured,
