@@ -43,7 +43,9 @@ int RunReport(const ReportArgs& args) {
                         {"bytes", r.html.size()}, {"seconds", seconds}};
     if (r.tolerance_given) {
       j["tolerance_mm"] = r.tolerance_mm;
-      j["pass"] = r.pass;
+      // null when not decided (no held-out figure, or too few poses).
+      j["pass"] = r.tolerance_decided ? nlohmann::json(r.pass) : nullptr;
+      j["decided"] = r.tolerance_decided;
       if (r.tolerance_available) {
         j["heldout_rms_mm"] = r.heldout_rms_mm;
         j["heldout_ci95_mm"] = {r.heldout_lo_mm, r.heldout_hi_mm};
@@ -59,8 +61,11 @@ int RunReport(const ReportArgs& args) {
     std::printf(
         "  %s: held-out RMS %.4g mm [%.4g, %.4g] (95 %%, %d poses), "
         "tolerance %.4g mm\n",
-        r.pass ? "PASS" : "FAIL", r.heldout_rms_mm, r.heldout_lo_mm,
-        r.heldout_hi_mm, r.heldout_n, r.tolerance_mm);
+        !r.tolerance_decided ? "NOT DECIDED"
+        : r.pass             ? "PASS"
+                             : "FAIL",
+        r.heldout_rms_mm, r.heldout_lo_mm, r.heldout_hi_mm, r.heldout_n,
+        r.tolerance_mm);
   }
   for (const auto& n : r.notes) std::printf("  note: %s\n", n.c_str());
   std::printf("%s\n", args.out.c_str());

@@ -21,7 +21,7 @@ figure.row figcaption{flex-basis:100%}
 figcaption{font-size:.9em;color:#444}
 code,pre{font-size:.85em;background:#f6f6f6} pre{padding:.5em;white-space:pre-wrap;word-break:break-all}
 .note{color:#8a5a00}
-.verdict p.pass{font-weight:bold;color:#1a6b1a} .verdict p.fail{font-weight:bold;color:#a01010}
+.verdict p.pass{font-weight:bold;color:#1a6b1a} .verdict p.fail{font-weight:bold;color:#a01010} .verdict p.undecided{font-weight:bold;color:#8a5a00}
 @media print{nav{display:none} body{max-width:none;padding:0} h2{page-break-after:avoid}}
 )CSS";
 

@@ -61,8 +61,10 @@ void AddVerdictSection(const std::vector<std::string>& verdict,
   std::string html = "<div class='verdict'>";
   for (const auto& v : verdict) {
     const bool tol = tolerance.given && v == tolerance.words;
-    html += tol ? std::string("<p class='") +
-                      (tolerance.pass ? "pass" : "fail") + "'>" + XmlEscape(v) +
+    const char* tol_class = !tolerance.decided ? "undecided"
+                            : tolerance.pass   ? "pass"
+                                               : "fail";
+    html += tol ? std::string("<p class='") + tol_class + "'>" + XmlEscape(v) +
                       "</p>"
                 : "<p>" + XmlEscape(v) + "</p>";
   }
@@ -143,6 +145,7 @@ ReportResult BuildReport(
   result.notes = an.notes;
   result.tolerance_given = tolerance.given;
   result.tolerance_available = tolerance.available;
+  result.tolerance_decided = tolerance.decided;
   result.pass = tolerance.pass;
   result.tolerance_mm = tolerance.tolerance_mm;
   result.heldout_rms_mm = tolerance.heldout.rms_mm;

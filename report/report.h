@@ -54,7 +54,8 @@ struct ReportResult {
   std::vector<std::string> notes;  // sections skipped and why
   // --tolerance: whether given, whether a held-out figure was there, and
   // the check (report/verdict.h ToleranceCheck).
-  bool tolerance_given = false, tolerance_available = false, pass = false;
+  bool tolerance_given = false, tolerance_available = false;
+  bool tolerance_decided = false, pass = false;
   double tolerance_mm = 0.0, heldout_rms_mm = 0.0;
   double heldout_lo_mm = 0.0, heldout_hi_mm = 0.0;
   int heldout_n = 0;

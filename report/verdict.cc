@@ -311,6 +311,7 @@ ToleranceCheck CheckTolerance(const ReportInputs& in, const ReportAnalysis& an,
   t.lo_mm = std::sqrt(ss / ChiSquareQuantile(0.975, dof));
   t.hi_mm = std::sqrt(ss / ChiSquareQuantile(0.025, dof));
   if (t.heldout.n < kMinHeldOutPoses) return t;  // words set above
+  t.decided = true;
   t.pass = t.hi_mm <= t.tolerance_mm;
   const std::string figure =
       "held-out RMS " + Fmt(t.heldout.rms_mm, 3) + " mm, 95 % interval [" +

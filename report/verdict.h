@@ -51,7 +51,9 @@ double ChiSquareQuantile(double p, double dof);
 // below the tolerance; with fewer than kMinHeldOutPoses held-out poses it is
 // not decided (no pass), and says so.
 struct ToleranceCheck {
-  bool given = false, available = false, pass = false;
+  // decided: available with at least kMinHeldOutPoses held-out poses;
+  // pass means something only when decided.
+  bool given = false, available = false, decided = false, pass = false;
   double tolerance_mm = 0.0;
   HeldOutFigure heldout;
   double lo_mm = 0.0, hi_mm = 0.0;  // 95 % interval of the held-out RMS

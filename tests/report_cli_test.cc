@@ -202,6 +202,7 @@ TEST(ReportCliTest, ToleranceAddsPassFailAndKeepsExitZero) {
   auto j = nlohmann::json::parse(r.out);
   EXPECT_EQ(j["tolerance_mm"], 1.0);
   EXPECT_EQ(j["pass"], true);
+  EXPECT_EQ(j["decided"], true);
   ASSERT_EQ(j["heldout_ci95_mm"].size(), 2u);
   EXPECT_LT(j["heldout_ci95_mm"][0].get<double>(),
             j["heldout_rms_mm"].get<double>());
@@ -231,6 +232,15 @@ TEST(ReportCliTest, FewPosesSayTooFewInsteadOfPercentages) {
   EXPECT_THAT(html, HasSubstr("too few poses (16)"));
   EXPECT_THAT(html, Not(HasSubstr("grid explains")));
   EXPECT_THAT(html, HasSubstr("a rough figure"));  // 3 held-out poses
+  // A tolerance is not decided on 3 held-out poses: pass is null.
+  const auto t = RunKincal("report --robot " + robot + " --obs " + dir +
+                           "/s/observations.csv --out " + dir +
+                           "/r.html --tolerance 0.5 --json");
+  ASSERT_EQ(t.exit_code, 0) << t.err;
+  const auto j = nlohmann::json::parse(t.out);
+  EXPECT_TRUE(j["pass"].is_null());
+  EXPECT_EQ(j["decided"], false);
+  EXPECT_THAT(ReadFile(dir + "/r.html"), HasSubstr("NOT DECIDED"));
 }
 
 // --bundle: the bundle's own figures, no calibration run by the report.
