@@ -118,7 +118,7 @@ ReportResult BuildReport(
   const ToleranceCheck tolerance = CheckTolerance(in, an, opt);
   const std::string name = in.has_robot ? in.robot.name
                            : in.has_cal ? in.cal.name
-                                        : std::string("kincal");
+                                        : std::string("cameras and tracking");
   HtmlReport page("kincal report: " + name);
   AddVerdictSection(WriteVerdict(in, an, opt), tolerance, &page);
   AddDiagnosisSection(in, opt, &page);
