@@ -356,16 +356,16 @@ class V4l2Source : public FrameSource {
                                std::to_string(buf.sequence) +
                                " (driver flagged an error)");
     }
-    PixelBuffer pb;
-    pb.data = maps_[buf.index].start;
-    pb.bytes = std::min<size_t>(buf.bytesused, maps_[buf.index].length);
-    pb.width = width_;
-    pb.height = height_;
-    pb.stride = static_cast<int>(stride_);
-    pb.layout = format_name_ == "GREY"   ? PixelLayout::kGray8
-                : format_name_ == "MJPG" ? PixelLayout::kMjpg
-                                         : PixelLayout::kYuyv;
-    Status s = ConvertToMat(pb, &frame->image);
+    PixelBuffer pixels;
+    pixels.data = maps_[buf.index].start;
+    pixels.bytes = std::min<size_t>(buf.bytesused, maps_[buf.index].length);
+    pixels.width = width_;
+    pixels.height = height_;
+    pixels.stride = static_cast<int>(stride_);
+    pixels.layout = format_name_ == "GREY"   ? PixelLayout::kGray8
+                    : format_name_ == "MJPG" ? PixelLayout::kMjpg
+                                             : PixelLayout::kYuyv;
+    Status s = ConvertToMat(pixels, &frame->image);
     if (!s.ok()) {
       return Status::Error(s.kind(), device_ + ": frame " +
                                          std::to_string(buf.sequence) + ": " +

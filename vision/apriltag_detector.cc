@@ -324,10 +324,10 @@ bool RefineCornersByEdges(const cv::Mat& gray, TagDetection* det,
       const Eigen::Vector2d p = a + t * len * dir;
       if (!Inside(gray, p, margin)) continue;
       base.push_back(p);
-      const Eigen::Vector2d pd = p - 0.5 * cell * n;
-      const Eigen::Vector2d pb = p + 0.5 * cell * n;
-      dark.push_back(Bilinear(gray, pd.x(), pd.y()));
-      bright.push_back(Bilinear(gray, pb.x(), pb.y()));
+      const Eigen::Vector2d p_dark = p - 0.5 * cell * n;
+      const Eigen::Vector2d p_bright = p + 0.5 * cell * n;
+      dark.push_back(Bilinear(gray, p_dark.x(), p_dark.y()));
+      bright.push_back(Bilinear(gray, p_bright.x(), p_bright.y()));
     }
     if (base.size() < 4) return false;
     const double i_dark = Median(dark);
