@@ -143,5 +143,83 @@ TEST(LabProcedure, SimulateFakeRobotCaptureTrackCalibrate) {
   EXPECT_TRUE(nlohmann::json::parse(r.out)["heldout_rms_mm"].is_number());
 }
 
+// The code block of docs/LAB.md whose first line starts with `prefix`.
+std::string LabBlock(const std::string& prefix) {
+  const std::string lab = ReadFile(testing::SourceDir() + "/docs/LAB.md");
+  size_t at = 0;
+  while ((at = lab.find("```\n", at)) != std::string::npos) {
+    const size_t begin = at + 4;
+    const size_t end = lab.find("```", begin);
+    if (end == std::string::npos) break;
+    if (lab.compare(begin, prefix.size(), prefix) == 0) {
+      return lab.substr(begin, end - begin);
+    }
+    at = end + 3;
+  }
+  return "";
+}
+
+// LAB.md's robot-program line, run as written on plans of a 5-joint
+// (BH-7) and a 7-joint (Panda URDF) robot: one list, every joint of every
+// pose, no empty element.
+TEST(LabProcedureTest, RobotProgramLineKeepsEveryJoint) {
+  const std::string awk = LabBlock("awk ");
+  ASSERT_FALSE(awk.empty()) << "docs/LAB.md has no ``` block starting 'awk '";
+  const std::string dir = testing::MakeTempDir("lab_awk");
+  const std::string panda = testing::SharedDataDir() + "/mukca/urdf/panda.urdf";
+  struct Case {
+    std::string robot_args;
+    int joints;
+  };
+  std::vector<Case> cases = {
+      {"--robot " + testing::SourceDir() + "/data/robots/bh7.yaml", 5}};
+  if (testing::Exists(panda))
+    cases.push_back({"--robot " + panda + " --tip panda_hand", 7});
+  for (const Case& c : cases) {
+    const RunResult plan = RunKincal("plan " + c.robot_args + " --n 20 --out " +
+                                     dir + "/poses.csv");
+    ASSERT_EQ(plan.exit_code, 0) << plan.err;
+    const RunResult list =
+        testing::RunShell("cd " + dir + " && " + awk.substr(0, awk.find('\n')));
+    ASSERT_EQ(list.exit_code, 0) << list.err;
+    const std::string& out = list.out;
+    ASSERT_GE(out.size(), 4u);
+    EXPECT_EQ(out.substr(0, 2), "[[");
+    EXPECT_EQ(out.substr(out.size() - 3), "]]\n");
+    EXPECT_EQ(out.find(",]"), std::string::npos) << out;
+    EXPECT_EQ(out.find(", ,"), std::string::npos) << out;
+    int poses = 0, commas = 0;
+    for (char ch : out) {
+      poses += ch == '[';
+      commas += ch == ',';
+    }
+    EXPECT_EQ(poses - 1, 20) << out;
+    // Inside each pose joints - 1 commas, between poses 19.
+    EXPECT_EQ(commas, 20 * (c.joints - 1) + 19) << out;
+  }
+}
+
+// LAB.md's camcal line gives the board in millimetres (camcal's unit): a
+// tag of at least 5 mm, not a size in metres.
+TEST(LabProcedureTest, CamcalBoardIsInMillimetres) {
+  const std::string lab = ReadFile(testing::SourceDir() + "/docs/LAB.md");
+  size_t at = 0;
+  int boards = 0;
+  while ((at = lab.find("--target aprilgrid:", at)) != std::string::npos) {
+    const size_t begin = at + 9;
+    const std::string spec =
+        lab.substr(begin, lab.find_first_of(" \n", begin) - begin);
+    // aprilgrid:COLSxROWS:TAG_SIZE:SPACING_RATIO
+    const size_t c1 = spec.find(':', 10);
+    const size_t c2 = spec.find(':', c1 + 1);
+    ASSERT_NE(c2, std::string::npos) << spec;
+    EXPECT_GE(std::stod(spec.substr(c1 + 1, c2 - c1 - 1)), 5.0)
+        << spec << ": tag size in metres? camcal reads millimetres";
+    ++boards;
+    at = begin;
+  }
+  EXPECT_GE(boards, 1);
+}
+
 }  // namespace
 }  // namespace kincal
