@@ -9,6 +9,7 @@
 #include "app/command.h"
 #include "data/error.h"
 #include "data/provenance.h"
+#include "kincal_commit.h"  // generated: KINCAL_COMMIT (app/commit.cmake)
 
 namespace kincal::app {
 
@@ -37,7 +38,8 @@ int main(int argc, char** argv) {
       "Units at every interface: mm, degrees, seconds."};
   app.require_subcommand(1);
   app.option_defaults()->always_capture_default();  // --help shows defaults
-  app.set_version_flag("--version", kincal::ToolVersion());
+  app.set_version_flag("--version", kincal::ToolVersion() +
+                                        " (commit " KINCAL_COMMIT ")");
   kincal::app::Runner run;
   kincal::app::AddSimulateCommand(app, &run);
   kincal::app::AddCalibrateCommand(app, &run);

@@ -185,6 +185,16 @@ TEST(CliHelp, EveryCommandHasAnExampleAndUnits) {
   EXPECT_GE(leaves.size(), 15u);  // the tree was walked
 }
 
+// --version names the version and the commit built from (git describe of
+// the source tree: a hex hash, "-dirty" with uncommitted changes).
+TEST(CliVersion, NamesTheCommit) {
+  const RunResult r = RunKincal("--version");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_THAT(r.out, ::testing::MatchesRegex(
+                         "kincal [0-9.]+ \\(commit ([0-9a-f]{7,}(-dirty)?|"
+                         "unknown)\\)\n"));
+}
+
 TEST_F(CliTest, HumanReadableOutputWithoutJson) {
   const RunResult r =
       RunKincal("calibrate --robot " + Robot() + " --obs " + Obs());
