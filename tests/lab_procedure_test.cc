@@ -11,6 +11,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <fstream>
 #include <map>
 #include <nlohmann/json.hpp>
 #include <thread>
@@ -219,6 +220,55 @@ TEST(LabProcedureTest, CamcalBoardIsInMillimetres) {
     at = begin;
   }
   EXPECT_GE(boards, 1);
+}
+
+// The code blocks of docs/LAB.md's section `heading` (a "## " line), in
+// order.
+std::vector<std::string> LabBlocksIn(const std::string& heading) {
+  const std::string lab = ReadFile(testing::SourceDir() + "/docs/LAB.md");
+  std::vector<std::string> blocks;
+  const size_t start = lab.find("\n" + heading + "\n");
+  if (start == std::string::npos) return blocks;
+  const size_t stop = lab.find("\n## ", start + heading.size() + 1);
+  size_t at = start;
+  while ((at = lab.find("```\n", at)) != std::string::npos && at < stop) {
+    const size_t begin = at + 4;
+    const size_t end = lab.find("```", begin);
+    if (end == std::string::npos || end > stop) break;
+    blocks.push_back(lab.substr(begin, end - begin));
+    at = end + 3;
+  }
+  return blocks;
+}
+
+// The rehearsal of docs/LAB.md exactly as written: every command block of
+// its section run by the shell in a fresh folder (the project's data/ and
+// scripts/ beside it, build/bin on the PATH), each must exit 0 and the
+// files the procedure goes on with must be there.
+TEST(LabProcedureTest, RehearsalBlocksRunAsWritten) {
+  const std::vector<std::string> blocks =
+      LabBlocksIn("## Rehearsal without hardware (run here)");
+  ASSERT_GE(blocks.size(), 2u) << "docs/LAB.md: rehearsal blocks missing";
+  const std::string dir = testing::MakeTempDir("lab_doc");
+  const std::string src = testing::SourceDir();
+  const std::string bin =
+      testing::KincalBinary().substr(0, testing::KincalBinary().rfind('/'));
+  ASSERT_EQ(
+      testing::RunShell("ln -s " + src + "/data " + dir + "/data && ln -s " +
+                        src + "/scripts " + dir + "/scripts")
+          .exit_code,
+      0);
+  for (const std::string& block : blocks) {
+    std::ofstream(dir + "/block.sh") << block;
+    const RunResult r = testing::RunShell("cd " + dir + " && PATH=" + bin +
+                                          ":$PATH sh -e block.sh >block.out");
+    EXPECT_EQ(r.exit_code, 0) << block << "\n" << r.err;
+  }
+  for (const char* file :
+       {"sim/rig.yaml", "session/observations.csv", "points.csv", "obs.csv",
+        "cal.yaml", "poses.csv", "handshake/frames.csv"}) {
+    EXPECT_TRUE(testing::Exists(dir + "/" + file)) << file;
+  }
 }
 
 }  // namespace
