@@ -6,8 +6,10 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <iostream>
 
 #include "data/error.h"
+#include "data/observation_checks.h"
 
 namespace kincal::app {
 
@@ -110,5 +112,24 @@ void PrintOutliers(const std::vector<RowOutlier>& outliers,
     std::printf("\n");
   }
 }
+
+Observations ReadCheckedObservations(const std::string& path,
+                                     const Robot& robot,
+                                     const std::string& robot_file,
+                                     Warnings* warnings) {
+  Observations obs = ReadObservationsCsv(path, robot.JointNames());
+  CheckObservationsAgainstRobot(robot, obs, robot_file, warnings);
+  return obs;
+}
+
+void AddWarnings(const std::vector<Warning>& warnings, nlohmann::json* j) {
+  if (warnings.empty()) return;
+  nlohmann::json list = nlohmann::json::array();
+  for (const Warning& w : warnings)
+    list.push_back({{"code", w.code}, {"message", w.message}});
+  (*j)["warnings"] = list;
+}
+
+Warnings CommandWarnings() { return Warnings(&std::cerr); }
 
 }  // namespace kincal::app

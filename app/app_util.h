@@ -14,6 +14,7 @@
 #include "calib/outliers.h"
 #include "data/observations.h"
 #include "data/robot.h"
+#include "data/warnings.h"
 
 namespace kincal::app {
 
@@ -50,6 +51,28 @@ nlohmann::json OutliersJson(const std::vector<RowOutlier>& outliers);
 // The same in words, one line each after a header line; nothing when empty.
 void PrintOutliers(const std::vector<RowOutlier>& outliers,
                    double axis_sigma_mm, double sigmas);
+
+// Reads observations.csv for `robot` (read from `robot_file`) and checks
+// them against it (data/observation_checks.h): InputError for readings
+// outside the joint limits or points in metres; warnings (e.g. radians) into
+// `warnings`. The one place the commands that take --robot and --obs load
+// their observations.
+Observations ReadCheckedObservations(const std::string& path,
+                                     const Robot& robot,
+                                     const std::string& robot_file,
+                                     Warnings* warnings);
+
+// Adds `warnings` to a result as "warnings": [{code, message}, ...]; nothing
+// when there are none (outputs of good inputs keep their fields).
+void AddWarnings(const std::vector<Warning>& warnings, nlohmann::json* j);
+inline void AddWarnings(const Warnings& warnings, nlohmann::json* j) {
+  AddWarnings(warnings.list(), j);
+}
+
+// A command's warnings list: each warning goes to stderr as it is found (in
+// JSON mode too, so that a later refusal still shows it) and into the JSON
+// result through AddWarnings.
+Warnings CommandWarnings();
 
 }  // namespace kincal::app
 

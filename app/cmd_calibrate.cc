@@ -227,7 +227,9 @@ void PrintCalibrate(const CalibrateArgs& args, const CalibrateResult& r,
 
 int RunCalibrate(CalibrateArgs args) {
   const Robot nominal = ReadNominal(args);
-  const Observations obs = ReadObservationsCsv(args.obs, nominal.JointNames());
+  Warnings warnings = CommandWarnings();
+  const Observations obs =
+      ReadCheckedObservations(args.obs, nominal, args.robot, &warnings);
   args.options = FitOptions(args);
   Progress progress("kincal calibrate", args.json || obs.rows.size() < 500);
   progress.Stage("fitting " + std::to_string(obs.rows.size()) +
@@ -235,7 +237,8 @@ int RunCalibrate(CalibrateArgs args) {
   const CalibrateResult r = Calibrate(nominal, obs, args.options);
   progress.Done();
   if (!args.out.empty()) WriteCalibrated(args, r);
-  const nlohmann::json j = CalibrateJson(args, r, nominal);
+  nlohmann::json j = CalibrateJson(args, r, nominal);
+  AddWarnings(warnings, &j);
   if (args.json) {
     PrintJson(j);
     return 0;

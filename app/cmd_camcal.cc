@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <iostream>
 #include <memory>
 #include <opencv2/imgcodecs.hpp>
 #include <string>
@@ -297,6 +298,11 @@ int RunCamcal(const CamcalArgs& args) {
   progress.Stage("calibrating (OpenCV start, Ceres refinement, covariance)");
   const CalibrationSummary sum = CalibrateCameras(problem, options);
   progress.Done();
+  const std::string failure = SolveFailure(sum, options);
+  if (!failure.empty()) {
+    std::cerr << "kincal: failure: " << failure << "; nothing written\n";
+    return 1;
+  }
   WriteRigYaml(args.out, sum.rig);
   if (args.json) {
     PrintJson(SummaryJson(args, spec, problem, files, sum));

@@ -152,6 +152,7 @@ nlohmann::json RecordingJson(const capture::CaptureOptions& options,
   j["stop_reason"] = r.stop_reason;
   j["complete"] = r.complete;
   if (r.has_joints) j["joints"] = JointsJson(r.joints);
+  AddWarnings(r.warnings, &j);
   return j;
 }
 
@@ -167,6 +168,28 @@ void PrintStepAndShoot(const CaptureArgs& args,
       "stopped: %s\n",
       r.poses, args.options.shots, args.options.out.c_str(),
       r.stop_reason.c_str());
+}
+
+// The merged joint readings in words: the clock offset, how it was found
+// and, when estimated, its agreement with the images.
+void PrintJoints(const capture::CaptureJoints& joints) {
+  if (joints.from_stream) {
+    std::printf(
+        "joints: %lld stream readings, clock offset %.3f s (fastest "
+        "sample)",
+        static_cast<long long>(joints.samples), joints.offset_s);
+  } else if (joints.offset_estimated) {
+    std::printf(
+        "joints: %s, clock offset %.3f s estimated (agreement with "
+        "the images %.0f%% of the frames, %d stops matched)",
+        joints.log.c_str(), joints.offset_s, 100.0 * joints.agreement,
+        joints.stops_matched);
+  } else {
+    std::printf("joints: %s, clock offset %.3f s (given)", joints.log.c_str(),
+                joints.offset_s);
+  }
+  std::printf("; %d frames with a reading, %d too fast\n",
+              joints.frames_with_reading, joints.frames_too_fast);
 }
 
 void PrintRecording(const CaptureArgs& args, const capture::CaptureResult& r) {
@@ -199,6 +222,7 @@ void PrintRecording(const CaptureArgs& args, const capture::CaptureResult& r) {
       static_cast<long long>(r.dropped_right),
       static_cast<long long>(r.dropped_pairs), r.stop_reason.c_str(),
       out.c_str(), out.c_str());
+  if (r.has_joints) PrintJoints(r.joints);
 }
 
 // Parse -> record (capture/capture_session.h) -> print. Ctrl-C stops the

@@ -33,10 +33,14 @@ std::string FormatJoint(const std::string& joint) {
 
 int RunModel(const ModelArgs& args) {
   const Robot robot = ReadRobot(args.robot, args.root, args.tip);
-  const Observations obs = ReadObservationsCsv(args.obs, robot.JointNames());
+  Warnings warnings = CommandWarnings();
+  const Observations obs =
+      ReadCheckedObservations(args.obs, robot, args.robot, &warnings);
   DiagnoseOptions options = args.options;
-  for (const std::string& v : args.validate)
-    options.validation.push_back(ReadObservationsCsv(v, robot.JointNames()));
+  for (const std::string& v : args.validate) {
+    options.validation.push_back(
+        ReadCheckedObservations(v, robot, args.robot, &warnings));
+  }
   Progress progress("kincal diagnose model", args.json);
   progress.Stage("fitting candidate extensions with the geometry, " +
                  std::to_string(obs.rows.size()) + " poses");
@@ -63,6 +67,7 @@ int RunModel(const ModelArgs& args) {
   if (args.json) {
     nlohmann::json j = DiagnosisJson(r, options);
     if (!args.out.empty()) j["out"] = args.out;
+    AddWarnings(warnings, &j);
     PrintJson(j);
     return 0;
   }
@@ -131,12 +136,16 @@ struct ClearanceArgs {
 
 int RunClearance(const ClearanceArgs& args) {
   const Robot robot = ReadRobot(args.robot, args.root, args.tip);
-  const Observations obs = ReadObservationsCsv(args.obs, robot.JointNames());
+  Warnings warnings = CommandWarnings();
+  const Observations obs =
+      ReadCheckedObservations(args.obs, robot, args.robot, &warnings);
   const ClearanceResult r = DiagnoseClearance(robot, obs, args.options);
   if (!args.csv.empty()) WriteFileAtomic(args.csv, ClearanceCsv(r));
   if (!args.plot.empty()) WriteFileAtomic(args.plot, ClearanceSvg(r));
   if (args.json) {
-    PrintJson(ClearanceJson(r));
+    nlohmann::json j = ClearanceJson(r);
+    AddWarnings(warnings, &j);
+    PrintJson(j);
     return 0;
   }
   std::printf("kincal diagnose clearance: %d poses, RMS %.4f mm, gamma %g\n",
@@ -168,13 +177,16 @@ struct CompareArgs {
 
 int RunCompare(const CompareArgs& args) {
   const Robot robot = ReadRobot(args.robot, args.root, args.tip);
+  Warnings warnings = CommandWarnings();
   const Observations before =
-      ReadObservationsCsv(args.before, robot.JointNames());
+      ReadCheckedObservations(args.before, robot, args.robot, &warnings);
   const Observations after =
-      ReadObservationsCsv(args.after, robot.JointNames());
+      ReadCheckedObservations(args.after, robot, args.robot, &warnings);
   const CompareResult r = CompareClearance(robot, before, after);
   if (args.json) {
-    PrintJson(CompareJson(r));
+    nlohmann::json j = CompareJson(r);
+    AddWarnings(warnings, &j);
+    PrintJson(j);
     return 0;
   }
   std::printf(

@@ -68,7 +68,9 @@ void AddPointsJson(const ModelState& st, const Observations& obs,
 
 int RunEvaluate(const EvaluateArgs& args) {
   const Robot robot = ReadRobot(args.robot, args.root, args.tip);
-  const Observations obs = ReadObservationsCsv(args.obs, robot.JointNames());
+  Warnings warnings = CommandWarnings();
+  const Observations obs =
+      ReadCheckedObservations(args.obs, robot, args.robot, &warnings);
   const EvaluateResult r = Evaluate(robot, obs, args.outlier_sigmas);
   if (!args.residuals.empty()) {
     std::ostringstream os;
@@ -93,6 +95,7 @@ int RunEvaluate(const EvaluateArgs& args) {
                     &w);
       j["without_outliers"] = w;
     }
+    AddWarnings(warnings, &j);
     PrintJson(j);
     return 0;
   }

@@ -63,7 +63,9 @@ std::string CurvesSvg(const SensitivityResult& r, double eta) {
 
 int RunSensitivity(const SensitivityArgs& args) {
   const Robot robot = ReadRobot(args.robot, args.root, args.tip);
-  const Observations obs = ReadObservationsCsv(args.obs, robot.JointNames());
+  Warnings warnings = CommandWarnings();
+  const Observations obs =
+      ReadCheckedObservations(args.obs, robot, args.robot, &warnings);
   const SensitivityResult r = AnalyzeSensitivity(robot, obs, args.options);
   if (!args.out_csv.empty()) WriteFileAtomic(args.out_csv, CurvesCsv(r));
   if (!args.plot.empty()) {
@@ -83,22 +85,24 @@ int RunSensitivity(const SensitivityArgs& args) {
                         {"offsets", c.offsets},
                         {"eps_mm", c.eps_mm}});
     }
-    PrintJson({{"verdict", r.verdict},
-               {"eps_mm", Number(r.eps_mm)},
-               {"epsilon", StatsJson(r.epsilon)},
-               {"eta_mm", args.options.eta_mm},
-               {"range", args.options.range},
-               {"steps", args.options.steps},
-               {"valleys_equal", r.valleys_equal},
-               {"below_eta", r.below_eta},
-               {"valley_min_mm", Number(r.valley_min_mm)},
-               {"valley_max_mm", Number(r.valley_max_mm)},
-               {"valley_tolerance_mm", Number(r.valley_tolerance_mm)},
-               {"reasons", r.reasons},
-               {"flat", r.flat},
-               {"unidentifiable", r.unidentifiable},
-               {"notes", r.notes},
-               {"curves", curves}});
+    nlohmann::json j = {{"verdict", r.verdict},
+                        {"eps_mm", Number(r.eps_mm)},
+                        {"epsilon", StatsJson(r.epsilon)},
+                        {"eta_mm", args.options.eta_mm},
+                        {"range", args.options.range},
+                        {"steps", args.options.steps},
+                        {"valleys_equal", r.valleys_equal},
+                        {"below_eta", r.below_eta},
+                        {"valley_min_mm", Number(r.valley_min_mm)},
+                        {"valley_max_mm", Number(r.valley_max_mm)},
+                        {"valley_tolerance_mm", Number(r.valley_tolerance_mm)},
+                        {"reasons", r.reasons},
+                        {"flat", r.flat},
+                        {"unidentifiable", r.unidentifiable},
+                        {"notes", r.notes},
+                        {"curves", curves}};
+    AddWarnings(warnings, &j);
+    PrintJson(j);
     return 0;
   }
   std::printf(

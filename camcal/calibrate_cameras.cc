@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <memory>
 #include <opencv2/calib3d.hpp>
 #include <opencv2/core/eigen.hpp>
@@ -456,6 +457,34 @@ void CalibrationOptions::Check() const {
           "calibration: min_points_per_view must be >= 4");
   Require(min_views >= 2, "calibration: min_views must be >= 2");
   Require(max_iterations > 0, "calibration: max_iterations must be > 0");
+  Require(max_rms_px > 0, "calibration: max_rms_px must be > 0");
+}
+
+std::string SolveFailure(const CalibrationSummary& summary,
+                         const CalibrationOptions& options) {
+  char text[512];
+  if (!summary.converged) {
+    std::snprintf(
+        text, sizeof text,
+        "the camera solve did not converge (%s after %d iterations, RMS "
+        "%.3g px): likely too many distortion terms for the views (%d); try "
+        "--distortion 5 (or 4), or record more views covering the image "
+        "corners",
+        summary.termination.c_str(), summary.iterations, summary.rms_px,
+        options.num_distortion);
+    return text;
+  }
+  if (!(summary.rms_px <= options.max_rms_px)) {
+    std::snprintf(
+        text, sizeof text,
+        "the camera solve ends at an RMS of %.4g px (above %g px, no "
+        "calibration): likely the wrong --target size or layout (columns x "
+        "rows of inner corners or tags, the tag spacing ratio) or images of "
+        "another target; check --target against the printed sheet",
+        summary.rms_px, options.max_rms_px);
+    return text;
+  }
+  return "";
 }
 
 std::vector<double> HeldOutRmsPx(const Rig& rig,

@@ -70,6 +70,9 @@ struct CalibrationOptions {
   // Each camera needs the target in at least this many views.
   int min_views = 3;
   int max_iterations = 200;
+  // A final RMS point residual above this (px) is no calibration: the
+  // target's size or layout does not match the images (SolveFailure).
+  double max_rms_px = 10.0;
   // Compute parameter sigma (ceres::Covariance, DENSE_SVD).
   bool compute_covariance = true;
   // Run the even/odd cross-validation (needs 2 * min_views views per camera).
@@ -148,6 +151,14 @@ struct CalibrationSummary {
 // no view seen by both cameras of a stereo pair).
 CalibrationSummary CalibrateCameras(const CalibrationProblem& problem,
                                     const CalibrationOptions& options = {});
+
+// Why the solve in `summary` is no calibration, with the likely cause and
+// the fix; empty when it is one. Not converged within max_iterations: too
+// many distortion terms for the views (try --distortion 5, or more views);
+// RMS above max_rms_px: the wrong --target size or layout. Commands write
+// nothing and exit 1 when this is not empty.
+std::string SolveFailure(const CalibrationSummary& summary,
+                         const CalibrationOptions& options);
 
 // Reprojection RMS of views when only each view's pose is fitted with the
 // cameras of `rig` held fixed (used for cross-validation). Returns one value

@@ -188,6 +188,27 @@ TEST(CalibrateCameras, TooFewViewsIsInputError) {
                InputError);
 }
 
+TEST(CalibrateCameras, SolveFailureNamesNonConvergenceAndAbsurdRms) {
+  CalibrationOptions options;
+  CalibrationSummary good;
+  good.converged = true;
+  good.rms_px = 0.4;
+  EXPECT_EQ(SolveFailure(good, options), "");
+  CalibrationSummary stuck = good;
+  stuck.converged = false;
+  stuck.termination = "NO_CONVERGENCE";
+  stuck.iterations = 200;
+  options.num_distortion = 8;
+  const std::string a = SolveFailure(stuck, options);
+  EXPECT_NE(a.find("did not converge"), std::string::npos) << a;
+  EXPECT_NE(a.find("--distortion 5"), std::string::npos) << a;
+  CalibrationSummary absurd = good;
+  absurd.rms_px = 700;
+  const std::string b = SolveFailure(absurd, options);
+  EXPECT_NE(b.find("700 px"), std::string::npos) << b;
+  EXPECT_NE(b.find("--target"), std::string::npos) << b;
+}
+
 TEST(ProjectionDifference, ZeroForSameModelAndRotationRemoved) {
   CameraIntrinsics a{"a", 640, 480, 800, 800, 320, 240, {-0.2, 0.1, 0, 0, 0}};
   EXPECT_LT(ProjectionDifferencePx(a, a).first, 1e-9);

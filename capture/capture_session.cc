@@ -19,8 +19,10 @@
 #include "capture/robot_link.h"
 #include "capture/stereo_grabber.h"
 #include "data/error.h"
+#include "data/observation_checks.h"
 #include "data/progress.h"
 #include "data/robot.h"
+#include "data/warnings.h"
 
 namespace kincal::capture {
 namespace {
@@ -46,7 +48,35 @@ struct Inputs {
   std::unique_ptr<FrameSource> left, right;
   std::optional<JointLog> joint_log;
   bool live = false;
+  Warnings warnings;
 };
+
+// The log's readings against the robot file: a reading outside its joint's
+// limits is refused (file:line, joint), readings that look like radians
+// warned about (data/observation_checks.h).
+void CheckLogAgainstRobot(const Robot& robot, const JointLog& log,
+                          const std::string& robot_file, Warnings* warnings) {
+  std::vector<int> column(robot.joints.size(), -1);
+  for (size_t k = 0; k < robot.joints.size(); ++k) {
+    for (size_t c = 0; c < log.names.size(); ++c) {
+      if (log.names[c] == robot.joints[k].name) column[k] = static_cast<int>(c);
+    }
+  }
+  std::vector<std::vector<double>> rows;
+  rows.reserve(log.q.size());
+  for (size_t r = 0; r < log.q.size(); ++r) {
+    std::vector<double> q(robot.joints.size(), 0.0);
+    for (size_t k = 0; k < robot.joints.size(); ++k) {
+      if (column[k] < 0) continue;
+      q[k] = log.q[r][column[k]];
+      CheckReadingWithinLimits(robot.joints[k], q[k], log.source,
+                               r < log.lines.size() ? log.lines[r] : 0,
+                               robot_file);
+    }
+    rows.push_back(q);
+  }
+  CheckJointUnits(robot, rows, log.source, warnings);
+}
 
 // Everything the user typed is checked before a camera or file is touched.
 Inputs CheckInputs(const CaptureOptions& options) {
@@ -60,6 +90,7 @@ Inputs CheckInputs(const CaptureOptions& options) {
           "capture: --left and --right name the same source '" + left_uri.path +
               "'");
   Inputs in;
+  in.warnings = Warnings(&std::cerr);
   in.left = MakeFrameSource(left_uri);
   in.right = MakeFrameSource(right_uri);
   Require(in.left->IsLive() == in.right->IsLive(),
@@ -68,11 +99,16 @@ Inputs CheckInputs(const CaptureOptions& options) {
               "): use two cameras or two recordings");
   if (!options.joints.empty()) {
     std::vector<std::string> names;
+    Robot robot;
     if (!options.robot.empty()) {
-      names = ReadRobotYaml(options.robot).JointNames();
+      robot = ReadRobotYaml(options.robot);
+      names = robot.JointNames();
     }
     in.joint_log =
         ReadJointLog(options.joints, options.robot.empty() ? nullptr : &names);
+    if (!options.robot.empty()) {
+      CheckLogAgainstRobot(robot, *in.joint_log, options.robot, &in.warnings);
+    }
   } else {
     Require((options.robot.empty() || !options.robot_listen.empty()) &&
                 std::isnan(options.joints_offset),
@@ -468,6 +504,7 @@ CaptureResult RunCaptureSession(const CaptureOptions& options) {
           "stream is put on the host clock) and no --joints");
 
   CaptureResult result;
+  result.warnings = in.warnings.list();
   StereoGrabberOptions grab_options;
   grab_options.tolerance_s = options.tolerance_ms * 1e-3;
   StereoGrabber grabber(in.left.get(), in.right.get(), grab_options);

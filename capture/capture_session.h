@@ -23,6 +23,7 @@
 #include <vector>
 
 #include "capture/step_and_shoot.h"
+#include "data/warnings.h"
 
 namespace kincal::capture {
 
@@ -91,6 +92,8 @@ struct CaptureResult {
   bool complete = false;  // no camera, disk or robot failure
   bool has_joints = false;
   CaptureJoints joints;  // when has_joints
+  // Inputs that look wrong (data/warnings.h); already on stderr.
+  std::vector<Warning> warnings;
 };
 
 // Throws InputError for bad input found before anything is written. A

@@ -157,6 +157,7 @@ JointLog ParseJointLog(const std::string& text, const std::string& label,
     }
     log.t.push_back(t);
     log.q.push_back(q);
+    log.lines.push_back(line.line);
   }
   if (log.t.size() < 2) {
     throw InputError(label, lines.back().line, 1,
@@ -365,6 +366,25 @@ void InterpolateReadings(const JointLog& log, const std::vector<double>& speeds,
   }
 }
 
+// An estimated offset near chance agreement matches no motion of this
+// session: refused, with what to do.
+void RequireAgreement(const JointLog& log, const JointMerge& merge,
+                      double min_agreement) {
+  if (merge.agreement >= min_agreement) return;
+  char percent[32];
+  std::snprintf(percent, sizeof percent, "%.0f%%", 100.0 * merge.agreement);
+  throw InputError(
+      log.source, 0, 0,
+      "the estimated clock offset " + Num(merge.offset_s) +
+          " s agrees with the images in only " + percent +
+          " of the frames (two unrelated recordings agree about half the "
+          "time; below " +
+          Num(100.0 * min_agreement) +
+          "% is refused): the log may be of another session. Give "
+          "--joints-offset if you know the offset, or record a motion both "
+          "the cameras and the log see (moves with stops between them)");
+}
+
 }  // namespace
 
 JointMerge MergeJointLog(const JointLog& log,
@@ -384,6 +404,7 @@ JointMerge MergeJointLog(const JointLog& log,
   } else {
     EstimateOffset(log, speeds, frame_times, image_motion, lo, hi, options,
                    &merge);
+    RequireAgreement(log, merge, options.min_agreement);
   }
   // Coverage with the chosen offset.
   if (!options.uncovered_ok && (first - merge.offset_s < log.t.front() - 1e-9 ||

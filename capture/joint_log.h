@@ -28,6 +28,7 @@ struct JointLog {
   std::vector<std::string> names;      // joint columns in file order
   std::vector<double> t;               // strictly increasing
   std::vector<std::vector<double>> q;  // per row, per name
+  std::vector<int> lines;              // per row: line in the file (1-based)
 };
 
 // Strict reader: `t` column required; every other column a joint; when
@@ -50,6 +51,10 @@ struct JointMergeOptions {
   // Frames outside the log get no reading instead of an error (a live
   // stream that ended early).
   bool uncovered_ok = false;
+  // An estimated offset whose moving/still agreement is below this is
+  // refused (InputError): two random indicators agree about half the time,
+  // a log of this session's motion in nearly every frame.
+  double min_agreement = 0.8;
 };
 
 struct JointMerge {
@@ -69,7 +74,9 @@ struct JointMerge {
 // `frame_times` (s, the session's clock, increasing) and `image_motion`
 // (one number per frame, larger = more change since the previous frame;
 // needed only to estimate the offset). InputError when the offset cannot be
-// estimated (no stops seen) or the log does not cover every frame.
+// estimated (no stops seen), the estimate's agreement is below
+// options.min_agreement (the message gives the offset and the agreement) or
+// the log does not cover every frame.
 JointMerge MergeJointLog(const JointLog& log,
                          const std::vector<double>& frame_times,
                          const std::vector<double>& image_motion,

@@ -104,6 +104,38 @@ TEST(JointLogTest, EstimatesTheClockOffsetFromStopsAndInterpolates) {
   EXPECT_GT(m.too_fast, 200);
 }
 
+// Images whose stops are the log's, but which move again 0.6 s after each
+// stop (something else moves in view): the stops fix an offset, yet the
+// moving/still states agree in well under half the frames. Refused, with the
+// offset and its agreement; a given offset is not checked.
+TEST(JointLogTest, AChanceLevelOffsetIsRefused) {
+  const Profile p;
+  const JointLog log = ParseJointLog(LogText(p, 100), "joints.csv", nullptr);
+  const double offset = -987.6543;
+  std::vector<double> times, motion;
+  for (int k = 0; k < 1500; ++k) {  // 50 s
+    times.push_back(20.0 + 5.0 / 30 + k / 30.0);
+    const double u = times.back() - offset - 0.5 / 30 - p.t0;
+    const int n = static_cast<int>(
+        std::upper_bound(p.starts.begin(), p.starts.end(), u) -
+        p.starts.begin() - 1);
+    motion.push_back(u - p.starts[n] < 0.6 ? 0.6 : 4.0);
+  }
+  try {
+    const JointMerge m = MergeJointLog(log, times, motion, {});
+    FAIL() << "accepted an offset with agreement " << m.agreement;
+  } catch (const InputError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("estimated clock offset"), std::string::npos) << what;
+    EXPECT_NE(what.find("% of the frames"), std::string::npos) << what;
+    EXPECT_NE(what.find("--joints-offset"), std::string::npos) << what;
+  }
+  // A given offset is the user's: no agreement check.
+  JointMergeOptions given;
+  given.offset_s = offset;
+  EXPECT_NO_THROW(MergeJointLog(log, times, motion, given));
+}
+
 // A perfectly periodic program cannot tell its cycles apart: the estimate
 // must refuse rather than pick one.
 TEST(JointLogTest, PeriodicStopsAreAmbiguous) {
