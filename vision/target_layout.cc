@@ -30,9 +30,11 @@ void TargetLayoutOptions::Check() const {
         std::to_string(tag_size_mm));
   }
   if (min_views < 2) throw InputError("min_views: expected at least 2");
-  if (!(huber_px > 0) || !(outlier_px > 0) || !(outlier_ratio > 1)) {
+  if (!(huber_px > 0) || !(outlier_px > 0) || !(outlier_ratio > 1) ||
+      !(max_rms_px > 0)) {
     throw InputError(
-        "huber_px and outlier_px must be > 0 and outlier_ratio > 1");
+        "huber_px, outlier_px and max_rms_px must be > 0 and outlier_ratio "
+        "> 1");
   }
   if (max_iterations < 1) throw InputError("max_iterations: expected >= 1");
   pose.Check();
@@ -432,6 +434,14 @@ TargetLayoutResult MeasureTargetLayout(const Rig& rig,
   result.corners_used = residuals / 2;
   result.rms_px = std::sqrt(2 * cost / std::max(1, residuals));
   result.sigma0_px = std::sqrt(2 * cost / std::max(1, residuals - parameters));
+  if (!(result.rms_px <= options.max_rms_px)) {
+    std::ostringstream os;
+    os << "the tag corners fit the rig with an RMS of " << result.rms_px
+       << " px (at most " << options.max_rms_px
+       << " expected): check --size (the edge of the tags' black square, "
+          "mm), the rig file and the family";
+    throw InputError(os.str());
+  }
 
   result.target.family = options.family;
   result.target.has_tip = false;

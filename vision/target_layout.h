@@ -53,6 +53,9 @@ struct TargetLayoutOptions {
   double outlier_px = 1.0;
   double outlier_ratio = 5.0;
   int max_iterations = 100;
+  // A final corner RMS above this is refused: the tag size (or the rig, or
+  // the family) does not fit the images.
+  double max_rms_px = 2.0;
   ToolPoseOptions pose;  // the one-tag pose fits of step 1
 
   void Check() const;  // InputError naming the bad option
@@ -83,7 +86,8 @@ struct TargetLayoutResult {
 
 // Throws InputError (the reason and what to record instead) when the views
 // cannot determine the layout: fewer than options.min_views frames with two
-// or more tags, or a tag never seen together with the others.
+// or more tags, a tag never seen together with the others, or a fit whose
+// corner RMS exceeds options.max_rms_px (a wrong tag size).
 TargetLayoutResult MeasureTargetLayout(const Rig& rig,
                                        const std::vector<LayoutFrame>& frames,
                                        const TargetLayoutOptions& options);

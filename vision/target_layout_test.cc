@@ -200,6 +200,20 @@ TEST(TargetLayout, RefusesATagNeverSeenWithTheOthers) {
   }
 }
 
+// Corners of 25 mm tags fitted as 30 mm tags do not fit: refused.
+TEST(TargetLayout, RefusesAWrongTagSize) {
+  const Rig rig = ExampleStereoRig(1280, 1024);
+  TargetLayoutOptions o = Options();
+  o.tag_size_mm = 30;
+  try {
+    MeasureTargetLayout(rig, Frames(rig, TrueLayout(), 20, 0.1, 5), o);
+    ADD_FAILURE() << "a wrong tag size accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("check --size"), std::string::npos)
+        << e.what();
+  }
+}
+
 TEST(TargetLayout, RejectsBadOptions) {
   const Rig rig = ExampleStereoRig(1280, 1024);
   TargetLayoutOptions o = Options();
