@@ -221,6 +221,22 @@ TEST(TargetCli, PivotSessionGivesTheTip) {
   ASSERT_TRUE(measured.has_tip && measured.has_tip_sigma);
   const TargetTag* true_ref = truth.FindTag(j["reference_tag"].get<int>());
   ASSERT_NE(true_ref, nullptr);
+  double max_t = 0, max_r = 0;
+  for (const TargetTag& tag : measured.tags) {
+    const TargetTag* true_tag = truth.FindTag(tag.id);
+    ASSERT_NE(true_tag, nullptr);
+    const Rigid3 ref_from_tag =
+        true_ref->tool_from_tag.Inverse() * true_tag->tool_from_tag;
+    max_t = std::max(max_t, (tag.tool_from_tag.t - ref_from_tag.t).norm());
+    max_r = std::max(max_r, RotationVectorFromMatrix(tag.tool_from_tag.R *
+                                                     ref_from_tag.R.transpose())
+                                    .norm() *
+                                180 / M_PI);
+  }
+  std::printf("tool alone: %d views, max tag error %.4f mm %.4f deg\n",
+              j["views_used"].get<int>(), max_t, max_r);
+  EXPECT_LT(max_t, 0.05);
+  EXPECT_LT(max_r, 0.05);
   const Eigen::Vector3d want =
       true_ref->tool_from_tag.Inverse() * truth.tip_in_tool;
   const Eigen::Vector3d error = measured.tip_in_tool - want;
@@ -232,6 +248,38 @@ TEST(TargetCli, PivotSessionGivesTheTip) {
       j["pivot_tilt_deg"].get<double>());
   EXPECT_LT(error.norm(), 0.1);
   EXPECT_EQ(j["tip_sigma_mm"].size(), 3u);
+
+  // The criterion on the tool-alone session: track with the measured
+  // target (layout and pivot tip) against track with the true target, both
+  // against the rendered truth: r_measured <= sqrt((1.1 r)^2 + 0.1^2).
+  WriteTargetYaml(dir + "/true.yaml", truth);
+  for (const char* which : {"t", "true"}) {
+    const RunResult tr =
+        RunKincal("track --rig " + dir + "/rig.yaml --target " + dir + "/" +
+                  which + ".yaml --session " + dir + "/views --quiet --out " +
+                  dir + "/" + which + ".csv");
+    ASSERT_EQ(tr.exit_code, 0) << tr.err;
+  }
+  const auto measured_tips = ReadTips(dir + "/t.csv", 1);
+  const auto true_tips = ReadTips(dir + "/true.csv", 1);
+  const auto truth_tips = ReadTips(dir + "/views/truth.csv", 13);
+  ASSERT_EQ(measured_tips.size(), truth_tips.size());
+  double sum_measured = 0, sum_true = 0;
+  int n = 0;
+  for (size_t f = 0; f < truth_tips.size(); ++f) {
+    if (!measured_tips[f].allFinite() || !true_tips[f].allFinite()) continue;
+    sum_measured += (measured_tips[f] - truth_tips[f]).squaredNorm();
+    sum_true += (true_tips[f] - truth_tips[f]).squaredNorm();
+    ++n;
+  }
+  ASSERT_GT(n, 30);
+  const double r_measured = std::sqrt(sum_measured / n);
+  const double r_true = std::sqrt(sum_true / n);
+  std::printf(
+      "tool alone, track: tip RMS %.4f mm with the measured target, %.4f mm "
+      "with the true one (%d frames)\n",
+      r_measured, r_true, n);
+  EXPECT_LT(r_measured, std::hypot(1.1 * r_true, 0.1));
 
   // A pivot session tilted +-2 deg only: refused with what to record.
   RecordedSessionInput flat;
