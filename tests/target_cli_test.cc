@@ -221,22 +221,40 @@ TEST(TargetCli, PivotSessionGivesTheTip) {
   ASSERT_TRUE(measured.has_tip && measured.has_tip_sigma);
   const TargetTag* true_ref = truth.FindTag(j["reference_tag"].get<int>());
   ASSERT_NE(true_ref, nullptr);
-  double max_t = 0, max_r = 0;
+  double max_t = 0, max_r = 0, z2 = 0;
+  int count = 0;
   for (const TargetTag& tag : measured.tags) {
     const TargetTag* true_tag = truth.FindTag(tag.id);
     ASSERT_NE(true_tag, nullptr);
     const Rigid3 ref_from_tag =
         true_ref->tool_from_tag.Inverse() * true_tag->tool_from_tag;
+    if (tag.id != true_ref->id) {
+      const Eigen::Vector3d dt = tag.tool_from_tag.t - ref_from_tag.t;
+      const Eigen::Vector3d dr =
+          RotationVectorFromMatrix(tag.tool_from_tag.R *
+                                   ref_from_tag.R.transpose()) *
+          180 / M_PI;
+      for (int k = 0; k < 3; ++k) {
+        z2 += std::pow(dt(k) / tag.sigma_t_mm(k), 2) +
+              std::pow(dr(k) / tag.sigma_r_deg(k), 2);
+        count += 2;
+      }
+    }
     max_t = std::max(max_t, (tag.tool_from_tag.t - ref_from_tag.t).norm());
     max_r = std::max(max_r, RotationVectorFromMatrix(tag.tool_from_tag.R *
                                                      ref_from_tag.R.transpose())
                                     .norm() *
                                 180 / M_PI);
   }
-  std::printf("tool alone: %d views, max tag error %.4f mm %.4f deg\n",
-              j["views_used"].get<int>(), max_t, max_r);
+  std::printf(
+      "tool alone: %d views, max tag error %.4f mm %.4f deg, RMS "
+      "error/sigma %.2f\n",
+      j["views_used"].get<int>(), max_t, max_r, std::sqrt(z2 / count));
   EXPECT_LT(max_t, 0.05);
   EXPECT_LT(max_r, 0.05);
+  // One seed, 18 numbers: measured 1.05; loose bounds.
+  EXPECT_GT(std::sqrt(z2 / count), 0.5);
+  EXPECT_LT(std::sqrt(z2 / count), 2.0);
   const Eigen::Vector3d want =
       true_ref->tool_from_tag.Inverse() * truth.tip_in_tool;
   const Eigen::Vector3d error = measured.tip_in_tool - want;
