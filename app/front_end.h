@@ -11,8 +11,8 @@
 //                      GStreamer...: ~270 shared libraries, 0.2-0.3 s to load)
 //
 // In bin/kincal, the image commands (KINCAL_IMAGE_COMMANDS in
-// app/CMakeLists.txt: camcal, track, capture, bundle) are registered by
-// app/front_end.cc with their names and descriptions only (so
+// app/CMakeLists.txt: camcal, track, capture, bundle, target) are
+// registered by app/front_end.cc with their names and descriptions only (so
 // `kincal --help` lists them) and accept any arguments; once CLI11 selects
 // one, or `simulate` is given --render, kincal replaces itself by
 // kincal-vision with the same argv (exec), so output, exit codes, provenance
@@ -39,6 +39,10 @@ inline constexpr char kBundleDescription[] =
     "over every tag corner in every camera at every frame with joint readings "
     "(robot parameters, base in the rig, target on the flange, optionally the "
     "cameras)";
+inline constexpr char kTargetDescription[] =
+    "Measure a tool target from a recorded session of the tool: the tag "
+    "poses from one bundle over every tag corner, the needle tip by pivot "
+    "calibration (--pivot); writes target.yaml with sigmas";
 
 // Replaces this process by kincal-vision with this process's argv (read
 // from /proc/self/cmdline). kincal-vision is $KINCAL_VISION when set, else

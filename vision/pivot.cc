@@ -8,12 +8,47 @@
 
 namespace kincal {
 
+double PivotTiltRangeDeg(const std::vector<Rigid3>& rig_from_tool) {
+  const int n = static_cast<int>(rig_from_tool.size());
+  if (n < 2) return 0;
+  // Mean rotation: the nearest rotation to the mean matrix.
+  Eigen::Matrix3d sum = Eigen::Matrix3d::Zero();
+  for (const Rigid3& p : rig_from_tool) sum += p.R;
+  Eigen::JacobiSVD<Eigen::Matrix3d> mean_svd(
+      sum, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  Eigen::Matrix3d mean = mean_svd.matrixU() * mean_svd.matrixV().transpose();
+  if (mean.determinant() < 0) return 0;  // rotations all over the sphere
+  // Rotation vectors of each pose relative to the mean, in the rig frame.
+  Eigen::MatrixXd w(n, 3);
+  for (int i = 0; i < n; ++i) {
+    w.row(i) = RotationVectorFromMatrix(rig_from_tool[i].R * mean.transpose())
+                   .transpose();
+  }
+  const Eigen::RowVector3d centre = w.colwise().mean();
+  const Eigen::MatrixXd centred = w.rowwise() - centre;
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(centred.transpose() *
+                                                     centred);
+  // Eigenvalues ascending: column 1 is the second principal axis.
+  const Eigen::VectorXd along = centred * eig.eigenvectors().col(1);
+  return (along.maxCoeff() - along.minCoeff()) * 180.0 / M_PI;
+}
+
 PivotResult PivotCalibration(const std::vector<Rigid3>& rig_from_tool,
-                             double min_conditioning) {
+                             double min_conditioning,
+                             double min_tilt_range_deg) {
   const int n = static_cast<int>(rig_from_tool.size());
   if (n < 3) {
     throw InputError("pivot calibration: expected at least 3 tool poses, got " +
                      std::to_string(n));
+  }
+  const double tilt = PivotTiltRangeDeg(rig_from_tool);
+  if (tilt < min_tilt_range_deg) {
+    std::ostringstream os;
+    os << "pivot calibration: the tool was tilted over " << tilt
+       << " deg in its second direction (at least " << min_tilt_range_deg
+       << " deg needed to locate the tip): tilt the tool more around the "
+          "divot, at least +-15 deg in two directions";
+    throw InputError(os.str());
   }
   Eigen::MatrixXd A(3 * n, 6);
   Eigen::VectorXd b(3 * n);
@@ -46,6 +81,19 @@ PivotResult PivotCalibration(const std::vector<Rigid3>& rig_from_tool,
     r.max_mm = std::max(r.max_mm, e);
   }
   r.rms_mm = std::sqrt(sum / n);
+  r.tilt_range_deg = tilt;
+  if (3 * n > 6) {
+    const double sigma2 = sum / (3 * n - 6);
+    // (A^T A)^-1 = V S^-2 V^T.
+    const Eigen::MatrixXd V = svd.matrixV();
+    const Eigen::VectorXd inv_s2 = s.array().square().inverse();
+    const Eigen::MatrixXd cov =
+        sigma2 * V * inv_s2.asDiagonal() * V.transpose();
+    for (int k = 0; k < 3; ++k) {
+      r.tip_sigma_mm(k) = std::sqrt(cov(k, k));
+      r.pivot_sigma_mm(k) = std::sqrt(cov(3 + k, 3 + k));
+    }
+  }
   return r;
 }
 

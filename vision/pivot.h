@@ -24,13 +24,27 @@ struct PivotResult {
   // Smallest / largest singular value of the stacked system: near 0 when the
   // rotations do not span two axes (the offset along the axis is unknown).
   double conditioning = 0;
+  // 1-sigma of tip_in_tool and pivot_in_rig per axis (mm), from the linear
+  // least squares: sigma^2 (A^T A)^-1 with sigma^2 = |residual|^2 / (3n - 6)
+  // (the pose noise seen through the residuals).
+  Eigen::Vector3d tip_sigma_mm = Eigen::Vector3d::Zero();
+  Eigen::Vector3d pivot_sigma_mm = Eigen::Vector3d::Zero();
+  // How far the tool was tilted: the extent (max - min, deg) of the poses'
+  // rotations about the second principal axis of their spread (the smaller
+  // of the two largest; a needle turned about one axis only has ~0).
+  double tilt_range_deg = 0;
 };
 
+// Tilt range of a set of tool poses, as PivotResult::tilt_range_deg.
+double PivotTiltRangeDeg(const std::vector<Rigid3>& rig_from_tool);
+
 // rig_from_tool: tool poses (mm) while pivoting. Throws InputError for fewer
-// than 3 poses or rotations that leave the offset undetermined
-// (conditioning < min_conditioning, e.g. all about one axis).
+// than 3 poses, rotations that leave the offset undetermined
+// (conditioning < min_conditioning, e.g. all about one axis), or a tilt
+// range below min_tilt_range_deg (the message says how to record instead).
 PivotResult PivotCalibration(const std::vector<Rigid3>& rig_from_tool,
-                             double min_conditioning = 1e-3);
+                             double min_conditioning = 1e-3,
+                             double min_tilt_range_deg = 0);
 
 }  // namespace kincal
 

@@ -55,6 +55,73 @@ TEST(Pivot, RejectsTooFewOrDegeneratePoses) {
   EXPECT_THROW(PivotCalibration(one_axis), InputError);
 }
 
+// PivotPoses tilts by +-0.3 rad (~34 deg) about x and y: the tilt range is
+// ~34 deg in the second direction; tilting ten times less is refused with
+// what to record instead, and turning about one axis has no second tilt.
+TEST(Pivot, RefusesTooSmallTiltRange) {
+  const Eigen::Vector3d tip(0, 100, 0), pivot(0, 0, 500);
+  const auto wide = PivotPoses(tip, pivot, Eigen::Matrix3d::Identity(), 12);
+  EXPECT_NEAR(PivotTiltRangeDeg(wide), 34.4, 1.0);
+  EXPECT_NO_THROW(PivotCalibration(wide, 1e-3, 15.0));
+  std::vector<Rigid3> narrow;
+  for (int i = 0; i < 12; ++i) {
+    const double a = 2 * M_PI * i / 12;
+    Rigid3 p;
+    p.R = (Eigen::AngleAxisd(0.03 * std::sin(a), Eigen::Vector3d::UnitX()) *
+           Eigen::AngleAxisd(0.03 * std::cos(a), Eigen::Vector3d::UnitY()))
+              .toRotationMatrix();
+    p.t = pivot - p.R * tip;
+    narrow.push_back(p);
+  }
+  EXPECT_LT(PivotTiltRangeDeg(narrow), 4.0);
+  try {
+    PivotCalibration(narrow, 1e-3, 15.0);
+    ADD_FAILURE() << "a 3.4 deg tilt was accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("tilt the tool more"),
+              std::string::npos)
+        << e.what();
+  }
+  std::vector<Rigid3> one_axis;
+  for (int i = 0; i < 8; ++i) {
+    Rigid3 p;
+    p.R =
+        Eigen::AngleAxisd(0.1 * i, Eigen::Vector3d::UnitX()).toRotationMatrix();
+    p.t = pivot - p.R * tip;
+    one_axis.push_back(p);
+  }
+  EXPECT_LT(PivotTiltRangeDeg(one_axis), 1e-6);
+}
+
+// With noise on the tool positions, the tip's sigma matches its error: RMS
+// of error / sigma over 60 seeds and 3 axes within [0.7, 1.4].
+TEST(Pivot, TipSigmaIsHonest) {
+  const Eigen::Vector3d tip(3, 100, 12), pivot(40, 60, 480);
+  const auto exact = PivotPoses(tip, pivot, Eigen::Matrix3d::Identity(), 20);
+  double sum = 0;
+  int count = 0;
+  for (int seed = 0; seed < 60; ++seed) {
+    std::mt19937_64 rng(seed);
+    std::normal_distribution<double> noise(0.0, 0.1);
+    auto poses = exact;
+    for (Rigid3& p : poses) {
+      p.t += Eigen::Vector3d(noise(rng), noise(rng), noise(rng));
+    }
+    const PivotResult r = PivotCalibration(poses);
+    for (int k = 0; k < 3; ++k) {
+      ASSERT_GT(r.tip_sigma_mm(k), 0);
+      const double z = (r.tip_in_tool(k) - tip(k)) / r.tip_sigma_mm(k);
+      sum += z * z;
+      ++count;
+    }
+    EXPECT_NEAR(r.rms_mm, 0.1 * std::sqrt(3.0), 0.08);
+  }
+  const double ratio = std::sqrt(sum / count);
+  std::printf("pivot: RMS of tip error / sigma = %.3f\n", ratio);
+  EXPECT_GT(ratio, 0.7);
+  EXPECT_LT(ratio, 1.4);
+}
+
 // Rendered stereo frames of the example tool pivoting about its tip: poses
 // from the images, then the pivot calibration recovers tip_in_tool.
 TEST(Pivot, RenderedPivotRecoversTipOffset) {

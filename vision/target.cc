@@ -59,6 +59,18 @@ Rigid3 ReadPose(const YamlReader& r, const YAML::Node& node,
   return pose;
 }
 
+// A list of three non-negative numbers (a sigma), e.g. tip_sigma_mm.
+Eigen::Vector3d ReadSigma(const YamlReader& r, const YAML::Node& node,
+                          const std::string& what) {
+  const auto v = r.Numbers(node, what, 3, 3);
+  for (double x : v) {
+    if (!(x >= 0 && x < kMaxToolMm)) {
+      r.Fail(node, what + ": expected three non-negative numbers (1-sigma)");
+    }
+  }
+  return Eigen::Vector3d(v[0], v[1], v[2]);
+}
+
 std::string Vec(const Eigen::Vector3d& v) {
   return "[" + FormatDouble(v.x()) + ", " + FormatDouble(v.y()) + ", " +
          FormatDouble(v.z()) + "]";
@@ -73,7 +85,9 @@ Target ParseTargetYaml(const std::string& text, const std::string& file) {
     throw InputError(file, 0, 0, "empty file: expected a tool target");
   }
   r.ExpectMap(root, "target file");
-  r.CheckKeys(root, {"kincal_target", "family", "tags", "tip_in_tool"},
+  r.CheckKeys(root,
+              {"kincal_target", "family", "tags", "tip_in_tool", "tip_sigma_mm",
+               "made_by"},
               "target file");
   const YAML::Node version = r.Required(root, "kincal_target", "target file");
   if (r.Integer(version, "kincal_target") != 1) {
@@ -97,7 +111,7 @@ Target ParseTargetYaml(const std::string& text, const std::string& file) {
     const YAML::Node t = tags[i];
     const std::string what = "tags[" + std::to_string(i) + "]";
     r.ExpectMap(t, what);
-    r.CheckKeys(t, {"id", "size", "tool_from_tag"}, what);
+    r.CheckKeys(t, {"id", "size", "tool_from_tag", "sigma"}, what);
     TargetTag tag;
     const YAML::Node id = r.Required(t, "id", what);
     tag.id = r.Integer(id, what + ".id");
@@ -118,16 +132,34 @@ Target ParseTargetYaml(const std::string& text, const std::string& file) {
     }
     tag.tool_from_tag = ReadPose(r, r.Required(t, "tool_from_tag", what),
                                  what + ".tool_from_tag");
+    if (t["sigma"]) {
+      const YAML::Node sigma = t["sigma"];
+      const std::string sw = what + ".sigma";
+      r.ExpectMap(sigma, sw);
+      r.CheckKeys(sigma, {"t_mm", "r_deg"}, sw);
+      tag.has_sigma = true;
+      tag.sigma_t_mm =
+          ReadSigma(r, r.Required(sigma, "t_mm", sw), sw + ".t_mm");
+      tag.sigma_r_deg =
+          ReadSigma(r, r.Required(sigma, "r_deg", sw), sw + ".r_deg");
+    }
     target.tags.push_back(tag);
   }
-  const auto tip = r.Numbers(r.Required(root, "tip_in_tool", "target file"),
-                             "tip_in_tool", 3, 3);
-  target.tip_in_tool = Eigen::Vector3d(tip[0], tip[1], tip[2]);
-  if (!(target.tip_in_tool.cwiseAbs().maxCoeff() <= kMaxToolMm)) {
-    r.Fail(root["tip_in_tool"],
-           "tip_in_tool: expected each coordinate within +-" +
-               FormatDouble(kMaxToolMm) + " mm of the tool origin");
+  target.has_tip = static_cast<bool>(root["tip_in_tool"]);
+  if (target.has_tip) {
+    const auto tip = r.Numbers(root["tip_in_tool"], "tip_in_tool", 3, 3);
+    target.tip_in_tool = Eigen::Vector3d(tip[0], tip[1], tip[2]);
+    if (!(target.tip_in_tool.cwiseAbs().maxCoeff() <= kMaxToolMm)) {
+      r.Fail(root["tip_in_tool"],
+             "tip_in_tool: expected each coordinate within +-" +
+                 FormatDouble(kMaxToolMm) + " mm of the tool origin");
+    }
   }
+  if (root["tip_sigma_mm"]) {
+    target.has_tip_sigma = true;
+    target.tip_sigma_mm = ReadSigma(r, root["tip_sigma_mm"], "tip_sigma_mm");
+  }
+  if (root["made_by"]) target.made_by = r.String(root["made_by"], "made_by");
   return target;
 }
 
@@ -148,9 +180,24 @@ std::string FormatTargetYaml(const Target& target) {
     for (int i = 0; i < 9; ++i) {
       os << (i ? ", " : "") << FormatDouble(R(i / 3, i % 3));
     }
-    os << "], t: " << Vec(t.tool_from_tag.t) << "}}\n";
+    os << "], t: " << Vec(t.tool_from_tag.t) << "}";
+    if (t.has_sigma) {
+      os << ", sigma: {t_mm: " << Vec(t.sigma_t_mm)
+         << ", r_deg: " << Vec(t.sigma_r_deg) << "}";
+    }
+    os << "}\n";
   }
-  os << "tip_in_tool: " << Vec(target.tip_in_tool) << "\n";
+  if (target.has_tip) {
+    os << "tip_in_tool: " << Vec(target.tip_in_tool) << "\n";
+  }
+  if (target.has_tip_sigma) {
+    os << "tip_sigma_mm: " << Vec(target.tip_sigma_mm) << "\n";
+  }
+  if (!target.made_by.empty()) {
+    YAML::Emitter quoted;
+    quoted << YAML::DoubleQuoted << target.made_by;
+    os << "made_by: " << quoted.c_str() << "\n";
+  }
   return os.str();
 }
 

@@ -26,6 +26,12 @@ struct TargetTag {
   int id = 0;
   double size_mm = 0;  // edge of the black square
   Rigid3 tool_from_tag;
+  // Measured targets (kincal target): 1-sigma of the pose, translation in
+  // the tool frame (mm) and rotation vector of the error in the tool frame
+  // (deg). Written as `sigma: {t_mm: [...], r_deg: [...]}` when has_sigma.
+  bool has_sigma = false;
+  Eigen::Vector3d sigma_t_mm = Eigen::Vector3d::Zero();
+  Eigen::Vector3d sigma_r_deg = Eigen::Vector3d::Zero();
 
   // Corner k (libapriltag's order, see vision/apriltag_detector.h) in `tool`.
   Eigen::Vector3d CornerInTool(int k) const;
@@ -35,12 +41,22 @@ struct Target {
   std::string family = "tag36h11";
   std::vector<TargetTag> tags;
   Eigen::Vector3d tip_in_tool = Eigen::Vector3d::Zero();
+  // False for a board without a tip (tip_in_tool absent from the file; it
+  // then reads as the tool origin).
+  bool has_tip = true;
+  // Measured tip: 1-sigma per tool axis, mm (`tip_sigma_mm`).
+  bool has_tip_sigma = false;
+  Eigen::Vector3d tip_sigma_mm = Eigen::Vector3d::Zero();
+  // The command line that measured the target (`made_by`); empty = none.
+  std::string made_by;
 
   // nullptr when the target has no tag with this id.
   const TargetTag* FindTag(int id) const;
 };
 
-// Reads target.yaml (version 1). Strict: unknown keys, a missing field, a
+// Reads target.yaml (version 1, with the optional measured-target fields of
+// format version 3: per-tag `sigma`, `tip_sigma_mm`, `made_by`, and
+// `tip_in_tool` optional). Strict: unknown keys, a missing field, a
 // duplicate id, an id outside the family, a non-positive size or a matrix
 // that is not a rotation raise InputError with file:line:column. R may be
 // rounded (orthonormal within 1e-3); it is replaced by the nearest rotation.

@@ -53,6 +53,38 @@ TEST(TargetYaml, RoundTrips) {
         1e-12);
   }
   EXPECT_EQ(back.tip_in_tool, t.tip_in_tool);
+  EXPECT_TRUE(back.has_tip);
+  EXPECT_FALSE(back.tags[0].has_sigma);
+  EXPECT_FALSE(back.has_tip_sigma);
+  EXPECT_TRUE(back.made_by.empty());
+}
+
+// The measured-target fields (format version 3): per-tag sigma, the tip's
+// sigma, made_by (quoted, any characters), and a board without a tip.
+TEST(TargetYaml, MeasuredFieldsRoundTrip) {
+  Target t = ParseTargetYaml(kValid, "target.yaml");
+  t.tags[0].has_sigma = true;
+  t.tags[0].sigma_t_mm = Eigen::Vector3d(0.01, 0.02, 0.125);
+  t.tags[0].sigma_r_deg = Eigen::Vector3d(0.03, 0.5, 0.0);
+  t.has_tip_sigma = true;
+  t.tip_sigma_mm = Eigen::Vector3d(0.05, 0.06, 0.25);
+  t.made_by = "kincal target --session 'a b' --out \"t: x.yaml\"";
+  const Target back = ParseTargetYaml(FormatTargetYaml(t), "t.yaml");
+  ASSERT_TRUE(back.tags[0].has_sigma);
+  EXPECT_FALSE(back.tags[1].has_sigma);
+  EXPECT_EQ(back.tags[0].sigma_t_mm, t.tags[0].sigma_t_mm);
+  EXPECT_EQ(back.tags[0].sigma_r_deg, t.tags[0].sigma_r_deg);
+  ASSERT_TRUE(back.has_tip_sigma);
+  EXPECT_EQ(back.tip_sigma_mm, t.tip_sigma_mm);
+  EXPECT_EQ(back.made_by, t.made_by);
+
+  t.has_tip = false;
+  t.has_tip_sigma = false;
+  const std::string text = FormatTargetYaml(t);
+  EXPECT_EQ(text.find("tip_in_tool"), std::string::npos) << text;
+  const Target board = ParseTargetYaml(text, "t.yaml");
+  EXPECT_FALSE(board.has_tip);
+  EXPECT_EQ(board.tip_in_tool, Eigen::Vector3d::Zero());
 }
 
 // Each bad file is rejected with the position of the fault.
@@ -89,8 +121,12 @@ TEST(TargetYaml, RejectsBadFilesWithPosition) {
        "[1,0,0,0,1,0,0,0,1], t: [0,0]}}\ntip_in_tool: [0,0,1]\n",
        "t.yaml:3:", "t"},
       {"kincal_target: 1\ntags:\n  - {id: 1, size: 3, tool_from_tag: {R: "
-       "[1,0,0,0,1,0,0,0,1], t: [0,0,0]}}\n",
-       "t.yaml:1:", "tip_in_tool"},
+       "[1,0,0,0,1,0,0,0,1], t: [0,0,0]}, sigma: {t_mm: [0, -1, 0], r_deg: "
+       "[0, 0, 0]}}\n",
+       "t.yaml:3:", "non-negative"},
+      {"kincal_target: 1\ntags:\n  - {id: 1, size: 3, tool_from_tag: {R: "
+       "[1,0,0,0,1,0,0,0,1], t: [0,0,0]}}\ntip_sigma_mm: [1, 2]\n",
+       "t.yaml:4:", "tip_sigma_mm"},
       {"kincal_target: 1\ntags: [\n", "t.yaml:", "invalid YAML"},
       {"", "t.yaml", "empty"},
   };

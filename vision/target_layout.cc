@@ -1,0 +1,505 @@
+#include "vision/target_layout.h"
+
+#include <ceres/ceres.h>
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <map>
+#include <memory>
+#include <set>
+#include <sstream>
+
+#include "camcal/cost_functions.h"
+#include "data/error.h"
+#include "data/rigid3.h"
+#include "vision/stereo_images.h"
+
+namespace kincal {
+
+void TargetLayoutOptions::Check() const {
+  if (!IsKnownTagFamily(family)) {
+    throw InputError("--family: unknown tag family '" + family +
+                     "' (expected tag36h11, tag25h9 or tag16h5)");
+  }
+  if (!(tag_size_mm >= 0.5 && tag_size_mm <= 5000)) {
+    throw InputError(
+        "--size: expected the edge of the tags' black square "
+        "in mm (0.5 to 5000), got " +
+        std::to_string(tag_size_mm));
+  }
+  if (min_views < 2) throw InputError("min_views: expected at least 2");
+  if (!(huber_px > 0) || !(outlier_px > 0) || !(outlier_ratio > 1) ||
+      !(max_rms_px > 0)) {
+    throw InputError(
+        "huber_px, outlier_px and max_rms_px must be > 0 and outlier_ratio "
+        "> 1");
+  }
+  if (max_iterations < 1) throw InputError("max_iterations: expected >= 1");
+  pose.Check();
+}
+
+namespace {
+
+// Reprojection of one tag corner through the layout:
+//   r = pi(K, cam_from_rig * rig_from_tool * tool_from_tag * c_in_tag) - px
+// with rig_from_tool = (exp([a]x) R_tool0, t) and tool_from_tag =
+// (exp([b]x) R_tag0, u): the blocks (a, t) and (b, u) are rotation vectors
+// of small corrections applied on the left of the start rotations (so that
+// b's covariance is the rotation error's in the tool frame), translations
+// in mm. false (no residual, no exception) for a point behind the camera.
+class LayoutCornerCost {
+ public:
+  LayoutCornerCost(const Eigen::Vector2d& px, const Eigen::Vector3d& c_in_tag,
+                   const Camera& camera, const Eigen::Matrix3d& rig_R_tool0,
+                   const Eigen::Matrix3d& tool_R_tag0)
+      : px_(px),
+        c_in_tag_(c_in_tag),
+        intrinsics_(camera.intrinsics.ToArray()),
+        cam_from_rig_(camera.cam_from_rig),
+        rig_R_tool0_(rig_R_tool0),
+        tool_R_tag0_(tool_R_tag0) {}
+
+  template <typename T>
+  bool operator()(const T* rig_from_tool, const T* tool_from_tag,
+                  T* residuals) const {
+    using M3 = Eigen::Matrix<T, 3, 3>;
+    using V3 = Eigen::Matrix<T, 3, 1>;
+    const M3 tool_R_tag =
+        RotationMatrixFromVectorT(tool_from_tag) * tool_R_tag0_.cast<T>();
+    const M3 rig_R_tool =
+        RotationMatrixFromVectorT(rig_from_tool) * rig_R_tool0_.cast<T>();
+    const V3 c_in_tool =
+        tool_R_tag * c_in_tag_.cast<T>() +
+        V3(tool_from_tag[3], tool_from_tag[4], tool_from_tag[5]);
+    const V3 c_in_rig =
+        rig_R_tool * c_in_tool +
+        V3(rig_from_tool[3], rig_from_tool[4], rig_from_tool[5]);
+    const V3 c_in_cam =
+        cam_from_rig_.R.cast<T>() * c_in_rig + cam_from_rig_.t.cast<T>();
+    T intrinsics[kNumIntrinsics];
+    for (int i = 0; i < kNumIntrinsics; ++i) intrinsics[i] = T(intrinsics_[i]);
+    return PixelResidual(intrinsics, c_in_cam.data(), px_, residuals);
+  }
+
+  static ceres::CostFunction* Create(const Eigen::Vector2d& px,
+                                     const Eigen::Vector3d& c_in_tag,
+                                     const Camera& camera,
+                                     const Eigen::Matrix3d& rig_R_tool0,
+                                     const Eigen::Matrix3d& tool_R_tag0) {
+    return new ceres::AutoDiffCostFunction<LayoutCornerCost, 2, 6, 6>(
+        new LayoutCornerCost(px, c_in_tag, camera, rig_R_tool0, tool_R_tag0));
+  }
+
+ private:
+  const Eigen::Vector2d px_;
+  const Eigen::Vector3d c_in_tag_;
+  const std::array<double, kNumIntrinsics> intrinsics_;
+  const Rigid3 cam_from_rig_;
+  const Eigen::Matrix3d rig_R_tool0_;
+  const Eigen::Matrix3d tool_R_tag0_;
+};
+
+// Step 1: rig_from_tag of every tag found in a frame, by id.
+using TagPoses = std::map<int, Rigid3>;
+
+std::vector<TagPoses> SingleTagPoses(const Rig& rig,
+                                     const std::vector<LayoutFrame>& frames,
+                                     const TargetLayoutOptions& options) {
+  std::vector<TagPoses> poses(frames.size());
+  for (size_t f = 0; f < frames.size(); ++f) {
+    std::set<int> ids;
+    for (const auto& cam : frames[f].detections) {
+      for (const TagDetection& d : cam) ids.insert(d.id);
+    }
+    for (int id : ids) {
+      Target one;
+      one.family = options.family;
+      TargetTag tag;
+      tag.id = id;
+      tag.size_mm = options.tag_size_mm;
+      one.tags.push_back(tag);
+      const ToolPoseResult r =
+          EstimateToolPose(rig, one, frames[f].detections, options.pose);
+      if (r.found) poses[f][id] = r.rig_from_tool;
+    }
+  }
+  return poses;
+}
+
+// The candidate whose translation is nearest the per-axis median.
+Rigid3 MedianCandidate(const std::vector<Rigid3>& candidates) {
+  Eigen::Vector3d median;
+  for (int k = 0; k < 3; ++k) {
+    std::vector<double> v;
+    for (const Rigid3& c : candidates) v.push_back(c.t(k));
+    std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
+    median(k) = v[v.size() / 2];
+  }
+  size_t best = 0;
+  for (size_t i = 1; i < candidates.size(); ++i) {
+    if ((candidates[i].t - median).norm() <
+        (candidates[best].t - median).norm()) {
+      best = i;
+    }
+  }
+  return candidates[best];
+}
+
+// Steps 2-3: the reference tag and every tag's start pose in the tool frame.
+std::map<int, Rigid3> StartLayout(const std::vector<TagPoses>& poses,
+                                  int* reference) {
+  std::map<int, int> seen;
+  for (const TagPoses& p : poses) {
+    for (const auto& [id, pose] : p) ++seen[id];
+  }
+  if (seen.empty()) {
+    throw InputError(
+        "no tag of the family was found in any view: check --family and the "
+        "images (the tags must be sharp and at least ~20 px wide)");
+  }
+  *reference = seen.begin()->first;
+  for (const auto& [id, n] : seen) {
+    if (n > seen[*reference]) *reference = id;
+  }
+  std::map<int, Rigid3> layout = {{*reference, Rigid3()}};
+  bool grew = true;
+  while (grew && layout.size() < seen.size()) {
+    grew = false;
+    for (const auto& [id, n] : seen) {
+      if (layout.count(id)) continue;
+      std::vector<Rigid3> candidates;
+      for (const TagPoses& p : poses) {
+        if (!p.count(id)) continue;
+        for (const auto& [placed, tool_from_placed] : layout) {
+          if (!p.count(placed)) continue;
+          candidates.push_back(tool_from_placed * p.at(placed).Inverse() *
+                               p.at(id));
+          break;
+        }
+      }
+      if (candidates.empty()) continue;
+      layout[id] = MedianCandidate(candidates);
+      grew = true;
+    }
+  }
+  if (layout.size() < seen.size()) {
+    std::ostringstream os;
+    os << "tags";
+    for (const auto& [id, n] : seen) {
+      if (!layout.count(id)) os << " " << id;
+    }
+    os << " were never seen in one image together with tag " << *reference
+       << " or a tag connected to it, so their place on the tool is unknown: "
+          "record views that show each of them together with a neighbouring "
+          "tag";
+    throw InputError(os.str());
+  }
+  return layout;
+}
+
+struct Corner {
+  int frame = 0;  // index into the used frames
+  int tag = 0;    // index into the layout's tags
+  int camera = 0;
+  int k = 0;
+  Eigen::Vector2d px;
+};
+
+struct Problem {
+  std::vector<int> ids;  // tags by index
+  std::vector<std::array<double, 6>> tag_blocks, frame_blocks;
+  std::vector<Eigen::Matrix3d> tag_R0, frame_R0;
+  std::vector<Eigen::Vector3d> tag_t0, frame_t0;
+  std::vector<Corner> corners;
+  std::vector<bool> corner_used;
+  int reference = 0;  // index
+};
+
+std::unique_ptr<ceres::Problem> BuildProblem(Problem* p, const Rig& rig,
+                                             double tag_size_mm,
+                                             ceres::LossFunction* loss) {
+  ceres::Problem::Options po;
+  po.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  auto problem = std::make_unique<ceres::Problem>(po);
+  for (size_t i = 0; i < p->corners.size(); ++i) {
+    if (!p->corner_used[i]) continue;
+    const Corner& c = p->corners[i];
+    problem->AddResidualBlock(
+        LayoutCornerCost::Create(c.px, TagCornerInTag(c.k, tag_size_mm),
+                                 rig.cameras[c.camera], p->frame_R0[c.frame],
+                                 p->tag_R0[c.tag]),
+        loss, p->frame_blocks[c.frame].data(), p->tag_blocks[c.tag].data());
+  }
+  problem->SetParameterBlockConstant(p->tag_blocks[p->reference].data());
+  return problem;
+}
+
+Rigid3 BlockPose(const std::array<double, 6>& block,
+                 const Eigen::Matrix3d& R0) {
+  const Rigid3 delta = Rigid3FromPoseBlock(block.data());
+  return {delta.R * R0, delta.t};
+}
+
+void Solve(ceres::Problem* problem, int max_iterations) {
+  ceres::Solver::Options so;
+  so.linear_solver_type = ceres::SPARSE_SCHUR;
+  so.max_num_iterations = max_iterations;
+  so.function_tolerance = 1e-12;
+  so.gradient_tolerance = 1e-12;
+  so.parameter_tolerance = 1e-12;
+  ceres::Solver::Summary summary;
+  ceres::Solve(so, problem, &summary);
+}
+
+// Residual norm of each corner (px); -1 for a point behind a camera.
+std::vector<double> CornerResiduals(const Problem& p, const Rig& rig,
+                                    double tag_size_mm) {
+  std::vector<double> out;
+  for (const Corner& c : p.corners) {
+    const LayoutCornerCost cost(c.px, TagCornerInTag(c.k, tag_size_mm),
+                                rig.cameras[c.camera], p.frame_R0[c.frame],
+                                p.tag_R0[c.tag]);
+    double r[2];
+    out.push_back(
+        cost(p.frame_blocks[c.frame].data(), p.tag_blocks[c.tag].data(), r)
+            ? std::hypot(r[0], r[1])
+            : -1.0);
+  }
+  return out;
+}
+
+// The frames with two or more placed tags, their start poses and corners.
+Problem CollectProblem(const Rig& rig, const std::vector<LayoutFrame>& frames,
+                       const std::vector<TagPoses>& poses,
+                       const std::map<int, Rigid3>& layout, int reference,
+                       const TargetLayoutOptions& options,
+                       std::vector<int>* frames_used) {
+  Problem p;
+  std::map<int, int> index;
+  for (const auto& [id, pose] : layout) {
+    if (id == reference) p.reference = static_cast<int>(p.ids.size());
+    index[id] = static_cast<int>(p.ids.size());
+    p.ids.push_back(id);
+    p.tag_R0.push_back(pose.R);
+    p.tag_blocks.push_back({0, 0, 0, pose.t.x(), pose.t.y(), pose.t.z()});
+  }
+  Target start;
+  start.family = options.family;
+  for (const auto& [id, pose] : layout) {
+    TargetTag tag;
+    tag.id = id;
+    tag.size_mm = options.tag_size_mm;
+    tag.tool_from_tag = pose;
+    start.tags.push_back(tag);
+  }
+  for (size_t f = 0; f < frames.size(); ++f) {
+    if (poses[f].size() < 2) continue;
+    const ToolPoseResult r =
+        EstimateToolPose(rig, start, frames[f].detections, options.pose);
+    if (!r.found) continue;
+    const int fi = static_cast<int>(frames_used->size());
+    frames_used->push_back(static_cast<int>(f));
+    p.frame_R0.push_back(r.rig_from_tool.R);
+    const Eigen::Vector3d& t = r.rig_from_tool.t;
+    p.frame_blocks.push_back({0, 0, 0, t.x(), t.y(), t.z()});
+    for (size_t c = 0; c < frames[f].detections.size(); ++c) {
+      std::set<int> ids_here;
+      for (const TagDetection& d : frames[f].detections[c]) {
+        ids_here.insert(d.id);
+      }
+      for (const TagDetection& d : frames[f].detections[c]) {
+        // Tags detected twice in one camera are ambiguous: left out.
+        if (!index.count(d.id) || !poses[f].count(d.id)) continue;
+        if (std::count_if(
+                frames[f].detections[c].begin(), frames[f].detections[c].end(),
+                [&](const TagDetection& e) { return e.id == d.id; }) > 1) {
+          continue;
+        }
+        for (int k = 0; k < 4; ++k) {
+          p.corners.push_back(
+              {fi, index[d.id], static_cast<int>(c), k, d.corners[k]});
+        }
+      }
+    }
+  }
+  p.corner_used.assign(p.corners.size(), true);
+  return p;
+}
+
+// Corners whose residual is too large after the robust fit are left out.
+int RejectOutliers(Problem* p, const Rig& rig,
+                   const TargetLayoutOptions& options) {
+  const std::vector<double> res = CornerResiduals(*p, rig, options.tag_size_mm);
+  std::vector<double> sorted;
+  for (double r : res) {
+    if (r >= 0) sorted.push_back(r);
+  }
+  if (sorted.empty()) return 0;
+  std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2,
+                   sorted.end());
+  const double limit = std::max(
+      options.outlier_px, options.outlier_ratio * sorted[sorted.size() / 2]);
+  int rejected = 0;
+  for (size_t i = 0; i < res.size(); ++i) {
+    if (res[i] < 0 || res[i] > limit) {
+      p->corner_used[i] = false;
+      ++rejected;
+    }
+  }
+  return rejected;
+}
+
+// Step 5: each tag's 1-sigma from the covariance of its block.
+void TagSigmas(const Problem& p, ceres::Problem* problem, double sigma0,
+               std::vector<LayoutTag>* tags) {
+  ceres::Covariance::Options co;
+  co.algorithm_type = ceres::SPARSE_QR;
+  ceres::Covariance covariance(co);
+  std::vector<std::pair<const double*, const double*>> blocks;
+  for (size_t i = 0; i < p.ids.size(); ++i) {
+    if (static_cast<int>(i) == p.reference) continue;
+    blocks.push_back({p.tag_blocks[i].data(), p.tag_blocks[i].data()});
+  }
+  if (blocks.empty() || !covariance.Compute(blocks, problem)) return;
+  for (size_t i = 0; i < p.ids.size(); ++i) {
+    if (static_cast<int>(i) == p.reference) continue;
+    double cov[36];
+    covariance.GetCovarianceBlock(p.tag_blocks[i].data(),
+                                  p.tag_blocks[i].data(), cov);
+    for (int k = 0; k < 3; ++k) {
+      (*tags)[i].sigma_r_deg(k) =
+          sigma0 * std::sqrt(cov[k * 6 + k]) * 180 / M_PI;
+      (*tags)[i].sigma_t_mm(k) = sigma0 * std::sqrt(cov[(k + 3) * 6 + k + 3]);
+    }
+  }
+}
+
+}  // namespace
+
+TargetLayoutResult MeasureTargetLayout(const Rig& rig,
+                                       const std::vector<LayoutFrame>& frames,
+                                       const TargetLayoutOptions& options) {
+  options.Check();
+  for (const LayoutFrame& f : frames) {
+    if (f.detections.size() != rig.cameras.size()) {
+      throw InputError("frame " + std::to_string(f.frame) + " has " +
+                       std::to_string(f.detections.size()) +
+                       " cameras' detections; the rig has " +
+                       std::to_string(rig.cameras.size()));
+    }
+  }
+  const std::vector<TagPoses> poses = SingleTagPoses(rig, frames, options);
+  int multi = 0;
+  for (const TagPoses& p : poses) multi += p.size() >= 2 ? 1 : 0;
+  if (multi < options.min_views) {
+    throw InputError(
+        "only " + std::to_string(multi) + " of " +
+        std::to_string(frames.size()) +
+        " views show two or more tags of the tool (at least " +
+        std::to_string(options.min_views) +
+        " needed): record the tool from more directions, each view showing "
+        "neighbouring tags together");
+  }
+  TargetLayoutResult result;
+  const std::map<int, Rigid3> layout =
+      StartLayout(poses, &result.reference_tag_id);
+  Problem p =
+      CollectProblem(rig, frames, poses, layout, result.reference_tag_id,
+                     options, &result.frames_used);
+  result.views_used = static_cast<int>(result.frames_used.size());
+  if (result.views_used < options.min_views) {
+    throw InputError(
+        "only " + std::to_string(result.views_used) +
+        " views gave a tool pose from two or more tags (at least " +
+        std::to_string(options.min_views) +
+        " needed): record more views of the tool");
+  }
+  {
+    ceres::HuberLoss huber(options.huber_px);
+    auto robust = BuildProblem(&p, rig, options.tag_size_mm, &huber);
+    Solve(robust.get(), options.max_iterations);
+  }
+  result.corners_rejected = RejectOutliers(&p, rig, options);
+  auto problem = BuildProblem(&p, rig, options.tag_size_mm, nullptr);
+  Solve(problem.get(), options.max_iterations);
+
+  double cost = 0;
+  problem->Evaluate(ceres::Problem::EvaluateOptions(), &cost, nullptr, nullptr,
+                    nullptr);
+  const int residuals = problem->NumResiduals();
+  const int parameters = 6 * (static_cast<int>(p.frame_blocks.size()) +
+                              static_cast<int>(p.ids.size()) - 1);
+  result.corners_used = residuals / 2;
+  result.rms_px = std::sqrt(2 * cost / std::max(1, residuals));
+  result.sigma0_px = std::sqrt(2 * cost / std::max(1, residuals - parameters));
+  if (!(result.rms_px <= options.max_rms_px)) {
+    std::ostringstream os;
+    os << "the tag corners fit the rig with an RMS of " << result.rms_px
+       << " px (at most " << options.max_rms_px
+       << " expected): check --size (the edge of the tags' black square, "
+          "mm), the rig file and the family";
+    throw InputError(os.str());
+  }
+
+  result.target.family = options.family;
+  result.target.has_tip = false;
+  for (size_t i = 0; i < p.ids.size(); ++i) {
+    LayoutTag tag;
+    tag.id = p.ids[i];
+    tag.tool_from_tag = BlockPose(p.tag_blocks[i], p.tag_R0[i]);
+    std::set<int> frames_seen;
+    for (size_t c = 0; c < p.corners.size(); ++c) {
+      if (p.corner_used[c] && p.corners[c].tag == static_cast<int>(i)) {
+        frames_seen.insert(p.corners[c].frame);
+      }
+    }
+    tag.views = static_cast<int>(frames_seen.size());
+    result.tags.push_back(tag);
+  }
+  TagSigmas(p, problem.get(), result.sigma0_px, &result.tags);
+  for (const LayoutTag& t : result.tags) {
+    TargetTag tag;
+    tag.id = t.id;
+    tag.size_mm = options.tag_size_mm;
+    tag.tool_from_tag = t.tool_from_tag;
+    tag.has_sigma = true;
+    tag.sigma_t_mm = t.sigma_t_mm;
+    tag.sigma_r_deg = t.sigma_r_deg;
+    result.target.tags.push_back(tag);
+  }
+  for (size_t f = 0; f < p.frame_blocks.size(); ++f) {
+    result.rig_from_tool.push_back(BlockPose(p.frame_blocks[f], p.frame_R0[f]));
+  }
+  return result;
+}
+
+std::vector<LayoutFrame> DetectSessionTags(
+    const Session& session, const Rig& rig, const AprilTagOptions& detector,
+    const std::function<void(int, int)>& progress) {
+  if (rig.cameras.size() != 2) {
+    throw InputError("a recorded session has two cameras; the rig has " +
+                     std::to_string(rig.cameras.size()));
+  }
+  detector.Check();
+  AprilTagDetector detectors[2] = {AprilTagDetector(detector),
+                                   AprilTagDetector(detector)};
+  std::vector<LayoutFrame> frames;
+  const int total = static_cast<int>(session.frames.size());
+  for (const SessionFrame& sf : session.frames) {
+    LayoutFrame f;
+    f.frame = sf.frame;
+    f.detections.resize(2);
+    const std::string* files[2] = {&sf.left_image, &sf.right_image};
+    ForBothCameras([&](int c) {
+      f.detections[c] = detectors[c].Detect(
+          ReadCameraImage(*files[c], rig.cameras[c].intrinsics));
+    });
+    frames.push_back(std::move(f));
+    if (progress) progress(static_cast<int>(frames.size()), total);
+  }
+  return frames;
+}
+
+}  // namespace kincal

@@ -1,0 +1,228 @@
+#include "vision/target_layout.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <random>
+
+#include "data/error.h"
+#include "data/rigid3.h"
+#include "synth/render.h"
+
+namespace kincal {
+namespace {
+
+constexpr double kTagMm = 25.0;
+
+Eigen::Matrix3d Rot(const Eigen::Vector3d& axis, double deg) {
+  return Eigen::AngleAxisd(deg * M_PI / 180, axis.normalized())
+      .toRotationMatrix();
+}
+
+// Three tags on a holder: tag 4 flat, tag 7 turned 35 deg about y to one
+// side and tag 9 turned 35 deg the other way (70 deg between them).
+std::vector<std::pair<int, Rigid3>> TrueLayout() {
+  Rigid3 a, b, c;
+  a.R = Rot(Eigen::Vector3d::UnitX(), 5);
+  a.t = Eigen::Vector3d(0, -5, 2);
+  b.R = Rot(Eigen::Vector3d::UnitY(), 35);
+  b.t = Eigen::Vector3d(-30, 0, 10);
+  c.R = Rot(Eigen::Vector3d::UnitY(), -35);
+  c.t = Eigen::Vector3d(30, 2, 10);
+  return {{4, a}, {7, b}, {9, c}};
+}
+
+// A tool pose in front of the rig, tilted by up to ~35 deg.
+Rigid3 ToolPose(int i, std::mt19937_64* rng) {
+  std::uniform_real_distribution<double> u(-1, 1);
+  Rigid3 pose;
+  pose.R = Rot(Eigen::Vector3d(u(*rng), u(*rng), 0.2 * u(*rng)), 35 * u(*rng));
+  pose.t = Eigen::Vector3d(60 + 30 * u(*rng), 10 * u(*rng),
+                           420 + 40 * std::sin(0.3 * i));
+  return pose;
+}
+
+// Corners of every tag facing a camera (within 75 deg) and inside its
+// image, with Gaussian pixel noise.
+std::vector<LayoutFrame> Frames(const Rig& rig,
+                                const std::vector<std::pair<int, Rigid3>>& tags,
+                                int n, double noise_px, int seed) {
+  std::mt19937_64 rng(seed);
+  std::normal_distribution<double> noise(0, noise_px);
+  std::vector<LayoutFrame> frames;
+  for (int i = 0; i < n; ++i) {
+    const Rigid3 rig_from_tool = ToolPose(i, &rng);
+    LayoutFrame f;
+    f.frame = i;
+    for (const Camera& cam : rig.cameras) {
+      std::vector<TagDetection> dets;
+      for (const auto& [id, tool_from_tag] : tags) {
+        const Rigid3 cam_from_tag =
+            cam.cam_from_rig * rig_from_tool * tool_from_tag;
+        const Eigen::Vector3d view = cam_from_tag.t.normalized();
+        if (view.dot(cam_from_tag.R.col(2)) < std::cos(75 * M_PI / 180)) {
+          continue;
+        }
+        TagDetection d;
+        d.id = id;
+        bool inside = true;
+        for (int k = 0; k < 4; ++k) {
+          const Eigen::Vector2d px =
+              Project(cam.intrinsics, cam_from_tag * TagCornerInTag(k, kTagMm));
+          inside = inside && px.x() > 5 && px.y() > 5 &&
+                   px.x() < cam.intrinsics.width - 5 &&
+                   px.y() < cam.intrinsics.height - 5;
+          d.corners[k] = px + Eigen::Vector2d(noise(rng), noise(rng));
+        }
+        d.detector_corners = d.corners;
+        if (inside) dets.push_back(d);
+      }
+      f.detections.push_back(dets);
+    }
+    frames.push_back(f);
+  }
+  return frames;
+}
+
+TargetLayoutOptions Options() {
+  TargetLayoutOptions o;
+  o.tag_size_mm = kTagMm;
+  return o;
+}
+
+// ref_from_tag of the truth for the measured layout's reference tag.
+Rigid3 TrueRefFromTag(const std::vector<std::pair<int, Rigid3>>& truth,
+                      int reference, int id) {
+  Rigid3 tool_from_ref, tool_from_tag;
+  for (const auto& [tid, pose] : truth) {
+    if (tid == reference) tool_from_ref = pose;
+    if (tid == id) tool_from_tag = pose;
+  }
+  return tool_from_ref.Inverse() * tool_from_tag;
+}
+
+TEST(TargetLayout, RecoversTagPosesWithHonestSigma) {
+  const Rig rig = ExampleStereoRig(1280, 1024);
+  const auto truth = TrueLayout();
+  double z2_t = 0, z2_r = 0, max_t = 0, max_r = 0;
+  int count = 0;
+  for (int seed = 1; seed <= 8; ++seed) {
+    const TargetLayoutResult r =
+        MeasureTargetLayout(rig, Frames(rig, truth, 40, 0.1, seed), Options());
+    ASSERT_EQ(r.tags.size(), 3u);
+    EXPECT_GE(r.views_used, 30);
+    EXPECT_FALSE(r.target.has_tip);
+    EXPECT_NEAR(r.sigma0_px, 0.1, 0.02);
+    for (const LayoutTag& tag : r.tags) {
+      const Rigid3 want = TrueRefFromTag(truth, r.reference_tag_id, tag.id);
+      const Eigen::Vector3d dt = tag.tool_from_tag.t - want.t;
+      const Eigen::Vector3d dr =
+          RotationVectorFromMatrix(tag.tool_from_tag.R * want.R.transpose()) *
+          180 / M_PI;
+      if (tag.id == r.reference_tag_id) {
+        EXPECT_LT(dt.norm() + dr.norm(), 1e-9);
+        EXPECT_EQ(tag.sigma_t_mm.norm(), 0);
+        continue;
+      }
+      max_t = std::max(max_t, dt.norm());
+      max_r = std::max(max_r, dr.norm());
+      for (int k = 0; k < 3; ++k) {
+        ASSERT_GT(tag.sigma_t_mm(k), 0);
+        ASSERT_GT(tag.sigma_r_deg(k), 0);
+        z2_t += std::pow(dt(k) / tag.sigma_t_mm(k), 2);
+        z2_r += std::pow(dr(k) / tag.sigma_r_deg(k), 2);
+        ++count;
+      }
+    }
+  }
+  const double ratio_t = std::sqrt(z2_t / count);
+  const double ratio_r = std::sqrt(z2_r / count);
+  std::printf(
+      "layout: max error %.4f mm, %.4f deg; RMS error/sigma t %.3f, r %.3f\n",
+      max_t, max_r, ratio_t, ratio_r);
+  EXPECT_LT(max_t, 0.05);
+  EXPECT_LT(max_r, 0.05);
+  EXPECT_GT(ratio_t, 0.7);
+  EXPECT_LT(ratio_t, 1.4);
+  EXPECT_GT(ratio_r, 0.7);
+  EXPECT_LT(ratio_r, 1.4);
+}
+
+// Two tags are enough; a few wild corners are left out by the robust fit.
+TEST(TargetLayout, TwoTagsAndOutliers) {
+  const Rig rig = ExampleStereoRig(1280, 1024);
+  auto truth = TrueLayout();
+  truth.pop_back();
+  auto frames = Frames(rig, truth, 20, 0.1, 3);
+  int spoiled = 0;
+  for (int i = 0; i < 20; i += 4) {
+    if (frames[i].detections[0].empty()) continue;
+    frames[i].detections[0][0].corners[1] += Eigen::Vector2d(6, -4);
+    ++spoiled;
+  }
+  const TargetLayoutResult r = MeasureTargetLayout(rig, frames, Options());
+  EXPECT_GE(r.corners_rejected, spoiled);
+  for (const LayoutTag& tag : r.tags) {
+    const Rigid3 want = TrueRefFromTag(truth, r.reference_tag_id, tag.id);
+    EXPECT_LT((tag.tool_from_tag.t - want.t).norm(), 0.05);
+  }
+}
+
+TEST(TargetLayout, RefusesTooFewViews) {
+  const Rig rig = ExampleStereoRig(1280, 1024);
+  try {
+    MeasureTargetLayout(rig, Frames(rig, TrueLayout(), 6, 0.1, 1), Options());
+    ADD_FAILURE() << "6 views accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("record the tool from more"),
+              std::string::npos)
+        << e.what();
+  }
+}
+
+// Tag 9 only ever shows alone: its place on the tool is unknown.
+TEST(TargetLayout, RefusesATagNeverSeenWithTheOthers) {
+  const Rig rig = ExampleStereoRig(1280, 1024);
+  auto truth = TrueLayout();
+  const auto pair =
+      std::vector<std::pair<int, Rigid3>>(truth.begin(), truth.begin() + 2);
+  auto frames = Frames(rig, pair, 15, 0.1, 2);
+  const auto alone = Frames(rig, {truth[2]}, 5, 0.1, 4);
+  frames.insert(frames.end(), alone.begin(), alone.end());
+  try {
+    MeasureTargetLayout(rig, frames, Options());
+    ADD_FAILURE() << "an unconnected tag accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("tags 9 were never seen"),
+              std::string::npos)
+        << e.what();
+  }
+}
+
+// Corners of 25 mm tags fitted as 30 mm tags do not fit: refused.
+TEST(TargetLayout, RefusesAWrongTagSize) {
+  const Rig rig = ExampleStereoRig(1280, 1024);
+  TargetLayoutOptions o = Options();
+  o.tag_size_mm = 30;
+  try {
+    MeasureTargetLayout(rig, Frames(rig, TrueLayout(), 20, 0.1, 5), o);
+    ADD_FAILURE() << "a wrong tag size accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("check --size"), std::string::npos)
+        << e.what();
+  }
+}
+
+TEST(TargetLayout, RejectsBadOptions) {
+  const Rig rig = ExampleStereoRig(1280, 1024);
+  TargetLayoutOptions o = Options();
+  o.tag_size_mm = 0;
+  EXPECT_THROW(MeasureTargetLayout(rig, {}, o), InputError);
+  o = Options();
+  o.family = "tag99";
+  EXPECT_THROW(MeasureTargetLayout(rig, {}, o), InputError);
+}
+
+}  // namespace
+}  // namespace kincal
