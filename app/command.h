@@ -27,6 +27,7 @@ void AddExportCommand(CLI::App& app, Runner* run);
 void AddReportCommand(CLI::App& app, Runner* run);
 void AddPlanCommand(CLI::App& app, Runner* run);
 void AddBundleCommand(CLI::App& app, Runner* run);
+void AddPrintCommand(CLI::App& app, Runner* run);
 
 // Prints a result object as one line of JSON on stdout, with the command line
 // and tool version added ("command", "kincal_version").

@@ -11,8 +11,8 @@
 //                      GStreamer...: ~270 shared libraries, 0.2-0.3 s to load)
 //
 // In bin/kincal, the image commands (KINCAL_IMAGE_COMMANDS in
-// app/CMakeLists.txt: camcal, track, capture, bundle) are registered by
-// app/front_end.cc with their names and descriptions only (so
+// app/CMakeLists.txt: camcal, track, capture, bundle, print) are registered
+// by app/front_end.cc with their names and descriptions only (so
 // `kincal --help` lists them) and accept any arguments; once CLI11 selects
 // one, or `simulate` is given --render, kincal replaces itself by
 // kincal-vision with the same argv (exec), so output, exit codes, provenance
@@ -39,6 +39,9 @@ inline constexpr char kBundleDescription[] =
     "over every tag corner in every camera at every frame with joint readings "
     "(robot parameters, base in the rig, target on the flange, optionally the "
     "cameras)";
+inline constexpr char kPrintDescription[] =
+    "Write a print-ready calibration sheet (PDF or SVG, physical size, with a "
+    "100 mm scale bar) of a camcal target spec or a tool's target.yaml";
 
 // Replaces this process by kincal-vision with this process's argv (read
 // from /proc/self/cmdline). kincal-vision is $KINCAL_VISION when set, else
