@@ -38,10 +38,16 @@ cv::Mat Rasterise(const std::string& pdf) {
   return cv::imread(prefix + ".pgm", cv::IMREAD_GRAYSCALE);
 }
 
-// Black runs (value < 128) of one image row: [begin, end) in pixels.
-std::vector<std::pair<int, int>> BlackRuns(const cv::Mat& page, int row) {
-  std::vector<std::pair<int, int>> runs;
+// Black runs (value < 128) of one image row: [begin, end) in pixels, each
+// edge placed where the grey level crosses 128 between two pixel centres
+// (pdftoppm antialiases: an edge pixel's grey is its white fraction), so a
+// run is measured to a fraction of a pixel.
+std::vector<std::pair<double, double>> BlackRuns(const cv::Mat& page, int row) {
+  std::vector<std::pair<double, double>> runs;
   const uint8_t* p = page.ptr<uint8_t>(row);
+  auto crossing = [p](int a, int b) {  // pixels a, b = a + 1; p[a] != p[b]
+    return a + 0.5 + (p[a] - 128.0) / (p[a] - p[b]);
+  };
   for (int x = 0; x < page.cols;) {
     if (p[x] >= 128) {
       ++x;
@@ -49,7 +55,8 @@ std::vector<std::pair<int, int>> BlackRuns(const cv::Mat& page, int row) {
     }
     const int begin = x;
     while (x < page.cols && p[x] < 128) ++x;
-    runs.push_back({begin, x});
+    runs.push_back({begin > 0 ? crossing(begin - 1, begin) : 0.0,
+                    x < page.cols ? crossing(x - 1, x) : double(page.cols)});
   }
   return runs;
 }
@@ -57,6 +64,9 @@ std::vector<std::pair<int, int>> BlackRuns(const cv::Mat& page, int row) {
 struct Measured {
   double bar_mm = 0;  // first to last tick of the scale bar, centre to centre
   double pattern_width_mm = 0, pattern_height_mm = 0;  // black bounding box
+  // Black runs 1 mm below the pattern's top: the top row of chessboard
+  // squares, or the top sides of the top row of tags (their black ring).
+  std::vector<double> top_runs_mm;
 };
 
 // Finds the scale bar's baseline (the first row from the top with a black
@@ -80,7 +90,8 @@ Measured MeasureSheet(const cv::Mat& page) {
   }
   const int pattern_rows =
       baseline - static_cast<int>(std::lround(6 * kPxPerMm));
-  int x0 = page.cols, x1 = -1, y0 = page.rows, y1 = -1;
+  double x0 = page.cols, x1 = -1;
+  int y0 = page.rows, y1 = -1;
   for (int y = 0; y < pattern_rows; ++y) {
     for (const auto& run : BlackRuns(page, y)) {
       x0 = std::min(x0, run.first);
@@ -91,6 +102,11 @@ Measured MeasureSheet(const cv::Mat& page) {
   }
   m.pattern_width_mm = (x1 - x0) / kPxPerMm;
   m.pattern_height_mm = (y1 - y0) / kPxPerMm;
+  if (y1 < 0) return m;
+  for (const auto& run :
+       BlackRuns(page, y0 + static_cast<int>(std::lround(kPxPerMm)))) {
+    m.top_runs_mm.push_back((run.second - run.first) / kPxPerMm);
+  }
   return m;
 }
 
@@ -131,6 +147,10 @@ TEST(PrintCli, ChessboardPdfAtPhysicalSize) {
                               "chessboard square (width / 10)");
   ExpectWithinTenthOfAPercent(m.pattern_height_mm / 7, 20,
                               "chessboard square (height / 7)");
+  ASSERT_EQ(m.top_runs_mm.size(), 5u);  // black squares of the top row
+  for (double run : m.top_runs_mm) {
+    ExpectWithinTenthOfAPercent(run, 20, "one chessboard square");
+  }
 }
 
 TEST(PrintCli, AprilGridPdfAtPhysicalSize) {
@@ -158,8 +178,10 @@ TEST(PrintCli, AprilGridPdfAtPhysicalSize) {
                               "AprilGrid width (6 tags, 5 gaps)");
   ExpectWithinTenthOfAPercent(m.pattern_height_mm, stated,
                               "AprilGrid height (6 tags, 5 gaps)");
-  ExpectWithinTenthOfAPercent(m.pattern_width_mm / stated * 24, 24,
-                              "AprilGrid tag (width scaled)");
+  ASSERT_EQ(m.top_runs_mm.size(), 6u);  // top sides of the top row of tags
+  for (double run : m.top_runs_mm) {
+    ExpectWithinTenthOfAPercent(run, 24, "one tag's black square");
+  }
 }
 
 TEST(PrintCli, SvgInMillimetresAndToolTargetYaml) {
@@ -190,6 +212,24 @@ TEST(PrintCli, SvgInMillimetresAndToolTargetYaml) {
   const std::string tool = ReadFile(dir + "/tool.svg");
   EXPECT_THAT(tool, HasSubstr(">id 4, 25 mm<"));
   EXPECT_THAT(tool, HasSubstr(">id 9, 40 mm<"));
+}
+
+// print is an image command (cairo, OpenCV): bin/kincal lists it and hands
+// it to kincal-vision, whose --help is the one shown.
+TEST(PrintCli, SameHelpFromBothBinaries) {
+  const std::string kincal = testing::KincalBinary();
+  const std::string vision =
+      kincal.substr(0, kincal.find_last_of('/') + 1) + "kincal-vision";
+  const auto a = RunKincal("print --help");
+  const auto b = RunShell(vision + " print --help");
+  ASSERT_EQ(a.exit_code, 0);
+  EXPECT_THAT(a.out, HasSubstr("--paper"));
+  std::string expected = b.out;
+  for (size_t at = expected.find(vision); at != std::string::npos;
+       at = expected.find(vision, at + kincal.size())) {
+    expected.replace(at, vision.size(), kincal);
+  }
+  EXPECT_EQ(a.out, expected);
 }
 
 TEST(PrintCli, BadInputExits2AndWritesNothing) {
