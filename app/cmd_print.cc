@@ -1,12 +1,15 @@
 // kincal print: a print-ready calibration sheet at physical size
 // (vision/target_sheet.h, docs/PRINT.md).
 
+#include <cmath>
 #include <cstdio>
+#include <fstream>
 #include <memory>
 
 #include "app/app_util.h"
 #include "app/command.h"
 #include "app/front_end.h"
+#include "data/error.h"
 #include "data/provenance.h"
 #include "vision/calib_target.h"
 #include "vision/target.h"
@@ -20,6 +23,8 @@ struct PrintArgs {
   bool json = false;
 };
 
+double RoundMicrometre(double mm) { return std::round(mm * 1000) / 1000; }
+
 int RunPrint(const PrintArgs& args) {
   SheetOptions options;
   options.paper = args.paper;
@@ -27,6 +32,13 @@ int RunPrint(const PrintArgs& args) {
   // A spec has a colon (chessboard:..., aprilgrid:..., or a misspelt kind,
   // which ParseCalibTargetSpec names); anything else is a target.yaml path.
   const bool spec = args.target.find(':') != std::string::npos;
+  if (!spec && !std::ifstream(args.target)) {
+    throw InputError("--target '" + args.target +
+                     "': no such file; expected "
+                     "chessboard:COLSxROWS:SQUARE, "
+                     "aprilgrid:COLSxROWS:TAG_SIZE:SPACING_RATIO (e.g. "
+                     "chessboard:9x6:20) or a target.yaml");
+  }
   const TargetSheet sheet =
       spec ? LayoutCalibTargetSheet(ParseCalibTargetSpec(args.target), options)
            : LayoutToolTargetSheet(ReadTargetYaml(args.target), args.target,
@@ -39,7 +51,9 @@ int RunPrint(const PrintArgs& args) {
                {"target", sheet.target},
                {"paper", sheet.paper.name},
                {"orientation", sheet.landscape ? "landscape" : "portrait"},
-               {"pattern_mm", {sheet.board_width_mm, sheet.board_height_mm}}});
+               {"pattern_mm",
+                {RoundMicrometre(sheet.board_width_mm),
+                 RoundMicrometre(sheet.board_height_mm)}}});
     return 0;
   }
   std::printf(

@@ -256,6 +256,7 @@ TEST(PrintCli, BadInputExits2AndWritesNothing) {
   r = RunKincal("print --target " + dir + "/missing.yaml --out " + dir +
                 "/t.pdf");
   EXPECT_EQ(r.exit_code, 2);
+  EXPECT_THAT(r.err, HasSubstr("no such file; expected chessboard:"));
   EXPECT_FALSE(Exists(dir + "/t.pdf"));
 }
 
