@@ -11,7 +11,7 @@
 //                      GStreamer...: ~270 shared libraries, 0.2-0.3 s to load)
 //
 // In bin/kincal, the image commands (KINCAL_IMAGE_COMMANDS in
-// app/CMakeLists.txt: camcal, track, capture, bundle, target) are
+// app/CMakeLists.txt: camcal, track, capture, bundle, target, print) are
 // registered by app/front_end.cc with their names and descriptions only (so
 // `kincal --help` lists them) and accept any arguments; once CLI11 selects
 // one, or `simulate` is given --render, kincal replaces itself by
@@ -43,6 +43,9 @@ inline constexpr char kTargetDescription[] =
     "Measure a tool target from a recorded session of the tool: the tag "
     "poses from one bundle over every tag corner, the needle tip by pivot "
     "calibration (--pivot); writes target.yaml with sigmas";
+inline constexpr char kPrintDescription[] =
+    "Write a print-ready calibration sheet (PDF or SVG, physical size, with a "
+    "100 mm scale bar) of a camcal target spec or a tool's target.yaml";
 
 // Replaces this process by kincal-vision with this process's argv (read
 // from /proc/self/cmdline). kincal-vision is $KINCAL_VISION when set, else

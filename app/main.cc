@@ -55,6 +55,7 @@ int main(int argc, char** argv) {
   kincal::app::AddPlanCommand(app, &run);
   kincal::app::AddBundleCommand(app, &run);
   kincal::app::AddTargetCommand(app, &run);
+  kincal::app::AddPrintCommand(app, &run);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
