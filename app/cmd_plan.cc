@@ -15,6 +15,7 @@
 #include "data/rigid3.h"
 #include "data/urdf.h"
 #include "plan/confirm.h"
+#include "plan/obstacles.h"
 #include "plan/plan.h"
 #include "vision/target.h"
 
@@ -22,12 +23,13 @@ namespace kincal::app {
 namespace {
 
 struct PlanArgs {
-  std::string robot, root, tip, out, random_out, rig, target;
+  std::string robot, root, tip, out, random_out, rig, target, obstacles;
   std::vector<double> rig_from_base;
   std::string criterion = "sigma";
   int confirm = 0;
   PlanOptions options;
   bool json = false;
+  bool no_self_collision = false;
 };
 
 int RunPlan(PlanArgs args) {
@@ -57,6 +59,10 @@ int RunPlan(PlanArgs args) {
                           args.rig_from_base[5]);
     args.options.rig_from_base = r;
   }
+  if (!args.obstacles.empty()) {
+    args.options.safety.obstacles = ReadObstaclesYaml(args.obstacles);
+  }
+  args.options.safety.self_collision = !args.no_self_collision;
   if (args.criterion == "d") {
     args.options.criterion = PlanOptions::kDOptimal;
   } else if (args.criterion == "sigma") {
@@ -110,6 +116,13 @@ int RunPlan(PlanArgs args) {
     j["candidates"] = plan.feasible_candidates;
     j["draws"] = plan.draws;
     j["swaps"] = plan.swaps;
+    j["limit_margin"] = args.options.limit_margin;
+    j["link_radius_mm"] = args.options.safety.link_radius_mm;
+    j["obstacles"] = args.obstacles;
+    j["rejected_limits"] = plan.rejected_limits;
+    j["rejected_collision"] = plan.rejected_collision;
+    j["rejected_visibility"] = plan.rejected_visibility;
+    j["collisions"] = plan.collisions;
     if (rig) {
       const Eigen::Vector3d w =
           RotationVectorFromMatrix(plan.rig_from_base.R) * 180 / M_PI;
@@ -160,6 +173,11 @@ int RunPlan(PlanArgs args) {
                 plan.planned.sigma[k], plan.random.sigma[k],
                 plan.params[k].angle ? "deg" : "mm");
   }
+  std::printf(
+      "  rejected draws: %ld outside the limits minus %.3g of the "
+      "range, %ld for collisions, %ld with too few tags visible\n",
+      plan.rejected_limits, args.options.limit_margin, plan.rejected_collision,
+      plan.rejected_visibility);
   std::printf("  predicted tip RMS %.4f mm (random poses: %.4f mm)\n",
               plan.planned.tip_rms_mm, plan.random.tip_rms_mm);
   std::printf(
@@ -215,6 +233,23 @@ void AddPlanCommand(CLI::App& app, Runner* run) {
   sub->add_option("--extreme", args->options.extreme_fraction,
                   "probability that a candidate puts a joint at a limit")
       ->check(CLI::Range(0.0, 1.0));
+  sub->add_option("--limit-margin", args->options.limit_margin,
+                  "keep every pose this fraction of each joint's range away "
+                  "from both limits (extreme candidates go to the limit minus "
+                  "the margin)")
+      ->check(CLI::Range(0.0, 0.45));
+  sub->add_option("--obstacles", args->obstacles,
+                  "OBST.yaml: planes and boxes in the base frame "
+                  "(kincal_obstacles: 1; docs/LAB.md); poses where a link "
+                  "capsule meets one are rejected")
+      ->check(CLI::ExistingFile);
+  sub->add_option("--link-radius", args->options.safety.link_radius_mm,
+                  "radius of the capsules around the links (segments between "
+                  "the joint frames' origins, and the tool to the tip), mm")
+      ->check(CLI::Range(0.0, 1000.0));
+  sub->add_flag("--no-self-collision", args->no_self_collision,
+                "do not reject poses where two non-adjacent link capsules "
+                "meet");
   sub->add_option("--confirm", args->confirm,
                   "also simulate this many sessions at the planned and at the "
                   "random poses, calibrate them and report the actual errors")
