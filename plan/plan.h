@@ -11,12 +11,14 @@
 // values, Borm and Menq's O1 to the power of the parameter count): it is
 // invariant to the units of the parameters and it is the volume of the
 // confidence ellipsoid. Candidates are random feasible poses (within joint
-// limits and, with a rig, every candidate has at least `min_tags` tags of
-// the target fully visible, not too oblique and not too small in both
-// cameras); the design is built greedily and then improved by Fedorov
-// exchange (swap a design pose for a candidate while log det grows).
-// The chosen poses are ordered as a short path (nearest-neighbour tour plus
-// 2-opt on the joint motion, each joint normalised by its range).
+// limits less `limit_margin` of each range, the links' capsules clear of
+// the obstacles and of each other (plan/safety.h) and, with a rig, every
+// candidate has at least `min_tags` tags of the target fully visible, not
+// too oblique and not too small in both cameras); the design is built greedily
+// and then improved by Fedorov exchange (swap a design pose for a candidate
+// while log det grows). The chosen poses are ordered as a short path
+// (nearest-neighbour tour plus 2-opt on the joint motion, each joint normalised
+// by its range).
 //
 // Predictions assume independent Gaussian noise of `noise_mm` on each
 // coordinate of each measured tip: Cov = noise^2 (J^T J)^-1. The predicted
