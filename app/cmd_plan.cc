@@ -15,6 +15,7 @@
 #include "data/rigid3.h"
 #include "data/urdf.h"
 #include "plan/confirm.h"
+#include "plan/obstacles.h"
 #include "plan/plan.h"
 #include "vision/target.h"
 
@@ -22,13 +23,98 @@ namespace kincal::app {
 namespace {
 
 struct PlanArgs {
-  std::string robot, root, tip, out, random_out, rig, target;
+  std::string robot, root, tip, out, random_out, rig, target, obstacles;
   std::vector<double> rig_from_base;
   std::string criterion = "sigma";
   int confirm = 0;
   PlanOptions options;
   bool json = false;
+  bool no_self_collision = false;
 };
+
+// The JSON object of a plan (with --confirm: also simulated calibrations at
+// the planned and the random poses).
+nlohmann::json PlanJson(const PlanArgs& args, const Robot& robot,
+                        const PlanResult& plan, bool with_rig) {
+  nlohmann::json sigma = nlohmann::json::object();
+  nlohmann::json random_sigma = nlohmann::json::object();
+  for (size_t k = 0; k < plan.params.size(); ++k) {
+    sigma[plan.params[k].name] = Number(plan.planned.sigma[k]);
+    random_sigma[plan.params[k].name] = Number(plan.random.sigma[k]);
+  }
+  nlohmann::json j;
+  j["n"] = plan.poses.size();
+  j["out"] = args.out;
+  j["mode"] = args.options.fixed_point ? "fixed_point" : "free";
+  j["criterion"] = args.criterion;
+  j["noise_mm"] = args.options.noise_mm;
+  j["predicted_sigma"] = sigma;
+  j["random_predicted_sigma"] = random_sigma;
+  j["predicted_tip_rms_mm"] = Number(plan.planned.tip_rms_mm);
+  j["random_predicted_tip_rms_mm"] = Number(plan.random.tip_rms_mm);
+  j["sigma_gmean_over_bound"] = Number(plan.planned_sigma_gmean);
+  j["random_sigma_gmean_over_bound"] = Number(plan.random_sigma_gmean);
+  j["sigma_gain"] = Number(plan.random_sigma_gmean / plan.planned_sigma_gmean);
+  j["log_det"] = Number(plan.planned.log_det);
+  j["observability"] = {{"O1", Number(plan.planned.o1)},
+                        {"O3", Number(plan.planned.o3)},
+                        {"O4", Number(plan.planned.o4)}};
+  j["random_observability"] = {{"O1", Number(plan.random.o1)},
+                               {"O3", Number(plan.random.o3)},
+                               {"O4", Number(plan.random.o4)}};
+  j["random_log_det"] = Number(plan.random.log_det);
+  j["joint_travel"] = Number(plan.planned.joint_travel);
+  j["random_joint_travel"] = Number(plan.random.joint_travel);
+  j["unidentifiable"] = plan.unidentifiable;
+  j["candidates"] = plan.feasible_candidates;
+  j["draws"] = plan.draws;
+  j["swaps"] = plan.swaps;
+  j["limit_margin"] = args.options.limit_margin;
+  j["link_radius_mm"] = args.options.safety.link_radius_mm;
+  j["obstacles"] = args.obstacles;
+  j["rejected_limits"] = plan.rejected_limits;
+  j["rejected_collision"] = plan.rejected_collision;
+  j["rejected_visibility"] = plan.rejected_visibility;
+  j["collisions"] = plan.collisions;
+  if (with_rig) {
+    const Eigen::Vector3d w =
+        RotationVectorFromMatrix(plan.rig_from_base.R) * 180 / M_PI;
+    j["rig_from_base"] = {w.x(),
+                          w.y(),
+                          w.z(),
+                          plan.rig_from_base.t.x(),
+                          plan.rig_from_base.t.y(),
+                          plan.rig_from_base.t.z()};
+  }
+  if (args.options.fixed_point) {
+    const Eigen::Vector3d& p = plan.fixed_point_in_base;
+    j["fixed_point_in_base"] = {p.x(), p.y(), p.z()};
+  }
+  if (args.confirm > 0) {
+    ConfirmOptions co;
+    co.repetitions = args.confirm;
+    co.seed = args.options.seed;
+    const ConfirmResult a =
+        ConfirmDesign(robot, plan, plan.poses, args.options, co);
+    const ConfirmResult b =
+        ConfirmDesign(robot, plan, plan.random_poses, args.options, co);
+    nlohmann::json err = nlohmann::json::object();
+    nlohmann::json rerr = nlohmann::json::object();
+    for (size_t k = 0; k < plan.params.size(); ++k) {
+      err[plan.params[k].name] = Number(a.rms_error[k]);
+      rerr[plan.params[k].name] = Number(b.rms_error[k]);
+    }
+    j["confirmed"] = {{"repetitions", args.confirm},
+                      {"rms_error", err},
+                      {"random_rms_error", rerr},
+                      {"tip_rms_mm", Number(a.tip_rms_mm)},
+                      {"random_tip_rms_mm", Number(b.tip_rms_mm)},
+                      {"error_gain", Number(b.error_gmean / a.error_gmean)},
+                      {"failed_fits", a.failed_fits + b.failed_fits}};
+  }
+  j["seconds"] = plan.seconds;
+  return j;
+}
 
 int RunPlan(PlanArgs args) {
   const Robot robot = ReadRobot(args.robot, args.root, args.tip);
@@ -57,6 +143,10 @@ int RunPlan(PlanArgs args) {
                           args.rig_from_base[5]);
     args.options.rig_from_base = r;
   }
+  if (!args.obstacles.empty()) {
+    args.options.safety.obstacles = ReadObstaclesYaml(args.obstacles);
+  }
+  args.options.safety.self_collision = !args.no_self_collision;
   if (args.criterion == "d") {
     args.options.criterion = PlanOptions::kDOptimal;
   } else if (args.criterion == "sigma") {
@@ -75,79 +165,8 @@ int RunPlan(PlanArgs args) {
   if (!args.random_out.empty()) {
     WriteFileAtomic(args.random_out, FormatPosesCsv(robot, plan.random_poses));
   }
-  nlohmann::json sigma = nlohmann::json::object();
-  nlohmann::json random_sigma = nlohmann::json::object();
-  for (size_t k = 0; k < plan.params.size(); ++k) {
-    sigma[plan.params[k].name] = Number(plan.planned.sigma[k]);
-    random_sigma[plan.params[k].name] = Number(plan.random.sigma[k]);
-  }
   if (args.json) {
-    nlohmann::json j;
-    j["n"] = plan.poses.size();
-    j["out"] = args.out;
-    j["mode"] = args.options.fixed_point ? "fixed_point" : "free";
-    j["criterion"] = args.criterion;
-    j["noise_mm"] = args.options.noise_mm;
-    j["predicted_sigma"] = sigma;
-    j["random_predicted_sigma"] = random_sigma;
-    j["predicted_tip_rms_mm"] = Number(plan.planned.tip_rms_mm);
-    j["random_predicted_tip_rms_mm"] = Number(plan.random.tip_rms_mm);
-    j["sigma_gmean_over_bound"] = Number(plan.planned_sigma_gmean);
-    j["random_sigma_gmean_over_bound"] = Number(plan.random_sigma_gmean);
-    j["sigma_gain"] =
-        Number(plan.random_sigma_gmean / plan.planned_sigma_gmean);
-    j["log_det"] = Number(plan.planned.log_det);
-    j["observability"] = {{"O1", Number(plan.planned.o1)},
-                          {"O3", Number(plan.planned.o3)},
-                          {"O4", Number(plan.planned.o4)}};
-    j["random_observability"] = {{"O1", Number(plan.random.o1)},
-                                 {"O3", Number(plan.random.o3)},
-                                 {"O4", Number(plan.random.o4)}};
-    j["random_log_det"] = Number(plan.random.log_det);
-    j["joint_travel"] = Number(plan.planned.joint_travel);
-    j["random_joint_travel"] = Number(plan.random.joint_travel);
-    j["unidentifiable"] = plan.unidentifiable;
-    j["candidates"] = plan.feasible_candidates;
-    j["draws"] = plan.draws;
-    j["swaps"] = plan.swaps;
-    if (rig) {
-      const Eigen::Vector3d w =
-          RotationVectorFromMatrix(plan.rig_from_base.R) * 180 / M_PI;
-      j["rig_from_base"] = {w.x(),
-                            w.y(),
-                            w.z(),
-                            plan.rig_from_base.t.x(),
-                            plan.rig_from_base.t.y(),
-                            plan.rig_from_base.t.z()};
-    }
-    if (args.options.fixed_point) {
-      const Eigen::Vector3d& p = plan.fixed_point_in_base;
-      j["fixed_point_in_base"] = {p.x(), p.y(), p.z()};
-    }
-    if (args.confirm > 0) {
-      ConfirmOptions co;
-      co.repetitions = args.confirm;
-      co.seed = args.options.seed;
-      const ConfirmResult a =
-          ConfirmDesign(robot, plan, plan.poses, args.options, co);
-      const ConfirmResult b =
-          ConfirmDesign(robot, plan, plan.random_poses, args.options, co);
-      nlohmann::json err = nlohmann::json::object();
-      nlohmann::json rerr = nlohmann::json::object();
-      for (size_t k = 0; k < plan.params.size(); ++k) {
-        err[plan.params[k].name] = Number(a.rms_error[k]);
-        rerr[plan.params[k].name] = Number(b.rms_error[k]);
-      }
-      j["confirmed"] = {{"repetitions", args.confirm},
-                        {"rms_error", err},
-                        {"random_rms_error", rerr},
-                        {"tip_rms_mm", Number(a.tip_rms_mm)},
-                        {"random_tip_rms_mm", Number(b.tip_rms_mm)},
-                        {"error_gain", Number(b.error_gmean / a.error_gmean)},
-                        {"failed_fits", a.failed_fits + b.failed_fits}};
-    }
-    j["seconds"] = plan.seconds;
-    PrintJson(j);
+    PrintJson(PlanJson(args, robot, plan, rig.has_value()));
     return 0;
   }
   std::printf("kincal plan: %zu poses -> %s (%s, %d feasible candidates)\n",
@@ -160,6 +179,11 @@ int RunPlan(PlanArgs args) {
                 plan.planned.sigma[k], plan.random.sigma[k],
                 plan.params[k].angle ? "deg" : "mm");
   }
+  std::printf(
+      "  rejected draws: %ld outside the limits minus %.3g of the "
+      "range, %ld for collisions, %ld with too few tags visible\n",
+      plan.rejected_limits, args.options.limit_margin, plan.rejected_collision,
+      plan.rejected_visibility);
   std::printf("  predicted tip RMS %.4f mm (random poses: %.4f mm)\n",
               plan.planned.tip_rms_mm, plan.random.tip_rms_mm);
   std::printf(
@@ -215,6 +239,23 @@ void AddPlanCommand(CLI::App& app, Runner* run) {
   sub->add_option("--extreme", args->options.extreme_fraction,
                   "probability that a candidate puts a joint at a limit")
       ->check(CLI::Range(0.0, 1.0));
+  sub->add_option("--limit-margin", args->options.limit_margin,
+                  "keep every pose this fraction of each joint's range away "
+                  "from both limits (extreme candidates go to the limit minus "
+                  "the margin)")
+      ->check(CLI::Range(0.0, 0.45));
+  sub->add_option("--obstacles", args->obstacles,
+                  "OBST.yaml: planes and boxes in the base frame "
+                  "(kincal_obstacles: 1; docs/LAB.md); poses where a link "
+                  "capsule meets one are rejected")
+      ->check(CLI::ExistingFile);
+  sub->add_option("--link-radius", args->options.safety.link_radius_mm,
+                  "radius of the capsules around the links (segments between "
+                  "the joint frames' origins, and the tool to the tip), mm")
+      ->check(CLI::Range(0.0, 1000.0));
+  sub->add_flag("--no-self-collision", args->no_self_collision,
+                "do not reject poses where two non-adjacent link capsules "
+                "meet");
   sub->add_option("--confirm", args->confirm,
                   "also simulate this many sessions at the planned and at the "
                   "random poses, calibrate them and report the actual errors")

@@ -23,12 +23,31 @@ namespace {
 
 using Poses = std::vector<std::vector<double>>;
 
+std::vector<double> InternalJoints(const Chain& chain,
+                                   const std::vector<double>& q);
+
 Eigen::Matrix4d BaseFromTip(const Chain& chain, const std::vector<double>& q) {
+  return BaseFromTipAt(chain, InternalJoints(chain, q));
+}
+
+std::vector<double> InternalJoints(const Chain& chain,
+                                   const std::vector<double>& q) {
   std::vector<double> qi(q.size());
   for (size_t j = 0; j < q.size(); ++j) {
     qi[j] = chain.ReadingToInternal(static_cast<int>(j), q[j]);
   }
-  return BaseFromTipAt(chain, qi);
+  return qi;
+}
+
+// The robot with every joint's limits moved inwards by `margin` of its range.
+Robot WithLimitMargin(const Robot& robot, double margin) {
+  Robot inner = robot;
+  for (RobotRow& row : inner.joints) {
+    const double keep = margin * (row.upper - row.lower);
+    row.lower += keep;
+    row.upper -= keep;
+  }
+  return inner;
 }
 
 PoseInput MakeInput(const Chain& chain, const std::vector<double>& q) {
@@ -81,14 +100,15 @@ bool WithinLimits(const Robot& robot, const std::vector<double>& q) {
 }
 
 // Position-only inverse kinematics in reading units: damped Gauss-Newton
-// with a numeric Jacobian from `q`. True when within 1e-6 mm and limits.
-bool SolveTipAt(const Robot& robot, const Chain& chain,
-                const Eigen::Vector3d& target, std::vector<double>* q) {
+// with a numeric Jacobian from `q`. True when within 1e-6 mm (limits are
+// the caller's check).
+bool SolveTipAt(const Chain& chain, const Eigen::Vector3d& target,
+                std::vector<double>* q) {
   const int n = static_cast<int>(q->size());
   for (int it = 0; it < 60; ++it) {
     const Eigen::Vector3d p = BaseFromTip(chain, *q).block<3, 1>(0, 3);
     const Eigen::Vector3d e = target - p;
-    if (e.norm() < 1e-6) return WithinLimits(robot, *q);
+    if (e.norm() < 1e-6) return true;
     Eigen::MatrixXd jac(3, n);
     for (int j = 0; j < n; ++j) {
       std::vector<double> qq = *q;
@@ -505,23 +525,33 @@ void CheckPlanInputs(const Robot& robot, const PlanOptions& options) {
   if (options.candidates < options.n) {
     throw InputError("--candidates must be at least --n");
   }
+  if (!(options.limit_margin >= 0 && options.limit_margin <= 0.45)) {
+    throw InputError(
+        "--limit-margin: expected a fraction of the range in "
+        "[0, 0.45]");
+  }
+  if (!(options.safety.link_radius_mm >= 0 &&
+        options.safety.link_radius_mm <= 1000)) {
+    throw InputError("--link-radius: expected 0 to 1000 mm");
+  }
 }
 
 // The fixed point: the tip of a feasible pose whose tip is nearest the
 // median of 200 feasible tips. Adds the draws it made to `*draws`.
-template <typename Visible>
+template <typename Feasible>
 Eigen::Vector3d ChooseFixedPoint(const Chain& chain, const PlanOptions& options,
-                                 Sampler* sampler, const Visible& visible,
+                                 Sampler* sampler, const Feasible& feasible,
                                  long* draws) {
   Poses first;
   while (static_cast<int>(first.size()) < 200 && *draws < options.max_draws) {
     ++*draws;
     std::vector<double> q = sampler->Draw();
-    if (visible(q)) first.push_back(q);
+    if (feasible(q)) first.push_back(q);
   }
   if (first.size() < 20) {
     throw InputError("no feasible poses found in " + std::to_string(*draws) +
-                     " random draws: are the tags visible from the rig?");
+                     " random draws: are the tags visible from the rig, is "
+                     "there room between the obstacles?");
   }
   std::vector<double> xs[3];
   std::vector<Eigen::Vector3d> tips;
@@ -558,6 +588,26 @@ double RobotSigmaGeometricMean(const Robot& robot,
   return std::exp(sum / std::max(1, count));
 }
 
+// Draws after which a plan with no feasible pose at all stops looking.
+constexpr long kHopelessDraws = 20000;
+
+// "rejected 12 at the limits' margin, 30 for collisions (plane 'table' 25,
+// self-collision 5), 0 with no tags visible".
+std::string DescribeRejections(const PlanResult& plan) {
+  std::string out = "rejected " + std::to_string(plan.rejected_limits) +
+                    " outside the limits minus the margin, " +
+                    std::to_string(plan.rejected_collision) + " for collisions";
+  if (!plan.collisions.empty()) {
+    std::string what;
+    for (const auto& [name, count] : plan.collisions) {
+      what += (what.empty() ? "" : ", ") + name + " " + std::to_string(count);
+    }
+    out += " (" + what + ")";
+  }
+  return out + ", " + std::to_string(plan.rejected_visibility) +
+         " with too few tags visible";
+}
+
 }  // namespace
 
 PlanResult PlanPoses(const Robot& robot, const PlanOptions& options) {
@@ -583,13 +633,35 @@ PlanResult PlanPoses(const Robot& robot, const PlanOptions& options) {
            options.min_tags;
   };
 
-  Sampler sampler(robot, options.seed);
+  // Inside the limits minus the margin, clear of obstacles and of itself,
+  // tags visible; each rejection counted by its constraint.
+  const Robot inner = WithLimitMargin(robot, options.limit_margin);
+  auto feasible = [&](const std::vector<double>& q) {
+    if (!WithinLimits(inner, q)) {
+      ++plan.rejected_limits;
+      return false;
+    }
+    const Contact contact =
+        FindContact(chain, InternalJoints(chain, q), options.safety);
+    if (contact.kind != Contact::kNone) {
+      ++plan.rejected_collision;
+      ++plan.collisions[contact.Describe(options.safety)];
+      return false;
+    }
+    if (!visible(q)) {
+      ++plan.rejected_visibility;
+      return false;
+    }
+    return true;
+  };
+
+  Sampler sampler(inner, options.seed);
   if (options.fixed_point) {
     plan.fixed_point_in_base =
-        ChooseFixedPoint(chain, options, &sampler, visible, &plan.draws);
+        ChooseFixedPoint(chain, options, &sampler, feasible, &plan.draws);
   }
   // Feasible poses from `s`: random draws (fixed point: random starts of the
-  // inverse kinematics) that are within limits and visible.
+  // inverse kinematics).
   auto collect = [&](Sampler* s, int count) {
     Poses out;
     long tries = 0;
@@ -600,19 +672,21 @@ PlanResult PlanPoses(const Robot& robot, const PlanOptions& options) {
       ++tries;
       std::vector<double> q = s->Draw();
       if (options.fixed_point &&
-          !SolveTipAt(robot, chain, plan.fixed_point_in_base, &q)) {
+          !SolveTipAt(chain, plan.fixed_point_in_base, &q)) {
         continue;
       }
-      if (visible(q)) out.push_back(q);
+      if (feasible(q)) out.push_back(q);
+      if (out.empty() && tries >= kHopelessDraws) break;
     }
     plan.draws += tries;
     if (static_cast<int>(out.size()) < count) {
-      throw InputError(
-          "found only " + std::to_string(out.size()) +
-          " feasible poses (need " + std::to_string(count) + ") in " +
-          std::to_string(tries) +
-          " random draws: widen the joint limits, check that the tags can "
-          "face the cameras, or lower --candidates");
+      throw InputError("found only " + std::to_string(out.size()) +
+                       " feasible poses (need " + std::to_string(count) +
+                       ") in " + std::to_string(tries) + " random draws; " +
+                       DescribeRejections(plan) +
+                       ": widen the joint limits or --limit-margin, move the "
+                       "obstacles, check that the tags can face the cameras, "
+                       "or lower --candidates");
     }
     return out;
   };
@@ -626,7 +700,7 @@ PlanResult PlanPoses(const Robot& robot, const PlanOptions& options) {
                                uniform.begin() + options.evaluation_poses);
   plan.random_poses.assign(uniform.begin() + options.evaluation_poses,
                            uniform.end());
-  Sampler extreme(robot, options.seed + 1,
+  Sampler extreme(inner, options.seed + 1,
                   options.fixed_point ? 0.0 : options.extreme_fraction);
   stage("drawing " + std::to_string(options.candidates) +
         " feasible candidates");

@@ -11,12 +11,14 @@
 // values, Borm and Menq's O1 to the power of the parameter count): it is
 // invariant to the units of the parameters and it is the volume of the
 // confidence ellipsoid. Candidates are random feasible poses (within joint
-// limits and, with a rig, every candidate has at least `min_tags` tags of
-// the target fully visible, not too oblique and not too small in both
-// cameras); the design is built greedily and then improved by Fedorov
-// exchange (swap a design pose for a candidate while log det grows).
-// The chosen poses are ordered as a short path (nearest-neighbour tour plus
-// 2-opt on the joint motion, each joint normalised by its range).
+// limits less `limit_margin` of each range, the links' capsules clear of
+// the obstacles and of each other (plan/safety.h) and, with a rig, every
+// candidate has at least `min_tags` tags of the target fully visible, not
+// too oblique and not too small in both cameras); the design is built greedily
+// and then improved by Fedorov exchange (swap a design pose for a candidate
+// while log det grows). The chosen poses are ordered as a short path
+// (nearest-neighbour tour plus 2-opt on the joint motion, each joint normalised
+// by its range).
 //
 // Predictions assume independent Gaussian noise of `noise_mm` on each
 // coordinate of each measured tip: Cov = noise^2 (J^T J)^-1. The predicted
@@ -31,6 +33,7 @@
 #include <Eigen/Core>
 #include <cstdint>
 #include <functional>
+#include <map>
 #include <optional>
 #include <string>
 #include <vector>
@@ -38,6 +41,7 @@
 #include "calib/model_state.h"
 #include "camcal/rig.h"
 #include "data/robot.h"
+#include "plan/safety.h"
 #include "vision/target.h"
 
 namespace kincal {
@@ -59,6 +63,11 @@ struct PlanOptions {
   // Candidate poses put each joint at one of its limits with this
   // probability (extreme poses carry the most information).
   double extreme_fraction = 0.3;
+  // Every pose keeps this fraction of each joint's range from both limits
+  // (extreme candidates go to the limit minus the margin); [0, 0.45].
+  double limit_margin = 0.05;
+  // Obstacles, link capsules and self-collision (plan/safety.h).
+  SafetyOptions safety;
 
   // Visibility (both set, or neither).
   const Rig* rig = nullptr;
@@ -100,13 +109,20 @@ struct PlanResult {
   Eigen::Vector3d fixed_point_in_base = Eigen::Vector3d::Zero();
   int feasible_candidates = 0;
   long draws = 0;  // random poses drawn to find them
+  // Draws rejected, by constraint: outside the limits minus the margin
+  // (fixed point: inverse kinematics solutions; free draws are drawn
+  // inside), meeting an obstacle or another link, no tags visible.
+  long rejected_limits = 0, rejected_collision = 0, rejected_visibility = 0;
+  // Collisions by what was met ("plane 'table'", "self-collision", ...).
+  std::map<std::string, long> collisions;
   int swaps = 0;
   std::vector<std::vector<double>> evaluation_poses;  // reading units
   double seconds = 0;
 };
 
 // Throws InputError when a joint has no limits, n is too small for the
-// identifiable parameters, or too few feasible poses are found.
+// identifiable parameters, or too few feasible poses are found (the message
+// says how many draws each constraint rejected).
 PlanResult PlanPoses(const Robot& robot, const PlanOptions& options);
 
 // Number of target tags fully visible in every camera of the rig for a tool

@@ -1,6 +1,7 @@
 // End to end: `kincal plan` writes POSES.csv (pose + one column per joint,
 // in the robot's units, within limits) and the spec's JSON fields; a robot
-// without joint limits is bad input (exit 2, nothing written).
+// without joint limits is bad input (exit 2, nothing written); with a table
+// plane no planned pose puts a link below it.
 
 #include <gtest/gtest.h>
 
@@ -8,9 +9,11 @@
 #include <sstream>
 #include <string>
 
+#include "calib/chain.h"
 #include "data/atomic_file.h"
 #include "data/csv.h"
 #include "data/robot.h"
+#include "data/urdf.h"
 #include "tests/testing/paths.h"
 #include "tests/testing/run.h"
 
@@ -92,6 +95,118 @@ TEST(PlanCli, RobotWithoutLimitsIsBadInputAndWritesNothing) {
                 "/poses.csv --json");
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_NE(r.err.find("limits"), std::string::npos) << r.err;
+  EXPECT_FALSE(testing::Exists(dir + "/poses.csv"));
+}
+
+// The joint values (reading units) of every row of a POSES.csv.
+std::vector<std::vector<double>> ReadPoses(const std::string& path) {
+  std::istringstream in(ReadFile(path));
+  std::string line;
+  std::getline(in, line);  // provenance
+  std::getline(in, line);  // header
+  std::vector<std::vector<double>> poses;
+  while (std::getline(in, line)) {
+    std::stringstream cells(line);
+    std::string cell;
+    std::getline(cells, cell, ',');
+    std::vector<double> q;
+    while (std::getline(cells, cell, ',')) q.push_back(std::stod(cell));
+    poses.push_back(q);
+  }
+  return poses;
+}
+
+// The lowest height above z = 0 of the joint frames' origins past the second
+// joint and of the tip, by the chain's forward kinematics (the links'
+// capsules run between these points; the base and first link stand on the
+// table).
+double LowestLinkPoint(const Chain& chain, const std::vector<double>& q) {
+  std::vector<double> qi(q.size());
+  for (size_t j = 0; j < q.size(); ++j) {
+    qi[j] = chain.ReadingToInternal(static_cast<int>(j), q[j]);
+  }
+  std::vector<Eigen::Vector3d> origins, axes;
+  JointAxesInBase(chain, qi, &origins, &axes);
+  double lowest = BaseFromTipAt(chain, qi)(2, 3);
+  for (size_t j = 2; j < origins.size(); ++j) {
+    lowest = std::min(lowest, origins[j].z());
+  }
+  return lowest;
+}
+
+// `plan` with a table at z = 0 (clearance 20 mm, links 40 mm thick): every
+// planned pose keeps the links 60 mm above it, while random poses without
+// the table go below it (so the check can fail).
+void ExpectPlanClearsTheTable(const std::string& robot_args, const Robot& robot,
+                              const std::string& name) {
+  const std::string dir = testing::MakeTempDir("plan_table_" + name);
+  WriteFileAtomic(dir + "/table.yaml",
+                  "kincal_obstacles: 1\nplanes:\n"
+                  "  - {name: table, point: [0, 0, 0], normal: [0, 0, 1], "
+                  "clearance_mm: 20}\n");
+  const std::string common =
+      "plan " + robot_args + " --n 20 --candidates 400 --seed 2 --json";
+  RunResult r =
+      RunKincal(common + " --obstacles " + dir + "/table.yaml --out " + dir +
+                "/poses.csv "
+                "--random-out " +
+                dir + "/random.csv");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_GT(j["rejected_collision"].get<long>(), 0);
+  EXPECT_GT(j["collisions"]["plane 'table'"].get<long>(), 0);
+  EXPECT_EQ(j["rejected_limits"].get<long>(), 0);  // free draws: inside
+  const Chain chain = Chain::FromRobot(robot);
+  for (const std::string file : {"/poses.csv", "/random.csv"}) {
+    const auto poses = ReadPoses(dir + file);
+    ASSERT_EQ(poses.size(), 20u);
+    for (const auto& q : poses) {
+      ASSERT_EQ(q.size(), robot.joints.size());
+      EXPECT_GE(LowestLinkPoint(chain, q), 60.0 - 1e-6) << name << file;
+      for (size_t k = 0; k < q.size(); ++k) {  // 5 % limit margin
+        const double range = robot.joints[k].upper - robot.joints[k].lower;
+        EXPECT_GE(q[k], robot.joints[k].lower + 0.05 * range - 1e-5);
+        EXPECT_LE(q[k], robot.joints[k].upper - 0.05 * range + 1e-5);
+      }
+    }
+  }
+  r = RunKincal(common + " --out " + dir + "/free.csv --random-out " + dir +
+                "/free_random.csv");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  int below = 0;
+  for (const std::string file : {"/free.csv", "/free_random.csv"}) {
+    for (const auto& q : ReadPoses(dir + file)) {
+      below += LowestLinkPoint(chain, q) < 60.0;
+    }
+  }
+  EXPECT_GT(below, 0) << name << ": without the table no pose met it";
+}
+
+TEST(PlanCli, Ur10TablePlaneIsNeverMet) {
+  const std::string path = testing::SourceDir() + "/data/robots/ur10.yaml";
+  ExpectPlanClearsTheTable("--robot " + path, ReadRobot(path), "ur10");
+}
+
+TEST(PlanCli, PandaTablePlaneIsNeverMet) {
+  const std::string path =
+      testing::SourceDir() + "/../shared/data/mukca/urdf/panda.urdf";
+  if (!testing::Exists(path)) GTEST_SKIP() << "no " << path;
+  ExpectPlanClearsTheTable("--robot " + path + " --tip panda_hand",
+                           ReadRobot(path, "", "panda_hand"), "panda");
+}
+
+TEST(PlanCli, NoRoomIsBadInputNamingTheConstraint) {
+  const std::string dir = testing::MakeTempDir("plan_no_room");
+  WriteFileAtomic(dir + "/ceiling.yaml",
+                  "kincal_obstacles: 1\nplanes:\n"
+                  "  - {name: ceiling, point: [0, 0, 100], normal: [0, 0, -1]}"
+                  "\n");
+  const RunResult r =
+      RunKincal("plan --robot " + testing::SourceDir() +
+                "/data/robots/ur10.yaml --n 10 --candidates 50 --obstacles " +
+                dir + "/ceiling.yaml --out " + dir + "/poses.csv --json");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("plane 'ceiling'"), std::string::npos) << r.err;
   EXPECT_FALSE(testing::Exists(dir + "/poses.csv"));
 }
 

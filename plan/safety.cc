@@ -1,0 +1,165 @@
+#include "plan/safety.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace kincal {
+namespace {
+
+constexpr double kShortSegmentMm = 1.0;
+
+// Distance from a point (box frame) to the axis-aligned box of half edges h.
+double PointBoxDistance(const Eigen::Vector3d& p, const Eigen::Vector3d& h) {
+  const Eigen::Vector3d outside = (p.cwiseAbs() - h).cwiseMax(0.0);
+  return outside.norm();
+}
+
+}  // namespace
+
+double SegmentPlaneDistance(const Segment& s, const ObstaclePlane& plane) {
+  return std::min(plane.normal.dot(s.a - plane.point),
+                  plane.normal.dot(s.b - plane.point));
+}
+
+// The distance from the point s(t) to the convex box is a convex function
+// of t, so a golden-section search on [0, 1] finds its minimum.
+double SegmentBoxDistance(const Segment& s, const ObstacleBox& box) {
+  const Eigen::Matrix3d box_from_base = box.base_from_box.transpose();
+  const Eigen::Vector3d a = box_from_base * (s.a - box.center);
+  const Eigen::Vector3d b = box_from_base * (s.b - box.center);
+  const Eigen::Vector3d h = 0.5 * box.size;
+  auto f = [&](double t) { return PointBoxDistance(a + t * (b - a), h); };
+  const double g = 0.5 * (std::sqrt(5.0) - 1);
+  double lo = 0, hi = 1;
+  double x1 = hi - g * (hi - lo), x2 = lo + g * (hi - lo);
+  double f1 = f(x1), f2 = f(x2);
+  for (int it = 0; it < 80 && hi - lo > 1e-12; ++it) {
+    if (f1 <= f2) {
+      hi = x2;
+      x2 = x1;
+      f2 = f1;
+      x1 = hi - g * (hi - lo);
+      f1 = f(x1);
+    } else {
+      lo = x1;
+      x1 = x2;
+      f1 = f2;
+      x2 = lo + g * (hi - lo);
+      f2 = f(x2);
+    }
+  }
+  return std::min({f(0.0), f(1.0), f1, f2});
+}
+
+// Closest points of two segments (Ericson, Real-Time Collision Detection,
+// 5.1.9): minimise |p(s) - q(t)| over s, t in [0, 1].
+double SegmentSegmentDistance(const Segment& s1, const Segment& s2) {
+  const Eigen::Vector3d d1 = s1.b - s1.a, d2 = s2.b - s2.a, r = s1.a - s2.a;
+  const double a = d1.squaredNorm(), e = d2.squaredNorm(), f = d2.dot(r);
+  const double eps = 1e-12;
+  double s = 0, t = 0;
+  if (a <= eps && e <= eps) return r.norm();
+  if (a <= eps) {
+    t = std::clamp(f / e, 0.0, 1.0);
+  } else {
+    const double c = d1.dot(r);
+    if (e <= eps) {
+      s = std::clamp(-c / a, 0.0, 1.0);
+    } else {
+      const double b = d1.dot(d2), denom = a * e - b * b;
+      s = denom > eps * a * e ? std::clamp((b * f - c * e) / denom, 0.0, 1.0)
+                              : 0.0;
+      t = (b * s + f) / e;
+      if (t < 0) {
+        t = 0;
+        s = std::clamp(-c / a, 0.0, 1.0);
+      } else if (t > 1) {
+        t = 1;
+        s = std::clamp((b - c) / a, 0.0, 1.0);
+      }
+    }
+  }
+  return ((s1.a + s * d1) - (s2.a + t * d2)).norm();
+}
+
+LinkCapsules LinkSegments(const Chain& chain, const std::vector<double>& q) {
+  std::vector<Eigen::Vector3d> origins, axes;
+  JointAxesInBase(chain, q, &origins, &axes);
+  std::vector<Eigen::Vector3d> points{Eigen::Vector3d::Zero()};
+  points.insert(points.end(), origins.begin(), origins.end());
+  points.push_back(BaseFromTipAt(chain, q).block<3, 1>(0, 3));
+  // points[k] for k <= 2 (base, joint 1's and joint 2's frame origins) turn
+  // about the first axis only.
+  LinkCapsules out;
+  Eigen::Vector3d from = points[0];
+  for (size_t k = 1; k < points.size(); ++k) {
+    if ((points[k] - from).norm() < kShortSegmentMm) continue;
+    out.segments.push_back({from, points[k]});
+    if (k <= 2) out.base_count = static_cast<int>(out.segments.size());
+    from = points[k];
+  }
+  return out;
+}
+
+Contact FindContact(const Chain& chain, const std::vector<double>& q,
+                    const SafetyOptions& options) {
+  const LinkCapsules links = LinkSegments(chain, q);
+  const double radius = options.link_radius_mm;
+  const int n = static_cast<int>(links.segments.size());
+  Contact contact;
+  const std::vector<ObstaclePlane>& planes = options.obstacles.planes;
+  for (size_t p = 0; p < planes.size(); ++p) {
+    const double needed = radius + planes[p].clearance_mm;
+    const bool stands_on =
+        planes[p].normal.dot(-planes[p].point) < needed;  // base origin
+    for (int k = stands_on ? links.base_count : 0; k < n; ++k) {
+      if (SegmentPlaneDistance(links.segments[k], planes[p]) < needed) {
+        contact.kind = Contact::kPlane;
+        contact.obstacle = static_cast<int>(p);
+        contact.link = k;
+        return contact;
+      }
+    }
+  }
+  const std::vector<ObstacleBox>& boxes = options.obstacles.boxes;
+  for (size_t b = 0; b < boxes.size(); ++b) {
+    for (int k = 0; k < n; ++k) {
+      if (SegmentBoxDistance(links.segments[k], boxes[b]) <
+          radius + boxes[b].clearance_mm) {
+        contact.kind = Contact::kBox;
+        contact.obstacle = static_cast<int>(b);
+        contact.link = k;
+        return contact;
+      }
+    }
+  }
+  if (!options.self_collision) return contact;
+  for (int i = 0; i < n; ++i) {
+    for (int k = i + 2; k < n; ++k) {
+      if (SegmentSegmentDistance(links.segments[i], links.segments[k]) <
+          2 * radius) {
+        contact.kind = Contact::kSelf;
+        contact.link = i;
+        contact.other_link = k;
+        return contact;
+      }
+    }
+  }
+  return contact;
+}
+
+std::string Contact::Describe(const SafetyOptions& options) const {
+  switch (kind) {
+    case kNone:
+      return "no contact";
+    case kPlane:
+      return "plane '" + options.obstacles.planes[obstacle].name + "'";
+    case kBox:
+      return "box '" + options.obstacles.boxes[obstacle].name + "'";
+    case kSelf:
+      return "self-collision";
+  }
+  return "";
+}
+
+}  // namespace kincal
