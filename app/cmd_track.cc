@@ -21,6 +21,7 @@
 #include "data/session.h"
 #include "data/urdf.h"
 #include "data/yaml_util.h"
+#include "vision/camera_order.h"
 #include "vision/stereo_images.h"
 #include "vision/target.h"
 #include "vision/tool_pose.h"
@@ -310,6 +311,37 @@ void PrintTrack(const TrackArgs& args, size_t n, const Tracked& t, bool merged,
   std::printf("  wrote %s and %s\n", args.out.c_str(), poses_path.c_str());
 }
 
+// When fewer than half the frames give a tip that passes the gate, a
+// sample of pairs is tried with the two images exchanged
+// (vision/camera_order.h); if that explains the data, the images were given
+// in the wrong order: bad input, nothing written.
+void RefuseSwappedCameras(const TrackArgs& args, const Rig& rig,
+                          const Target& target, const FramePairs& pairs,
+                          const Tracked& tracked) {
+  const int good = tracked.found - static_cast<int>(tracked.failed_gate.size());
+  if (pairs.left.empty() || 2 * good >= static_cast<int>(pairs.left.size())) {
+    return;
+  }
+  AprilTagOptions detector;
+  detector.family = target.family;
+  detector.quad_decimate = args.decimate;
+  const CameraOrderCheck check = CheckCameraOrder(
+      rig, target, pairs.left, pairs.right,
+      [&](const ToolPoseResult& r) { return PassesGate(args, r); }, detector);
+  if (!check.LooksSwapped()) return;
+  throw InputError(
+      "the --left and --right images look swapped: of " +
+      std::to_string(check.sampled) + " sampled frame pairs, " +
+      std::to_string(check.pass_as_given) +
+      " give a tool pose passing the quality gate as given and " +
+      std::to_string(check.pass_swapped) +
+      " with the two images exchanged. --left takes the images of the rig's "
+      "first camera (" +
+      args.rig +
+      "): exchange --left and --right, or "
+      "check which camera recorded which folder");
+}
+
 int RunTrack(const TrackArgs& args) {
   const auto start = std::chrono::steady_clock::now();
   const Rig rig = ReadRigYaml(args.rig);
@@ -321,6 +353,7 @@ int RunTrack(const TrackArgs& args) {
   const FramePairs pairs = ListFramePairs(args);
   Merge merge = PrepareMerge(args, pairs);
   const Tracked tracked = TrackFrames(args, rig, target, pairs, &merge);
+  RefuseSwappedCameras(args, rig, target, pairs, tracked);
   WriteFileAtomic(args.out, tracked.points);
   const std::string poses_path = PosesPath(args.out);
   WriteFileAtomic(poses_path, tracked.poses);

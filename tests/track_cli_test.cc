@@ -11,9 +11,9 @@
 #include <vector>
 
 #include "data/atomic_file.h"
+#include "synth/render.h"
 #include "tests/testing/paths.h"
 #include "tests/testing/run.h"
-#include "synth/render.h"
 
 namespace kincal {
 namespace {
@@ -103,6 +103,21 @@ TEST_F(TrackCli, TipsMatchRenderedTruth) {
   // The provenance comment and the poses file.
   EXPECT_EQ(ReadFile(out).rfind("# written by kincal", 0), 0u);
   EXPECT_TRUE(testing::Exists(dir_ + "/points.poses.csv"));
+}
+
+// The two image folders given the wrong way round: exit 2 naming the
+// swap, nothing written (the tips would not be there).
+TEST_F(TrackCli, SwappedCamerasAreNamedAndNothingWritten) {
+  const std::string s = dir_ + "/session";
+  const std::string out = dir_ + "/swapped.csv";
+  const RunResult r = RunKincal(
+      "track --rig " + s + "/rig.yaml --target " + s + "/target.yaml --left '" +
+      s + "/right_*.png' --right '" + s + "/left_*.png' --out " + out);
+  EXPECT_EQ(r.exit_code, 2) << r.out;
+  EXPECT_NE(r.err.find("look swapped"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("exchange --left and --right"), std::string::npos);
+  EXPECT_FALSE(testing::Exists(out));
+  EXPECT_FALSE(testing::Exists(dir_ + "/swapped.poses.csv"));
 }
 
 TEST_F(TrackCli, FullFrameModeGivesTheSameTips) {
