@@ -16,8 +16,9 @@ namespace {
 
 const char* kUsage =
     "expected chessboard:COLSxROWS:SQUARE or "
-    "aprilgrid:COLSxROWS:TAG_SIZE:SPACING_RATIO (e.g. chessboard:9x6:25 or "
-    "aprilgrid:6x6:30:0.3)";
+    "aprilgrid:COLSxROWS:TAG_SIZE:SPACING_RATIO[:first=N][:order=rows|columns]"
+    "[:origin=bottom-left|top-left][:rotation=0|90|180|270] (e.g. "
+    "chessboard:9x6:25 or aprilgrid:6x6:30:0.3)";
 
 std::vector<std::string> Split(const std::string& s, char sep) {
   std::vector<std::string> parts;
@@ -50,7 +51,52 @@ double ParsePositive(const std::string& s, const std::string& text,
   return v;
 }
 
+// One KEY=VALUE layout option of an AprilGrid spec.
+void ParseLayoutOption(const std::string& option, const std::string& text,
+                       CalibTargetSpec* spec) {
+  const size_t eq = option.find('=');
+  const std::string key = option.substr(0, eq);
+  const std::string value =
+      eq == std::string::npos ? "" : option.substr(eq + 1);
+  const auto bad = [&](const std::string& expected) {
+    return InputError("--target '" + text + "': layout option '" + option +
+                      "': expected " + expected);
+  };
+  if (key == "first") {
+    char* end = nullptr;
+    const long v = std::strtol(value.c_str(), &end, 10);
+    if (value.empty() || *end != '\0' || v < 0) {
+      throw bad("first=N, the first tag id (N >= 0)");
+    }
+    spec->first_id = static_cast<int>(std::min(v, 100000L));
+  } else if (key == "order") {
+    if (value != "rows" && value != "columns") {
+      throw bad("order=rows or order=columns");
+    }
+    spec->column_major = value == "columns";
+  } else if (key == "origin") {
+    if (value != "bottom-left" && value != "top-left") {
+      throw bad("origin=bottom-left or origin=top-left");
+    }
+    spec->origin_top = value == "top-left";
+  } else if (key == "rotation") {
+    if (value != "0" && value != "90" && value != "180" && value != "270") {
+      throw bad("rotation=0, 90, 180 or 270 (degrees, counter-clockwise)");
+    }
+    spec->rotation_deg = std::stoi(value);
+  } else {
+    throw bad("first=, order=, origin= or rotation=");
+  }
+}
+
 }  // namespace
+
+Eigen::Vector2i CalibTargetSpec::TagCell(int index) const {
+  int col = column_major ? index / rows : index % cols;
+  int row = column_major ? index % rows : index / cols;
+  if (origin_top) row = rows - 1 - row;
+  return {col, row};
+}
 
 CalibTargetSpec ParseCalibTargetSpec(const std::string& text) {
   const std::vector<std::string> parts = Split(text, ':');
@@ -64,8 +110,11 @@ CalibTargetSpec ParseCalibTargetSpec(const std::string& text) {
     }
   } else if (parts[0] == "aprilgrid") {
     spec.kind = CalibTargetSpec::Kind::kAprilGrid;
-    if (parts.size() != 4) {
+    if (parts.size() < 4) {
       throw InputError("--target '" + text + "': " + kUsage);
+    }
+    for (size_t i = 4; i < parts.size(); ++i) {
+      ParseLayoutOption(parts[i], text, &spec);
     }
   } else {
     throw InputError("--target '" + text + "': unknown target type '" +
@@ -89,11 +138,12 @@ CalibTargetSpec ParseCalibTargetSpec(const std::string& text) {
     }
   } else {
     spec.spacing_ratio = ParsePositive(parts[3], text, "spacing ratio");
-    if (spec.cols * spec.rows > TagFamilySize("tag36h11")) {
-      throw InputError("--target '" + text +
-                       "': " + std::to_string(spec.cols * spec.rows) +
-                       " tags, but tag36h11 has only " +
-                       std::to_string(TagFamilySize("tag36h11")) + " ids");
+    if (spec.first_id + spec.cols * spec.rows > TagFamilySize("tag36h11")) {
+      throw InputError(
+          "--target '" + text + "': ids " + std::to_string(spec.first_id) +
+          ".." + std::to_string(spec.first_id + spec.cols * spec.rows - 1) +
+          ", but tag36h11 has only " +
+          std::to_string(TagFamilySize("tag36h11")) + " ids");
     }
   }
   return spec;
@@ -110,13 +160,17 @@ std::vector<Eigen::Vector3d> CalibTargetSpec::Points() const {
   const double pitch = size * (1.0 + spacing_ratio);
   // libapriltag corner order: bottom-left, bottom-right, top-right, top-left
   // (y up in the target frame).
+  // A tag turned by 90 deg counter-clockwise has its corner k where the
+  // upright tag has corner k + 1.
   const double dx[4] = {0, 1, 1, 0};
   const double dy[4] = {0, 0, 1, 1};
-  for (int id = 0; id < rows * cols; ++id) {
-    const int r = id / cols;
-    const int c = id % cols;
+  const int turn = rotation_deg / 90;
+  for (int index = 0; index < rows * cols; ++index) {
+    const Eigen::Vector2i cell = TagCell(index);
     for (int k = 0; k < 4; ++k) {
-      pts.emplace_back(c * pitch + dx[k] * size, r * pitch + dy[k] * size, 0);
+      const int at = (k + turn) % 4;
+      pts.emplace_back(cell.x() * pitch + dx[at] * size,
+                       cell.y() * pitch + dy[at] * size, 0);
     }
   }
   return pts;
@@ -161,14 +215,17 @@ TargetObservation CalibTargetDetector::Detect(const cv::Mat& gray) {
   const int num_tags = spec_.cols * spec_.rows;
   const std::vector<TagDetection> dets = impl_->apriltag->Detect(gray);
   std::vector<int> count(num_tags, 0);
+  const auto index_of = [&](int id) { return id - spec_.first_id; };
   for (const TagDetection& det : dets) {
-    if (det.id >= 0 && det.id < num_tags) ++count[det.id];
+    const int i = index_of(det.id);
+    if (i >= 0 && i < num_tags) ++count[i];
   }
   for (const TagDetection& det : dets) {
     // Ids outside the grid, and ids seen twice (a false decode), are dropped.
-    if (det.id < 0 || det.id >= num_tags || count[det.id] != 1) continue;
+    const int i = index_of(det.id);
+    if (i < 0 || i >= num_tags || count[i] != 1) continue;
     for (int k = 0; k < 4; ++k) {
-      obs.p_in_target.push_back(impl_->points[4 * det.id + k]);
+      obs.p_in_target.push_back(impl_->points[4 * i + k]);
       obs.pixels.push_back(det.corners[k]);
     }
   }

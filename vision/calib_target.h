@@ -22,6 +22,14 @@
 //     black square, x right along the rows, y up, z = 0. Tag id's corner k
 //     (libapriltag order: bottom-left, bottom-right, top-right, top-left) is
 //     point 4 * id + k. Detection: vision/apriltag_detector.h.
+//   aprilgrid:COLSxROWS:TAG_SIZE:SPACING_RATIO:KEY=VALUE...
+//     Another layout of the same grid, for boards not printed by Kalibr:
+//     first=N (the first id, default 0), order=rows|columns (default rows),
+//     origin=bottom-left|top-left (the tag with the first id, default
+//     bottom-left), rotation=0|90|180|270 (each tag turned counter-clockwise
+//     as printed, default 0). E.g. AprilTags.jl's 8 x 5 grid of ids 1..40:
+//     aprilgrid:8x5:31.5:0.3:first=1:order=columns:origin=top-left:rotation=180
+//     Point 4 * (id - first) + k; the target frame stays the grid's.
 //
 // Lengths are in target units: give them in mm and the rig is in mm.
 
@@ -44,7 +52,19 @@ struct CalibTargetSpec {
   int rows = 0;
   double size = 0;           // square edge or tag black-square edge
   double spacing_ratio = 0;  // AprilGrid only
-  std::string text;          // the spec as given
+  // AprilGrid layout, as printed (defaults: Kalibr's). Ids first_id ..
+  // first_id + cols * rows - 1 run row by row (or column by column) from
+  // the bottom-left (or top-left) tag; every tag turned by rotation_deg
+  // counter-clockwise (0, 90, 180, 270).
+  int first_id = 0;
+  bool column_major = false;
+  bool origin_top = false;
+  int rotation_deg = 0;
+  std::string text;  // the spec as given
+
+  // Grid cell (column from the left, row from the bottom) of the tag
+  // first_id + index.
+  Eigen::Vector2i TagCell(int index) const;
 
   // All target points in index order (target units, z = 0).
   std::vector<Eigen::Vector3d> Points() const;

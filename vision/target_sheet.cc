@@ -134,10 +134,16 @@ const char kPrintAdvice[] =
     "a ruler before use.";
 
 // Black cells of one tag, its black square's top-left corner at `corner`
-// (page mm), edge `size_mm`, upright; runs of black cells in a row merged.
+// (page mm), edge `size_mm`, turned by rotation_deg counter-clockwise; runs
+// of black cells in a row merged.
 void AddTag(const std::string& family, int id, double size_mm,
-            const Eigen::Vector2d& corner, std::vector<SheetRect>* black) {
-  const cv::Mat image = TagImage(family, id);
+            const Eigen::Vector2d& corner, std::vector<SheetRect>* black,
+            int rotation_deg = 0) {
+  cv::Mat image = TagImage(family, id);
+  if (rotation_deg == 90)
+    cv::rotate(image, image, cv::ROTATE_90_COUNTERCLOCKWISE);
+  if (rotation_deg == 180) cv::rotate(image, image, cv::ROTATE_180);
+  if (rotation_deg == 270) cv::rotate(image, image, cv::ROTATE_90_CLOCKWISE);
   const int square_cells = TagBlackSquareCells(family);
   const int start = (image.cols - square_cells) / 2;
   const double cell = size_mm / square_cells;
@@ -180,10 +186,15 @@ std::string DescribeCalibTarget(const CalibTargetSpec& spec) {
     os << spec.cols << " x " << spec.rows << " inner corners, " << spec.cols + 1
        << " x " << spec.rows + 1 << " squares of " << Mm(spec.size) << " mm";
   } else {
-    os << spec.cols << " x " << spec.rows << " tag36h11 tags, ids 0-"
-       << spec.cols * spec.rows - 1
-       << " row by row from the bottom-left; black square " << Mm(spec.size)
-       << " mm, gap " << Mm(spec.spacing_ratio * spec.size) << " mm";
+    os << spec.cols << " x " << spec.rows << " tag36h11 tags, ids "
+       << spec.first_id << "-" << spec.first_id + spec.cols * spec.rows - 1
+       << (spec.column_major ? " column by column" : " row by row")
+       << (spec.origin_top ? " from the top-left" : " from the bottom-left")
+       << (spec.rotation_deg
+               ? ", turned " + std::to_string(spec.rotation_deg) + " deg"
+               : std::string())
+       << "; black square " << Mm(spec.size) << " mm, gap "
+       << Mm(spec.spacing_ratio * spec.size) << " mm";
   }
   os << "; pattern " << Mm(board.x()) << " x " << Mm(board.y()) << " mm)";
   return os.str();
@@ -277,13 +288,16 @@ void AddAprilGrid(const CalibTargetSpec& spec, const Eigen::Vector2d& corner,
                   double board_height, TargetSheet* sheet) {
   sheet->target_origin_on_page = corner + Eigen::Vector2d(0, board_height);
   sheet->target_y_sign = -1;
-  const std::vector<Eigen::Vector3d> points = spec.Points();
-  for (int id = 0; id < spec.cols * spec.rows; ++id) {
-    const Eigen::Vector3d& top_left = points[4 * id + 3];
-    AddTag("tag36h11", id, spec.size,
+  const double pitch = spec.size * (1.0 + spec.spacing_ratio);
+  for (int index = 0; index < spec.cols * spec.rows; ++index) {
+    // The black square's top-left corner (target frame, y up).
+    const Eigen::Vector2i cell = spec.TagCell(index);
+    const Eigen::Vector2d top_left(cell.x() * pitch,
+                                   cell.y() * pitch + spec.size);
+    AddTag("tag36h11", spec.first_id + index, spec.size,
            sheet->target_origin_on_page +
                Eigen::Vector2d(top_left.x(), -top_left.y()),
-           &sheet->black);
+           &sheet->black, spec.rotation_deg);
   }
 }
 

@@ -134,21 +134,30 @@ TEST(TargetSheet, BoardTooLargeNamesTheLargestSizeAndALargerPaper) {
 
 // The AprilGrid as printed, seen head-on, gives every tag with the id and
 // corner positions camcal's detector pairs with CalibTargetSpec::Points().
+// Kalibr's layout and the other layouts camcal reads (first id, column
+// order, top-left origin, turned tags): every printed corner is detected
+// where the spec puts it.
 TEST(TargetSheet, AprilGridDetectedWhereTheSpecPutsItsCorners) {
-  const CalibTargetSpec spec = ParseCalibTargetSpec("aprilgrid:5x4:24:0.3");
-  const TargetSheet sheet = LayoutCalibTargetSheet(spec, {});
-  const double px_per_mm = 4;
-  CalibTargetDetector detector(spec);
-  const TargetObservation obs = detector.Detect(Rasterise(sheet, px_per_mm));
-  ASSERT_EQ(obs.pixels.size(), 4u * 20u);  // every tag, once
-  double worst = 0;
-  for (size_t i = 0; i < obs.pixels.size(); ++i) {
-    worst = std::max(
-        worst,
-        (obs.pixels[i] - ExpectedPixel(sheet, obs.p_in_target[i], px_per_mm))
-            .norm());
+  for (const char* text :
+       {"aprilgrid:5x4:24:0.3",
+        "aprilgrid:5x4:24:0.3:first=7:order=columns:origin=top-left",
+        "aprilgrid:5x4:24:0.5:rotation=90", "aprilgrid:5x4:24:0.3:rotation=180",
+        "aprilgrid:5x4:24:0.3:origin=top-left:rotation=270"}) {
+    const CalibTargetSpec spec = ParseCalibTargetSpec(text);
+    const TargetSheet sheet = LayoutCalibTargetSheet(spec, {});
+    const double px_per_mm = 4;
+    CalibTargetDetector detector(spec);
+    const TargetObservation obs = detector.Detect(Rasterise(sheet, px_per_mm));
+    ASSERT_EQ(obs.pixels.size(), 4u * 20u) << text;  // every tag, once
+    double worst = 0;
+    for (size_t i = 0; i < obs.pixels.size(); ++i) {
+      worst = std::max(
+          worst,
+          (obs.pixels[i] - ExpectedPixel(sheet, obs.p_in_target[i], px_per_mm))
+              .norm());
+    }
+    EXPECT_LT(worst, 0.5) << text << ": px at " << px_per_mm << " px/mm";
   }
-  EXPECT_LT(worst, 0.5) << "px at " << px_per_mm << " px/mm";
 }
 
 TEST(TargetSheet, ChessboardDetectedAtTheSpecSquareSize) {
