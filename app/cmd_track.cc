@@ -159,6 +159,8 @@ struct Tracked {
   int found = 0, merged_count = 0;
   std::vector<int> failed_gate;  // found, but not good
   std::vector<double> rms_values;
+  std::vector<double> depths_mm;  // distance of the tool from the rig, found
+  int frames_tags_in_both = 0;    // frames with a target tag in each camera
   int full_searches[2] = {0, 0};
 };
 
@@ -180,6 +182,16 @@ bool PassesGate(const TrackArgs& args, const ToolPoseResult& r) {
   }
   return r.found && r.tags_used >= args.min_tags &&
          r.rms_px <= args.max_reproj_px && cameras[0] && cameras[1];
+}
+
+bool SeesTargetTag(const Target& target,
+                   const std::vector<TagDetection>& dets) {
+  for (const TagDetection& d : dets) {
+    for (const TargetTag& t : target.tags) {
+      if (t.id == d.id) return true;
+    }
+  }
+  return false;
 }
 
 Tracked TrackFrames(const TrackArgs& args, const Rig& rig, const Target& target,
@@ -210,6 +222,9 @@ Tracked TrackFrames(const TrackArgs& args, const Rig& rig, const Target& target,
           ReadCameraImage(*files[c], rig.cameras[c].intrinsics));
     });
     const ToolPoseResult r = EstimateToolPose(rig, target, dets);
+    if (SeesTargetTag(target, dets[0]) && SeesTargetTag(target, dets[1])) {
+      ++out.frames_tags_in_both;
+    }
     points << f;
     poses << f << "," << (r.found ? 1 : 0);
     const bool good = PassesGate(args, r);
@@ -222,6 +237,7 @@ Tracked TrackFrames(const TrackArgs& args, const Rig& rig, const Target& target,
     if (r.found) {
       ++out.found;
       out.rms_values.push_back(r.rms_px);
+      out.depths_mm.push_back(r.rig_from_tool.t.norm());
       for (int i = 0; i < 3; ++i)
         points << "," << FormatDouble(r.tip_in_rig(i));
       if (!good) out.failed_gate.push_back(static_cast<int>(f));
@@ -342,6 +358,38 @@ void RefuseSwappedCameras(const TrackArgs& args, const Rig& rig,
       "check which camera recorded which folder");
 }
 
+// A tool found closer to the cameras than any lens focuses (the median over
+// the frames below 20 mm) means the rig and target.yaml disagree on units:
+// typically a rig from camcal with the board given in metres (a baseline in
+// metres read as mm). Bad input, nothing written.
+void RefuseImpossibleDepth(const TrackArgs& args, const Rig& rig,
+                           const Tracked& tracked) {
+  constexpr double kMinDepthMm = 20.0;
+  const std::string units =
+      " disagree on units. camcal's --target lengths and target.yaml's are "
+      "millimetres: a board given in metres gives a rig 1000 times too small "
+      "(recalibrate with the board in mm)";
+  const double baseline =
+      rig.cameras.size() > 1 ? rig.cameras[1].cam_from_rig.t.norm() : 0.0;
+  const std::string pair = args.rig + " (baseline " + FormatDouble(baseline) +
+                           " mm) and " + args.target;
+  // Tags in both cameras, yet no tool pose fits any frame.
+  if (tracked.found == 0 && tracked.frames_tags_in_both >= 3) {
+    throw InputError("tags of the target are seen by both cameras in " +
+                     std::to_string(tracked.frames_tags_in_both) +
+                     " frames, but no tool pose fits them in any: " + pair +
+                     " do not describe the same set-up; most likely they" +
+                     units);
+  }
+  if (tracked.depths_mm.empty()) return;
+  const double depth = MedianOf(tracked.depths_mm);
+  if (depth >= kMinDepthMm) return;
+  throw InputError("the tool would be " + FormatDouble(depth) +
+                   " mm from the cameras (median over " +
+                   std::to_string(tracked.depths_mm.size()) +
+                   " frames), closer than any lens focuses: " + pair + units);
+}
+
 int RunTrack(const TrackArgs& args) {
   const auto start = std::chrono::steady_clock::now();
   const Rig rig = ReadRigYaml(args.rig);
@@ -354,6 +402,7 @@ int RunTrack(const TrackArgs& args) {
   Merge merge = PrepareMerge(args, pairs);
   const Tracked tracked = TrackFrames(args, rig, target, pairs, &merge);
   RefuseSwappedCameras(args, rig, target, pairs, tracked);
+  RefuseImpossibleDepth(args, rig, tracked);
   WriteFileAtomic(args.out, tracked.points);
   const std::string poses_path = PosesPath(args.out);
   WriteFileAtomic(poses_path, tracked.poses);

@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "camcal/rig.h"
 #include "data/atomic_file.h"
 #include "synth/render.h"
 #include "tests/testing/paths.h"
@@ -118,6 +119,24 @@ TEST_F(TrackCli, SwappedCamerasAreNamedAndNothingWritten) {
   EXPECT_NE(r.err.find("exchange --left and --right"), std::string::npos);
   EXPECT_FALSE(testing::Exists(out));
   EXPECT_FALSE(testing::Exists(dir_ + "/swapped.poses.csv"));
+}
+
+// A rig calibrated with the board in metres (translations 1000 times too
+// small) and a target.yaml in mm: tags seen, no pose fits; refused naming
+// the units, nothing written.
+TEST_F(TrackCli, RigInMetresIsNamedAndNothingWritten) {
+  const std::string s = dir_ + "/session";
+  Rig rig = ReadRigYaml(s + "/rig.yaml");
+  for (Camera& c : rig.cameras) c.cam_from_rig.t /= 1000.0;
+  WriteRigYaml(dir_ + "/rig_in_metres.yaml", rig);
+  const std::string out = dir_ + "/metres.csv";
+  const RunResult r =
+      RunKincal("track --rig " + dir_ + "/rig_in_metres.yaml --target " + s +
+                "/target.yaml --left '" + s + "/left_*.png' --right '" + s +
+                "/right_*.png' --out " + out);
+  EXPECT_EQ(r.exit_code, 2) << r.out;
+  EXPECT_NE(r.err.find("disagree on units"), std::string::npos) << r.err;
+  EXPECT_FALSE(testing::Exists(out));
 }
 
 TEST_F(TrackCli, FullFrameModeGivesTheSameTips) {

@@ -126,9 +126,14 @@ Target ParseTargetYaml(const std::string& text, const std::string& file) {
     const YAML::Node size = r.Required(t, "size", what);
     tag.size_mm = r.Number(size, what + ".size");
     if (!(tag.size_mm >= kMinTagMm && tag.size_mm <= kMaxTagMm)) {
+      const bool metres = tag.size_mm > 0 && tag.size_mm < kMinTagMm;
       r.Fail(size,
              what + ".size: expected a positive edge length in mm between " +
-                 FormatDouble(kMinTagMm) + " and " + FormatDouble(kMaxTagMm));
+                 FormatDouble(kMinTagMm) + " and " + FormatDouble(kMaxTagMm) +
+                 (metres ? ", got " + FormatDouble(tag.size_mm) +
+                               ": a size in metres? target.yaml lengths are "
+                               "millimetres (multiply by 1000)"
+                         : std::string()));
     }
     tag.tool_from_tag = ReadPose(r, r.Required(t, "tool_from_tag", what),
                                  what + ".tool_from_tag");

@@ -36,6 +36,9 @@ TEST(TargetRanges, RejectsOutOfRangeWithPosition) {
       {Target("1e308", "[0, 0, 0]", "[0, 0, 150]"), "t.yaml:4:", "size"},
       {Target("1e-300", "[0, 0, 0]", "[0, 0, 150]"), "t.yaml:4:", "size"},
       {Target("0.1", "[0, 0, 0]", "[0, 0, 150]"), "t.yaml:4:", "size"},
+      // A tag of 0.03: metres, named with the fix.
+      {Target("0.03", "[0, 0, 0]", "[0, 0, 0.15]"), "t.yaml:4:",
+       "metres? target.yaml lengths are millimetres (multiply by 1000)"},
       {Target("30", "[1e308, 0, 0]", "[0, 0, 150]"), "t.yaml:4:", ".t"},
       {Target("30", "[0, 0, 0]", "[0, 0, 1e308]"), "t.yaml:5:", "tip_in_tool"},
       {Target("30", "[0, 0, 0]", "[0, -2e4, 0]"), "t.yaml:5:", "tip_in_tool"},
