@@ -38,8 +38,8 @@ int main(int argc, char** argv) {
       "Units at every interface: mm, degrees, seconds."};
   app.require_subcommand(1);
   app.option_defaults()->always_capture_default();  // --help shows defaults
-  app.set_version_flag("--version", kincal::ToolVersion() +
-                                        " (commit " KINCAL_COMMIT ")");
+  app.set_version_flag("--version",
+                       kincal::ToolVersion() + " (commit " KINCAL_COMMIT ")");
   kincal::app::Runner run;
   kincal::app::AddSimulateCommand(app, &run);
   kincal::app::AddCalibrateCommand(app, &run);

@@ -116,9 +116,9 @@ TEST(JointLogTest, AChanceLevelOffsetIsRefused) {
   for (int k = 0; k < 1500; ++k) {  // 50 s
     times.push_back(20.0 + 5.0 / 30 + k / 30.0);
     const double u = times.back() - offset - 0.5 / 30 - p.t0;
-    const int n = static_cast<int>(
-        std::upper_bound(p.starts.begin(), p.starts.end(), u) -
-        p.starts.begin() - 1);
+    const int n =
+        static_cast<int>(std::upper_bound(p.starts.begin(), p.starts.end(), u) -
+                         p.starts.begin() - 1);
     motion.push_back(u - p.starts[n] < 0.6 ? 0.6 : 4.0);
   }
   try {

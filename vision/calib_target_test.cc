@@ -190,8 +190,7 @@ TEST(CalibTargetDetector, RealAprilGridPhotoInItsOwnLayout) {
   };
   int corners = 0;
   const double own = homography_rms(
-      "aprilgrid:8x5:31.5:1:first=1:order=columns:origin=top-left",
-      &corners);
+      "aprilgrid:8x5:31.5:1:first=1:order=columns:origin=top-left", &corners);
   // Turned tags put every corner one position round: no plane fits.
   int turned_corners = 0;
   const double turned = homography_rms(
@@ -204,8 +203,7 @@ TEST(CalibTargetDetector, RealAprilGridPhotoInItsOwnLayout) {
   EXPECT_GE(corners, 4 * 36) << "most of the 40 tags detected";
   EXPECT_LT(own, 15.0) << "px RMS of one homography over " << corners;
   int kalibr_corners = 0;
-  const double kalibr =
-      homography_rms("aprilgrid:8x5:31.5:1", &kalibr_corners);
+  const double kalibr = homography_rms("aprilgrid:8x5:31.5:1", &kalibr_corners);
   RecordProperty("kalibr_layout_rms_px", std::to_string(kalibr));
   EXPECT_GT(kalibr, 10 * own) << kalibr_corners << " corners";
 }
