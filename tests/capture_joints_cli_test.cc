@@ -15,6 +15,7 @@
 
 #include "data/atomic_file.h"
 #include "data/csv.h"
+#include "tests/testing/joint_log_session.h"
 #include "tests/testing/paths.h"
 #include "tests/testing/run.h"
 
@@ -24,83 +25,20 @@ namespace {
 using testing::RunKincal;
 using testing::RunResult;
 
-constexpr double kFps = 30;
-constexpr int kFrames = 450;           // 15 s
-constexpr double kLogStart = 5000.0;   // controller clock
-constexpr double kOffset = -5002.266;  // frame (media) time = log + offset
-
-// Irregular stop-and-go of two joints (deg), 10 deg/s moves of 8 deg.
-struct Program {
-  std::vector<double> starts, dwells;
-  Program() {
-    std::mt19937 rng(5);
-    std::uniform_real_distribution<double> dwell(0.8, 1.6);
-    double t = 0;
-    for (int n = 0; n < 40; ++n) {
-      starts.push_back(t);
-      dwells.push_back(dwell(rng));
-      t += dwells.back() + 0.8;
-    }
-  }
-  // Returns the joint values and whether the robot moves at log time t.
-  bool At(double t, double* j1, double* j2) const {
-    const double u = t - kLogStart;
-    const int n = static_cast<int>(
-        std::upper_bound(starts.begin(), starts.end(), u) - starts.begin() - 1);
-    const double r = u - starts[n];
-    const double moved =
-        r < dwells[n] ? 0.0 : std::min(r - dwells[n], 0.8) * 10;
-    *j1 = 8.0 * n + moved;
-    *j2 = 30 - 0.5 * *j1;
-    return r >= dwells[n] && r < dwells[n] + 0.8;
-  }
-};
-
-struct Fixture {
-  std::string dir, robot, log;
-};
+using testing::JointLogSession;
+using testing::JointLogSessionOptions;
+using testing::kFps;
+using testing::kFrames;
+using testing::kOffset;
+using Program = testing::StopAndGo;
+using Fixture = JointLogSession;
 
 Fixture Make(const std::string& tag, const std::string& log_header = "t,j1,j2",
              double log_seconds = 40) {
-  Fixture f;
-  f.dir = testing::MakeTempDir(tag);
-  const Program program;
-  std::mt19937 rng(1);
-  for (int k = 0; k < kFrames; ++k) {
-    double j1, j2;
-    program.At(k / kFps - kOffset, &j1, &j2);
-    cv::Mat img(120, 320, CV_8UC1, cv::Scalar(90));
-    cv::rectangle(img, cv::Rect(static_cast<int>(j1 * 4) % 280, 30, 24, 40),
-                  cv::Scalar(220), cv::FILLED);
-    cv::Mat noise(img.size(), CV_8UC1);
-    cv::randu(noise, 0, 3);
-    img += noise;
-    char name[64];
-    std::snprintf(name, sizeof(name), "/l_%04d.png", k);
-    cv::imwrite(f.dir + name, img);
-    std::snprintf(name, sizeof(name), "/r_%04d.png", k);
-    cv::imwrite(f.dir + name, img);
-  }
-  std::ostringstream log;
-  log.precision(12);
-  log << log_header << "\n";
-  for (int i = 0; i <= static_cast<int>(log_seconds * 125); ++i) {  // 125 Hz
-    const double t = kLogStart + i / 125.0;
-    double j1, j2;
-    program.At(t, &j1, &j2);
-    log << t << "," << j1 << "," << j2 << "\n";
-  }
-  f.log = f.dir + "/joints.csv";
-  WriteFileAtomic(f.log, log.str());
-  f.robot = f.dir + "/robot.yaml";
-  WriteFileAtomic(f.robot,
-                  "kincal_robot: 1\nname: two\nconvention: dh\njoints:\n"
-                  "  - {name: j1, type: revolute, d: 0, alpha: 0, a: 300, "
-                  "theta: 0, limits: [-10, 400]}\n"
-                  "  - {name: j2, type: revolute, d: 0, alpha: 0, a: 200, "
-                  "theta: 0, limits: [-200, 90]}\n"
-                  "tool: {d: 0, alpha: 0, a: 50, theta: 0}\n");
-  return f;
+  JointLogSessionOptions options;
+  options.log_header = log_header;
+  options.log_seconds = log_seconds;
+  return testing::MakeJointLogSession(tag, Program(), Program(), options);
 }
 
 std::string Capture(const Fixture& f, const std::string& out,

@@ -16,6 +16,7 @@
 #include <sstream>
 
 #include "data/atomic_file.h"
+#include "tests/testing/joint_log_session.h"
 #include "tests/testing/paths.h"
 #include "tests/testing/run.h"
 
@@ -139,100 +140,18 @@ TEST(ChecksCli, PointsInMetresAreRefusedWithTheFix) {
 
 // --- capture --joints: the clock offset's agreement ------------------------
 
-constexpr double kFps = 30;
-constexpr int kFrames = 450;           // 15 s
-constexpr double kLogStart = 5000.0;   // controller clock
-constexpr double kOffset = -5002.266;  // frame (media) time = log + offset
+using testing::JointLogSessionOptions;
+using Program = testing::StopAndGo;
+using Fixture = testing::JointLogSession;
 
-// Irregular stop-and-go of two joints (deg); `seed` picks the dwells.
-struct Program {
-  std::vector<double> starts, dwells;
-  explicit Program(unsigned seed, double move_s = 0.8) : move(move_s) {
-    std::mt19937 rng(seed);
-    std::uniform_real_distribution<double> dwell(0.8, 1.6);
-    double t = 0;
-    for (int n = 0; n < 40; ++n) {
-      starts.push_back(t);
-      dwells.push_back(dwell(rng));
-      t += dwells.back() + move;
-    }
-  }
-  double move;
-  // Seconds since the robot last stopped (the start of the current dwell).
-  double SinceStop(double t) const {
-    const double u = t - kLogStart;
-    const int n = static_cast<int>(
-        std::upper_bound(starts.begin(), starts.end(), u) - starts.begin() - 1);
-    return u - starts[n];
-  }
-  void At(double t, double* j1, double* j2) const {
-    const double u = t - kLogStart;
-    const int n = static_cast<int>(
-        std::upper_bound(starts.begin(), starts.end(), u) - starts.begin() - 1);
-    const double r = u - starts[n];
-    const double moved =
-        r < dwells[n] ? 0.0 : std::min(r - dwells[n], move) * 8.0 / move;
-    *j1 = 8.0 * n + moved;
-    *j2 = 30 - 0.5 * *j1;
-  }
-};
-
-struct Fixture {
-  std::string dir, robot, log;
-};
-
-// Images of `seen`'s motion; a 125 Hz log of `logged`'s, through `edit`.
-// With `distractor`, a second object moves in view all the time except in
-// the first 0.6 s after each stop of the robot.
-Fixture MakeCapture(const std::string& tag, const Program& seen,
-                    const Program& logged,
-                    const std::function<void(int, double*, double*)>& edit,
+Fixture MakeCapture(const std::string& tag,
+                    const std::function<void(int, double*, double*)>& edit = {},
                     bool distractor = false) {
-  Fixture f;
-  f.dir = testing::MakeTempDir(tag);
-  for (int k = 0; k < kFrames; ++k) {
-    double j1, j2;
-    seen.At(k / kFps - kOffset, &j1, &j2);
-    cv::Mat img(120, 320, CV_8UC1, cv::Scalar(90));
-    cv::rectangle(img, cv::Rect(static_cast<int>(j1 * 4) % 280, 30, 24, 40),
-                  cv::Scalar(220), cv::FILLED);
-    if (distractor && seen.SinceStop(k / kFps - kOffset) >= 0.6) {
-      cv::rectangle(img, cv::Rect((k * 7) % 280, 80, 24, 30), cv::Scalar(30),
-                    cv::FILLED);
-    }
-    cv::Mat noise(img.size(), CV_8UC1);
-    cv::randu(noise, 0, 3);
-    img += noise;
-    char name[64];
-    std::snprintf(name, sizeof(name), "/l_%04d.png", k);
-    cv::imwrite(f.dir + name, img);
-    std::snprintf(name, sizeof(name), "/r_%04d.png", k);
-    cv::imwrite(f.dir + name, img);
-  }
-  std::ostringstream log;
-  log.precision(12);
-  log << "t,j1,j2\n";
-  for (int i = 0; i <= 40 * 125; ++i) {
-    const double t = kLogStart + i / 125.0;
-    double j1, j2;
-    logged.At(t, &j1, &j2);
-    edit(i, &j1, &j2);
-    log << t << "," << j1 << "," << j2 << "\n";
-  }
-  f.log = f.dir + "/joints.csv";
-  WriteFileAtomic(f.log, log.str());
-  f.robot = f.dir + "/robot.yaml";
-  WriteFileAtomic(f.robot,
-                  "kincal_robot: 1\nname: two\nconvention: dh\njoints:\n"
-                  "  - {name: j1, type: revolute, d: 0, alpha: 0, a: 300, "
-                  "theta: 0, limits: [-10, 400]}\n"
-                  "  - {name: j2, type: revolute, d: 0, alpha: 0, a: 200, "
-                  "theta: 0, limits: [-200, 90]}\n"
-                  "tool: {d: 0, alpha: 0, a: 50, theta: 0}\n");
-  return f;
+  JointLogSessionOptions options;
+  options.edit = edit;
+  options.distractor = distractor;
+  return testing::MakeJointLogSession(tag, Program(5), Program(5), options);
 }
-
-void NoEdit(int, double*, double*) {}
 
 std::string Capture(const Fixture& f, const std::string& out,
                     const std::string& extra = "") {
@@ -242,8 +161,7 @@ std::string Capture(const Fixture& f, const std::string& out,
 }
 
 TEST(ChecksCli, CaptureTextShowsTheEstimatedOffsetAndItsAgreement) {
-  const Fixture f =
-      MakeCapture("checks_cap_ok", Program(5), Program(5), NoEdit);
+  const Fixture f = MakeCapture("checks_cap_ok");
   const RunResult r = RunKincal(Capture(f, f.dir + "/session"));
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_NE(r.out.find("clock offset -5002.2"), std::string::npos) << r.out;
@@ -256,8 +174,7 @@ TEST(ChecksCli, AChanceLevelOffsetIsRefusedUnlessGiven) {
   // Something else moves in view most of the time: the robot's stops still
   // fix an offset, but the images' moving/still state agrees with the log's
   // only about as often as chance.
-  const Fixture f =
-      MakeCapture("checks_cap_weak", Program(5), Program(5), NoEdit, true);
+  const Fixture f = MakeCapture("checks_cap_weak", {}, true);
   const std::string out = f.dir + "/session";
   const RunResult r = RunKincal(Capture(f, out, "--json"));
   EXPECT_EQ(r.exit_code, 2) << r.err;
@@ -279,10 +196,10 @@ TEST(ChecksCli, AChanceLevelOffsetIsRefusedUnlessGiven) {
 
 TEST(ChecksCli, ALogReadingOutsideTheLimitsIsRefusedBeforeRecording) {
   // Line 2 + 300 of joints.csv reads j2 = 500 deg (limits [-200, 90]).
-  const Fixture f = MakeCapture("checks_cap_limit", Program(5), Program(5),
-                                [](int i, double*, double* j2) {
-                                  if (i == 300) *j2 = 500;
-                                });
+  const Fixture f =
+      MakeCapture("checks_cap_limit", [](int i, double*, double* j2) {
+        if (i == 300) *j2 = 500;
+      });
   const std::string out = f.dir + "/session";
   const RunResult r = RunKincal(Capture(f, out, "--json"));
   EXPECT_EQ(r.exit_code, 2) << r.err;
