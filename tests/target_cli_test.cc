@@ -7,6 +7,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -67,6 +68,27 @@ std::vector<Eigen::Vector3d> ReadTips(const std::string& path, int first) {
     }
   }
   return tips;
+}
+
+// Tip RMS against the truth with the measured and with the true target, over
+// the frames both found.
+struct TipErrors {
+  double measured_mm, true_mm;
+  int frames;
+};
+TipErrors TipRms(const std::vector<Eigen::Vector3d>& measured,
+                 const std::vector<Eigen::Vector3d>& with_true,
+                 const std::vector<Eigen::Vector3d>& truth) {
+  double sum_measured = 0, sum_true = 0;
+  int n = 0;
+  for (size_t f = 0; f < truth.size(); ++f) {
+    if (!measured[f].allFinite() || !with_true[f].allFinite()) continue;
+    sum_measured += (measured[f] - truth[f]).squaredNorm();
+    sum_true += (with_true[f] - truth[f]).squaredNorm();
+    ++n;
+  }
+  return {std::sqrt(sum_measured / std::max(n, 1)),
+          std::sqrt(sum_true / std::max(n, 1)), n};
 }
 
 TEST(TargetCli, MeasuresTheRenderedToolsLayout) {
@@ -154,17 +176,9 @@ TEST(TargetCli, MeasuresTheRenderedToolsLayout) {
   const auto truth_tips = ReadTips(s + "/session/truth.csv", 13);
   ASSERT_EQ(measured_tips.size(), truth_tips.size());
   ASSERT_EQ(true_tips.size(), truth_tips.size());
-  double sum_measured = 0, sum_true = 0;
-  int n = 0;
-  for (size_t f = 0; f < truth_tips.size(); ++f) {
-    if (!measured_tips[f].allFinite() || !true_tips[f].allFinite()) continue;
-    sum_measured += (measured_tips[f] - truth_tips[f]).squaredNorm();
-    sum_true += (true_tips[f] - truth_tips[f]).squaredNorm();
-    ++n;
-  }
+  const auto [r_measured, r_true, n] =
+      TipRms(measured_tips, true_tips, truth_tips);
   ASSERT_GT(n, 10);
-  const double r_measured = std::sqrt(sum_measured / n);
-  const double r_true = std::sqrt(sum_true / n);
   std::printf(
       "track: tip RMS against the truth %.4f mm with the measured target, "
       "%.4f mm with the true one (%d frames)\n",
@@ -282,17 +296,9 @@ TEST(TargetCli, PivotSessionGivesTheTip) {
   const auto true_tips = ReadTips(dir + "/true.csv", 1);
   const auto truth_tips = ReadTips(dir + "/views/truth.csv", 13);
   ASSERT_EQ(measured_tips.size(), truth_tips.size());
-  double sum_measured = 0, sum_true = 0;
-  int n = 0;
-  for (size_t f = 0; f < truth_tips.size(); ++f) {
-    if (!measured_tips[f].allFinite() || !true_tips[f].allFinite()) continue;
-    sum_measured += (measured_tips[f] - truth_tips[f]).squaredNorm();
-    sum_true += (true_tips[f] - truth_tips[f]).squaredNorm();
-    ++n;
-  }
+  const auto [r_measured, r_true, n] =
+      TipRms(measured_tips, true_tips, truth_tips);
   ASSERT_GT(n, 30);
-  const double r_measured = std::sqrt(sum_measured / n);
-  const double r_true = std::sqrt(sum_true / n);
   std::printf(
       "tool alone, track: tip RMS %.4f mm with the measured target, %.4f mm "
       "with the true one (%d frames)\n",
