@@ -259,6 +259,37 @@ Eigen::Vector3d TipInBase(const Chain& chain, const PoseInput& in,
                            with_errors ? chain.drift.data() : nullptr, in);
 }
 
+std::vector<double> ModelJointValues(const Chain& chain, const PoseInput& in) {
+  const int n = chain.num_joints();
+  const bool masses = static_cast<int>(in.tau_mass.size()) == n;
+  std::vector<double> q(n);
+  for (int j = 0; j < n; ++j) {
+    const ChainRow& row = chain.rows[j];
+    q[j] = ModelJointValue<double>(row.type, in.q[j], in.s[j], in.tau[j],
+                                   chain.joint_errors[j].data(),
+                                   masses ? in.tau_mass[j] : 0.0,
+                                   row.transmission_lo, row.transmission_hi);
+  }
+  return q;
+}
+
+Eigen::Matrix4d ModelBaseFromTip(const Chain& chain, const PoseInput& in) {
+  Eigen::Matrix4d m = BaseFromTipAt(chain, ModelJointValues(chain, in));
+  const double* g = chain.drift.data();
+  const Eigen::Vector3d w((g[kMountIso] + g[kMountCos]) * in.moment.x() +
+                              g[kMountSin] * in.moment.y(),
+                          g[kMountSin] * in.moment.x() +
+                              (g[kMountIso] - g[kMountCos]) * in.moment.y(),
+                          0.0);
+  if (w.norm() > 0) {
+    m.block<3, 3>(0, 0) =
+        Eigen::AngleAxisd(w.norm(), w.normalized()).toRotationMatrix() *
+        m.block<3, 3>(0, 0);
+  }
+  m.block<3, 1>(0, 3) = TipInBase(chain, in);
+  return m;
+}
+
 void JointAxesInBase(const Chain& chain, const std::vector<double>& q,
                      std::vector<Eigen::Vector3d>* origins,
                      std::vector<Eigen::Vector3d>* axes) {
@@ -295,6 +326,69 @@ bool ThermalUsesTemperature(const Observations& obs) {
   return hi > lo;
 }
 
+PoseInput PoseInputAt(const Chain& chain,
+                      const std::vector<double>& q_internal) {
+  const int n = chain.num_joints();
+  KINCAL_CHECK(static_cast<int>(q_internal.size()) == n,
+               "pose has " << q_internal.size() << " joints, chain " << n);
+  // Link masses: the rows' (and the tool's) when any is given, else uniform
+  // beams of 10 kg/m of nominal row length, centre of mass half-way.
+  bool any_mass = false;
+  for (const ChainRow& r : chain.rows) any_mass = any_mass || r.mass_kg >= 0;
+  PoseInput in;
+  in.q = q_internal;
+  in.s.assign(n, 0.0);
+  // Gravity torque of a unit mass at the tip (nominal geometry, readings).
+  std::vector<Eigen::Vector3d> origins, axes;
+  JointAxesInBase(chain, in.q, &origins, &axes);
+  const Eigen::Matrix4d tip = BaseFromTipAt(chain, in.q);
+  const Eigen::Vector3d p_tip = tip.block<3, 1>(0, 3);
+  in.tau.resize(n);
+  for (int j = 0; j < n; ++j) {
+    in.tau[j] = chain.rows[j].type == JointType::kPrismatic
+                    ? axes[j].dot(chain.gravity)
+                    : axes[j].cross(p_tip - origins[j]).dot(chain.gravity);
+  }
+  // Link masses: weight vectors (N) at their centres (base frame, mm).
+  std::vector<Eigen::Vector3d> com(n + 1);
+  std::vector<double> mass(n + 1, 0.0);
+  Eigen::Matrix4d m = Eigen::Matrix4d::Identity();
+  for (int r = 0; r <= n; ++r) {
+    const ChainRow& row = chain.rows[r];
+    const Eigen::Vector3d start = m.block<3, 1>(0, 3);
+    m = m * RowTransform<double>(chain.convention, row, row.p.data(),
+                                 r < n ? in.q[r] : 0.0);
+    const Eigen::Vector3d end = m.block<3, 1>(0, 3);
+    if (any_mass) {
+      mass[r] = row.mass_kg >= 0 ? row.mass_kg : 0.0;
+      com[r] = (m * row.com_mm.homogeneous()).head<3>();
+    } else {
+      mass[r] = 10.0 * (end - start).norm() / 1000.0;
+      com[r] = 0.5 * (start + end);
+    }
+  }
+  in.tau_mass.assign(n, 0.0);
+  in.moment.setZero();
+  for (int r = 0; r <= n; ++r) {
+    const Eigen::Vector3d weight = mass[r] * kGravityMps2 * chain.gravity;
+    in.moment += com[r].cross(weight) / 1000.0;
+    for (int j = 0; j < n && j <= r; ++j) {
+      in.tau_mass[j] +=
+          chain.rows[j].type == JointType::kPrismatic
+              ? axes[j].dot(weight)
+              : axes[j].cross(com[r] - origins[j]).dot(weight) / 1000.0;
+    }
+  }
+  in.trig.resize(2 * kMaxHarmonic * n);
+  for (int j = 0; j < n; ++j) {
+    for (int h = 1; h <= kMaxHarmonic; ++h) {
+      in.trig[2 * kMaxHarmonic * j + 2 * (h - 1)] = std::cos(h * in.q[j]);
+      in.trig[2 * kMaxHarmonic * j + 2 * (h - 1) + 1] = std::sin(h * in.q[j]);
+    }
+  }
+  return in;
+}
+
 std::vector<PoseInput> MakePoseInputs(const Chain& chain,
                                       const Observations& obs) {
   const int n = chain.num_joints();
@@ -310,18 +404,12 @@ std::vector<PoseInput> MakePoseInputs(const Chain& chain,
     }
   }
   const bool use_temp = ThermalUsesTemperature(obs);
-  // Link masses: the rows' (and the tool's) when any is given, else uniform
-  // beams of 10 kg/m of nominal row length, centre of mass half-way.
-  bool any_mass = false;
-  for (const ChainRow& r : chain.rows) any_mass = any_mass || r.mass_kg >= 0;
   std::vector<PoseInput> out;
   std::vector<double> s(n, 0.0);
   const std::vector<double>* prev = nullptr;
-  std::vector<Eigen::Vector3d> origins, axes;
+  std::vector<double> q(n);
   for (const Observation& o : obs.rows) {
-    PoseInput in;
-    in.q.resize(n);
-    for (int j = 0; j < n; ++j) in.q[j] = chain.ReadingToInternal(j, o.q[j]);
+    for (int j = 0; j < n; ++j) q[j] = chain.ReadingToInternal(j, o.q[j]);
     if (prev != nullptr) {
       for (int j = 0; j < n; ++j) {
         const double dq = o.q[j] - (*prev)[j];
@@ -330,59 +418,11 @@ std::vector<PoseInput> MakePoseInputs(const Chain& chain,
       }
     }
     prev = &o.q;
+    PoseInput in = PoseInputAt(chain, q);
     in.s = s;
     in.t_h = o.HasTime() ? (o.t_s - t0) / 3600.0 : 0.0;
-    // Gravity torque of a unit mass at the tip (nominal geometry, readings).
-    JointAxesInBase(chain, in.q, &origins, &axes);
-    const Eigen::Matrix4d tip = BaseFromTipAt(chain, in.q);
-    const Eigen::Vector3d p_tip = tip.block<3, 1>(0, 3);
-    in.tau.resize(n);
-    for (int j = 0; j < n; ++j) {
-      in.tau[j] = chain.rows[j].type == JointType::kPrismatic
-                      ? axes[j].dot(chain.gravity)
-                      : axes[j].cross(p_tip - origins[j]).dot(chain.gravity);
-    }
-    // Link masses: weight vectors (N) at their centres (base frame, mm).
-    std::vector<Eigen::Vector3d> com(n + 1);
-    std::vector<double> mass(n + 1, 0.0);
-    {
-      Eigen::Matrix4d m = Eigen::Matrix4d::Identity();
-      for (int r = 0; r <= n; ++r) {
-        const ChainRow& row = chain.rows[r];
-        const Eigen::Vector3d start = m.block<3, 1>(0, 3);
-        m = m * RowTransform<double>(chain.convention, row, row.p.data(),
-                                     r < n ? in.q[r] : 0.0);
-        const Eigen::Vector3d end = m.block<3, 1>(0, 3);
-        if (any_mass) {
-          mass[r] = row.mass_kg >= 0 ? row.mass_kg : 0.0;
-          com[r] = (m * row.com_mm.homogeneous()).head<3>();
-        } else {
-          mass[r] = 10.0 * (end - start).norm() / 1000.0;
-          com[r] = 0.5 * (start + end);
-        }
-      }
-    }
-    in.tau_mass.assign(n, 0.0);
-    in.moment.setZero();
-    for (int r = 0; r <= n; ++r) {
-      const Eigen::Vector3d weight = mass[r] * kGravityMps2 * chain.gravity;
-      in.moment += com[r].cross(weight) / 1000.0;
-      for (int j = 0; j < n && j <= r; ++j) {
-        in.tau_mass[j] +=
-            chain.rows[j].type == JointType::kPrismatic
-                ? axes[j].dot(weight)
-                : axes[j].cross(com[r] - origins[j]).dot(weight) / 1000.0;
-      }
-    }
-    in.thermal_x = use_temp ? obs.rows[out.size()].temp_c - 20.0 : in.t_h;
-    in.trig.resize(2 * kMaxHarmonic * n);
-    for (int j = 0; j < n; ++j) {
-      for (int h = 1; h <= kMaxHarmonic; ++h) {
-        in.trig[2 * kMaxHarmonic * j + 2 * (h - 1)] = std::cos(h * in.q[j]);
-        in.trig[2 * kMaxHarmonic * j + 2 * (h - 1) + 1] = std::sin(h * in.q[j]);
-      }
-    }
-    out.push_back(in);
+    in.thermal_x = use_temp ? o.temp_c - 20.0 : in.t_h;
+    out.push_back(std::move(in));
   }
   return out;
 }

@@ -182,6 +182,12 @@ void FillTransmissionSines(const Chain& chain, PoseInput* in);
 // when every row has one and it varies, else t_h.
 std::vector<PoseInput> MakePoseInputs(const Chain& chain,
                                       const Observations& obs);
+// The part of a PoseInput that depends on the readings alone (tau, tau_mass,
+// moment, trig; internal units), with s = 0, t_h = 0 and thermal_x = 0: for
+// callers that choose the readings themselves (inverse kinematics), which
+// then set s, t_h and thermal_x.
+PoseInput PoseInputAt(const Chain& chain,
+                      const std::vector<double>& q_internal);
 // True when the thermal input of these observations is temperature (K).
 bool ThermalUsesTemperature(const Observations& obs);
 
@@ -588,6 +594,11 @@ Eigen::Vector3d TipInBase(const Chain& chain, const PoseInput& in,
                           bool with_errors = true);
 Eigen::Matrix4d BaseFromTipAt(const Chain& chain,
                               const std::vector<double>& q_internal);
+// The joint values FK uses for a pose (ModelJointValue of every joint), and
+// base_from_tip through the whole error model: the position is TipInBase's;
+// the rotation is FK's at those joint values, tilted by the mount family.
+std::vector<double> ModelJointValues(const Chain& chain, const PoseInput& in);
+Eigen::Matrix4d ModelBaseFromTip(const Chain& chain, const PoseInput& in);
 // Frames of every joint axis (base_from_link before joint j's motion), used
 // for gravity torques: origin and unit axis of joint j in the base frame.
 void JointAxesInBase(const Chain& chain, const std::vector<double>& q_internal,

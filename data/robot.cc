@@ -1,8 +1,10 @@
 #include "data/robot.h"
 
+#include <algorithm>
 #include <cmath>
 #include <set>
 #include <sstream>
+#include <stdexcept>
 
 #include "data/atomic_file.h"
 #include "data/error.h"
@@ -46,6 +48,39 @@ std::vector<std::string> Robot::JointNames() const {
   std::vector<std::string> names;
   for (const auto& j : joints) names.push_back(j.name);
   return names;
+}
+
+namespace {
+// Copies the geometry fields of `from` into `to` (names, limits and masses
+// stay `to`'s).
+void CopyGeometry(const RobotRow& from, RobotRow* to) {
+  to->theta_deg = from.theta_deg;
+  to->d_mm = from.d_mm;
+  to->a_mm = from.a_mm;
+  to->alpha_deg = from.alpha_deg;
+  to->beta_deg = from.beta_deg;
+  to->xyz_mm = from.xyz_mm;
+  to->rpy_deg = from.rpy_deg;
+  to->axis = from.axis;
+}
+}  // namespace
+
+Robot Robot::Nominal() const {
+  if (!HasNominal()) throw std::logic_error("robot has no nominal rows");
+  Robot out = *this;
+  for (size_t i = 0; i < joints.size(); ++i) {
+    CopyGeometry(nominal_joints[i], &out.joints[i]);
+  }
+  CopyGeometry(nominal_tool, &out.tool);
+  out.extensions.clear();
+  out.fitted_on = FitRecord{};
+  return out;
+}
+
+void Robot::SetNominal(const Robot& nominal) {
+  const Robot& source = nominal.HasNominal() ? nominal.Nominal() : nominal;
+  nominal_joints = source.joints;
+  nominal_tool = source.tool;
 }
 
 namespace {
@@ -301,6 +336,128 @@ Extension ReadExtension(const YamlReader& r, const YAML::Node& e, size_t i,
   return x;
 }
 
+// nominal: {joints: [rows with the joints' names, in order], tool: {...}}.
+void ReadNominal(const YamlReader& r, const YAML::Node& n, Robot* robot) {
+  r.ExpectMap(n, "nominal");
+  r.CheckKeys(n, {"joints", "tool"}, "nominal");
+  const YAML::Node joints = r.Required(n, "joints", "nominal");
+  r.ExpectSequence(joints, "nominal.joints");
+  if (joints.size() != robot->joints.size()) {
+    r.Fail(joints,
+           "nominal.joints: expected " + std::to_string(robot->joints.size()) +
+               " rows (one per joint), got " + std::to_string(joints.size()));
+  }
+  for (size_t i = 0; i < joints.size(); ++i) {
+    const std::string what = "nominal.joints[" + std::to_string(i) + "]";
+    const YAML::Node j = joints[i];
+    r.ExpectMap(j, what);
+    r.CheckKeys(
+        j, {"name", "d", "alpha", "a", "theta", "beta", "xyz", "rpy", "axis"},
+        what);
+    RobotRow row = robot->joints[i];
+    const std::string name =
+        r.String(r.Required(j, "name", what), what + ".name");
+    if (name != row.name) {
+      r.Fail(j["name"], what + ".name: expected '" + row.name +
+                            "' (the joints' order), got '" + name + "'");
+    }
+    ReadGeometry(r, j, robot->convention, what, &row);
+    robot->nominal_joints.push_back(row);
+  }
+  robot->nominal_tool = robot->tool;
+  const YAML::Node t = r.Required(n, "tool", "nominal");
+  r.ExpectMap(t, "nominal.tool");
+  r.CheckKeys(t, {"d", "alpha", "a", "theta", "beta", "xyz", "rpy"},
+              "nominal.tool");
+  ReadGeometry(r, t, robot->convention, "nominal.tool", &robot->nominal_tool);
+}
+
+// fitted_on: {poses, joints: {name: [lo, hi]}, temp_c: [lo, hi],
+// thermal_input, heldout_rms_mm, systematic_rms_mm}.
+void ReadFittedOn(const YamlReader& r, const YAML::Node& f, Robot* robot) {
+  r.ExpectMap(f, "fitted_on");
+  r.CheckKeys(f,
+              {"poses", "joints", "temp_c", "thermal_input", "heldout_rms_mm",
+               "systematic_rms_mm"},
+              "fitted_on");
+  FitRecord& rec = robot->fitted_on;
+  rec.poses = r.Integer(r.Required(f, "poses", "fitted_on"), "fitted_on.poses");
+  if (rec.poses < 1) r.Fail(f["poses"], "fitted_on.poses: expected >= 1");
+  if (f["joints"]) {
+    const YAML::Node j = f["joints"];
+    r.ExpectMap(j, "fitted_on.joints");
+    rec.joint_range.assign(robot->joints.size(),
+                           {std::numeric_limits<double>::quiet_NaN(),
+                            std::numeric_limits<double>::quiet_NaN()});
+    for (const auto& kv : j) {
+      const std::string name = kv.first.Scalar();
+      const int index = robot->JointIndex(name);
+      if (index < 0) {
+        r.Fail(kv.first, "fitted_on.joints: no joint named '" + name + "'");
+      }
+      const auto range = r.Numbers(kv.second, "fitted_on.joints." + name, 2, 2);
+      if (!(range[1] >= range[0])) {
+        r.Fail(kv.second, "fitted_on.joints." + name + ": expected [lo, hi]");
+      }
+      rec.joint_range[index] = {range[0], range[1]};
+    }
+  }
+  if (f["temp_c"]) {
+    const auto t = r.Numbers(f["temp_c"], "fitted_on.temp_c", 2, 2);
+    rec.temp_lo_c = t[0];
+    rec.temp_hi_c = t[1];
+  }
+  if (f["thermal_input"]) {
+    rec.thermal_input = r.String(f["thermal_input"], "fitted_on.thermal_input");
+    if (rec.thermal_input != "temp_c" && rec.thermal_input != "hours") {
+      r.Fail(f["thermal_input"],
+             "fitted_on.thermal_input: expected 'temp_c' or 'hours'");
+    }
+  }
+  rec.heldout_rms_mm =
+      r.NumberOr(f, "heldout_rms_mm", rec.heldout_rms_mm, "fitted_on");
+  rec.systematic_rms_mm =
+      r.NumberOr(f, "systematic_rms_mm", rec.systematic_rms_mm, "fitted_on");
+}
+
+// covariance: {params: [names], matrix: [[...], ...]} (symmetric, n x n).
+void ReadCovariance(const YamlReader& r, const YAML::Node& c, Robot* robot) {
+  r.ExpectMap(c, "covariance");
+  r.CheckKeys(c, {"params", "matrix"}, "covariance");
+  const YAML::Node params = r.Required(c, "params", "covariance");
+  r.ExpectSequence(params, "covariance.params");
+  FitRecord& rec = robot->fitted_on;
+  for (size_t i = 0; i < params.size(); ++i) {
+    rec.covariance_params.push_back(
+        r.String(params[i], "covariance.params[" + std::to_string(i) + "]"));
+  }
+  const int n = static_cast<int>(rec.covariance_params.size());
+  const YAML::Node m = r.Required(c, "matrix", "covariance");
+  r.ExpectSequence(m, "covariance.matrix");
+  if (static_cast<int>(m.size()) != n) {
+    r.Fail(m, "covariance.matrix: expected " + std::to_string(n) +
+                  " rows (one per parameter), got " + std::to_string(m.size()));
+  }
+  rec.covariance.resize(n, n);
+  for (int i = 0; i < n; ++i) {
+    const std::string what = "covariance.matrix[" + std::to_string(i) + "]";
+    const auto row = r.Numbers(m[i], what, n, n);
+    for (int k = 0; k < n; ++k) rec.covariance(i, k) = row[k];
+  }
+  for (int i = 0; i < n; ++i) {
+    for (int k = 0; k < i; ++k) {
+      const double a = rec.covariance(i, k), b = rec.covariance(k, i);
+      if (std::abs(a - b) > 1e-9 * std::max(1.0, std::abs(a) + std::abs(b))) {
+        r.Fail(m[i], "covariance.matrix: not symmetric at (" +
+                         std::to_string(i) + ", " + std::to_string(k) + ")");
+      }
+    }
+    if (!(rec.covariance(i, i) >= 0.0)) {
+      r.Fail(m[i], "covariance.matrix: negative variance on the diagonal");
+    }
+  }
+}
+
 }  // namespace
 
 Robot ParseRobotYaml(const std::string& text, const std::string& file) {
@@ -310,10 +467,11 @@ Robot ParseRobotYaml(const std::string& text, const std::string& file) {
     throw InputError(file, 0, 0, "empty file: expected a robot description");
   }
   r.ExpectMap(root, "robot file");
-  r.CheckKeys(root,
-              {"kincal_robot", "name", "convention", "gravity", "joints",
-               "tool", "bounds", "extensions"},
-              "robot file");
+  r.CheckKeys(
+      root,
+      {"kincal_robot", "name", "convention", "gravity", "joints", "tool",
+       "bounds", "extensions", "nominal", "fitted_on", "covariance"},
+      "robot file");
   Robot robot;
   ReadRobotHeader(r, root, &robot);
   const YAML::Node joints = r.Required(root, "joints", "robot file");
@@ -332,6 +490,9 @@ Robot ParseRobotYaml(const std::string& text, const std::string& file) {
       robot.extensions.push_back(ReadExtension(r, ext[i], i, robot));
     }
   }
+  if (root["nominal"]) ReadNominal(r, root["nominal"], &robot);
+  if (root["fitted_on"]) ReadFittedOn(r, root["fitted_on"], &robot);
+  if (root["covariance"]) ReadCovariance(r, root["covariance"], &robot);
   return robot;
 }
 
@@ -358,6 +519,57 @@ std::string Geometry(const Robot& robot, const RobotRow& row) {
     if (row.beta_deg != 0.0) os << ", beta: " << FormatDouble(row.beta_deg);
   }
   return os.str();
+}
+// nominal:, fitted_on: and covariance: when the robot has them.
+void FormatFitRecord(const Robot& robot, std::ostringstream& os) {
+  if (robot.HasNominal()) {
+    os << "nominal:\n  joints:\n";
+    for (const RobotRow& j : robot.nominal_joints) {
+      os << "    - {name: " << j.name << ", " << Geometry(robot, j) << "}\n";
+    }
+    os << "  tool: {" << Geometry(robot, robot.nominal_tool) << "}\n";
+  }
+  const FitRecord& rec = robot.fitted_on;
+  if (rec.present()) {
+    os << "fitted_on:\n  poses: " << rec.poses << "\n";
+    if (!rec.joint_range.empty()) {
+      os << "  joints: {";
+      for (size_t j = 0; j < rec.joint_range.size(); ++j) {
+        os << (j ? ", " : "") << robot.joints[j].name << ": ["
+           << FormatDouble(rec.joint_range[j][0]) << ", "
+           << FormatDouble(rec.joint_range[j][1]) << "]";
+      }
+      os << "}\n";
+    }
+    if (rec.temp_lo_c == rec.temp_lo_c) {
+      os << "  temp_c: [" << FormatDouble(rec.temp_lo_c) << ", "
+         << FormatDouble(rec.temp_hi_c) << "]\n";
+    }
+    if (!rec.thermal_input.empty()) {
+      os << "  thermal_input: " << rec.thermal_input << "\n";
+    }
+    if (rec.heldout_rms_mm == rec.heldout_rms_mm) {
+      os << "  heldout_rms_mm: " << FormatDouble(rec.heldout_rms_mm) << "\n";
+    }
+    if (rec.systematic_rms_mm == rec.systematic_rms_mm) {
+      os << "  systematic_rms_mm: " << FormatDouble(rec.systematic_rms_mm)
+         << "\n";
+    }
+  }
+  if (!rec.covariance_params.empty()) {
+    os << "covariance:  # interface units, parameter order below\n  params: [";
+    for (size_t i = 0; i < rec.covariance_params.size(); ++i) {
+      os << (i ? ", " : "") << rec.covariance_params[i];
+    }
+    os << "]\n  matrix:\n";
+    for (int i = 0; i < rec.covariance.rows(); ++i) {
+      os << "    - [";
+      for (int k = 0; k < rec.covariance.cols(); ++k) {
+        os << (k ? ", " : "") << FormatDouble(rec.covariance(i, k));
+      }
+      os << "]\n";
+    }
+  }
 }
 }  // namespace
 
@@ -397,6 +609,7 @@ std::string FormatRobotYaml(const Robot& robot,
       os << "}\n";
     }
   }
+  FormatFitRecord(robot, os);
   return os.str();
 }
 

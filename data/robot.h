@@ -2,6 +2,7 @@
 #define KINCAL_DATA_ROBOT_H_
 
 #include <Eigen/Core>
+#include <array>
 #include <limits>
 #include <map>
 #include <string>
@@ -65,6 +66,34 @@ struct Extension {
   std::map<std::string, double> values;
 };
 
+// What a calibrated model was fitted on and how well it knows its values
+// (robot.yaml `fitted_on:` and `covariance:`, written by calibrate, diagnose
+// and bundle): compensate flags targets outside the data's travel and
+// temperature and predicts each target's error from it.
+struct FitRecord {
+  int poses = 0;  // 0 = no record
+  // Per joint (robot order), the readings' range [lo, hi] in the data (reading
+  // units); empty = unknown.
+  std::vector<std::array<double, 2>> joint_range;
+  // temp_c range of the data (NaN = no temperature column).
+  double temp_lo_c = std::numeric_limits<double>::quiet_NaN();
+  double temp_hi_c = std::numeric_limits<double>::quiet_NaN();
+  // Input of the thermal extension: "temp_c" (per K of temp_c - 20) or
+  // "hours" (per hour since the first timed row); "" = no thermal term.
+  std::string thermal_input;
+  // Held-out tip RMS of the model (3D, mm) and the part of its residual above
+  // the measurement noise (3D RMS, mm; 0 when none is detected); NaN = unknown.
+  double heldout_rms_mm = std::numeric_limits<double>::quiet_NaN();
+  double systematic_rms_mm = std::numeric_limits<double>::quiet_NaN();
+  // Covariance of the fitted robot parameters (names as in
+  // docs/CONVENTIONS.md "Parameter names", interface units: mm, deg, the
+  // families' units; the measuring frame excluded). Empty = unknown.
+  std::vector<std::string> covariance_params;
+  Eigen::MatrixXd covariance;
+
+  bool present() const { return poses > 0; }
+};
+
 struct Robot {
   std::string name;
   Convention convention = Convention::kDh;
@@ -79,7 +108,19 @@ struct Robot {
   // press a parameter against them (CalibrateResult::widened_bounds).
   bool bounds_stated = false;
   std::vector<Extension> extensions;
+  // The nominal rows the calibration started from (robot.yaml `nominal:`):
+  // the kinematics the controller uses, for `compensate` of joint programs.
+  // Empty = not recorded.
+  std::vector<RobotRow> nominal_joints;
+  RobotRow nominal_tool;
+  FitRecord fitted_on;
 
+  bool HasNominal() const { return !nominal_joints.empty(); }
+  // This robot with its nominal rows (and no extensions, no record); throws
+  // std::logic_error when HasNominal() is false.
+  Robot Nominal() const;
+  // Records `nominal`'s rows as this robot's nominal (same joints).
+  void SetNominal(const Robot& nominal);
   int JointIndex(const std::string& name) const;  // -1 when absent
   std::vector<std::string> JointNames() const;
 };

@@ -89,6 +89,64 @@ TEST(RobotYamlTest, WriteThenReadIsIdentity) {
   EXPECT_EQ(back.extensions[0].values.at("width"), 0.42);
 }
 
+TEST(RobotYamlTest, NominalFitRecordAndCovarianceRoundTrip) {
+  const Robot nominal = ParseRobotYaml(kSpecExample, "spec.yaml");
+  Robot r = nominal;
+  r.joints[2].a_mm = 200.25;
+  r.tool.d_mm = 149.5;
+  r.SetNominal(nominal);
+  r.fitted_on.poses = 40;
+  r.fitted_on.joint_range = {{0, 50}, {-90, 90}, {-45, 45}, {-30, 30}, {0, 0}};
+  r.fitted_on.temp_lo_c = 21.5;
+  r.fitted_on.temp_hi_c = 27.0;
+  r.fitted_on.thermal_input = "temp_c";
+  r.fitted_on.heldout_rms_mm = 0.031;
+  r.fitted_on.systematic_rms_mm = 0.0;
+  r.fitted_on.covariance_params = {"j3.a", "tool.d"};
+  r.fitted_on.covariance.resize(2, 2);
+  r.fitted_on.covariance << 4e-4, -1e-4, -1e-4, 9e-4;
+  const Robot back = ParseRobotYaml(FormatRobotYaml(r), "back.yaml");
+  ASSERT_TRUE(back.HasNominal());
+  EXPECT_EQ(back.Nominal().joints[2].a_mm, 200.0);
+  EXPECT_EQ(back.Nominal().tool.d_mm, 150.0);
+  EXPECT_EQ(back.joints[2].a_mm, 200.25);
+  EXPECT_EQ(back.fitted_on.poses, 40);
+  ASSERT_EQ(back.fitted_on.joint_range.size(), 5u);
+  EXPECT_EQ(back.fitted_on.joint_range[1][0], -90.0);
+  EXPECT_EQ(back.fitted_on.temp_hi_c, 27.0);
+  EXPECT_EQ(back.fitted_on.thermal_input, "temp_c");
+  EXPECT_EQ(back.fitted_on.heldout_rms_mm, 0.031);
+  EXPECT_EQ(back.fitted_on.covariance_params[1], "tool.d");
+  EXPECT_EQ(back.fitted_on.covariance(0, 1), -1e-4);
+  EXPECT_EQ(back.fitted_on.covariance(1, 1), 9e-4);
+  // A nominal of a nominal is the same nominal (calibrating a calibrated
+  // file keeps the controller's kinematics).
+  Robot again = back;
+  again.SetNominal(back);
+  EXPECT_EQ(again.nominal_joints[2].a_mm, 200.0);
+}
+
+TEST(RobotYamlTest, FitRecordErrorsArePlaced) {
+  const std::string base = std::string(kSpecExample) +
+                           "covariance:\n  params: [j3.a, tool.d]\n"
+                           "  matrix:\n    - [1, 2]\n    - [3, 1]\n";
+  try {
+    ParseRobotYaml(base, "r.yaml");
+    FAIL() << "asymmetric covariance accepted";
+  } catch (const InputError& e) {
+    EXPECT_THAT(e.what(), HasSubstr("not symmetric"));
+  }
+  const std::string nominal = std::string(kSpecExample) +
+                              "nominal:\n  joints:\n    - {name: jx, d: 0, "
+                              "alpha: 0, a: 0, theta: 0}\n  tool: {d: 1}\n";
+  try {
+    ParseRobotYaml(nominal, "r.yaml");
+    FAIL() << "nominal with wrong row count accepted";
+  } catch (const InputError& e) {
+    EXPECT_THAT(e.what(), HasSubstr("nominal.joints: expected 5 rows"));
+  }
+}
+
 TEST(RobotYamlTest, TransmissionSeriesRoundTripAndTravelChecked) {
   Robot r = ParseRobotYaml(kSpecExample, "spec.yaml");
   r.extensions.push_back({"transmission",
