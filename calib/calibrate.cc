@@ -9,6 +9,7 @@
 #include <stdexcept>
 #include <utility>
 
+#include "calib/fit_record.h"
 #include "calib/free_fit.h"
 #include "calib/holdout.h"
 #include "calib/paper_method.h"
@@ -650,7 +651,15 @@ CalibrateResult Calibrate(const Robot& nominal, const Observations& obs,
     result.has_epsilon = true;
     result.epsilon = ComputeErrorStats(eps);
   }
-  result.calibrated = state.chain.ToRobot(nominal);
+  FitRecordInput record;
+  record.obs = &obs;
+  record.rows = result.train_rows;
+  record.fit = &result.fit;
+  record.state = &state;
+  record.heldout_rms_mm =
+      result.heldout.n > 0 ? result.heldout.rms_mm : result.train.rms_mm;
+  result.calibrated =
+      WithFitRecord(state.chain.ToRobot(nominal), nominal, record);
   result.seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start)
           .count();

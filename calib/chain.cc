@@ -128,6 +128,7 @@ Robot Chain::ToRobot(const Robot& description) const {
                "robot description has " << description.joints.size()
                                         << " joints, chain " << num_joints());
   Robot robot = description;
+  robot.fitted_on = FitRecord{};  // a record describes other values
   for (int j = 0; j < num_joints(); ++j) {
     RowToDescription(convention, rows[j].p, &robot.joints[j]);
   }

@@ -37,7 +37,8 @@ IkContext ContextFor(const Robot& robot, const Chain& chain, double temp_c,
                      const std::string& id) {
   IkContext c;
   bool thermal = false;
-  for (const auto& e : chain.joint_errors) thermal = thermal || e[kThermal] != 0;
+  for (const auto& e : chain.joint_errors)
+    thermal = thermal || e[kThermal] != 0;
   if (thermal && robot.fitted_on.thermal_input != "hours") {
     if (!(temp_c == temp_c)) {
       throw InputError(
@@ -51,13 +52,14 @@ IkContext ContextFor(const Robot& robot, const Chain& chain, double temp_c,
 }
 
 // Readings to start the controller's solution from when a target has no
-// seed: the previous solution, the start readings, the middle of the
-// limits, then seeded random readings inside them.
+// seed, tried in turn until one reaches it: the previous solution, the start
+// readings, the middle of the limits, then seeded random readings inside
+// them.
 std::vector<std::vector<double>> StartCandidates(
     const Robot& robot, const std::vector<double>& previous,
     const std::vector<double>& start, uint64_t seed) {
   std::vector<std::vector<double>> out;
-  if (!previous.empty()) return {previous};
+  if (!previous.empty()) out.push_back(previous);
   if (!start.empty()) out.push_back(start);
   const int n = static_cast<int>(robot.joints.size());
   std::vector<double> mid(n, 0.0), lo(n), hi(n);
@@ -80,7 +82,22 @@ std::vector<std::vector<double>> StartCandidates(
   return out;
 }
 
-// Step 1: the controller's readings for the target.
+// The smallest distance of any joint to its limits (reading units; +inf
+// without limits).
+double LimitClearance(const Robot& robot, const std::vector<double>& q) {
+  double clearance = std::numeric_limits<double>::infinity();
+  for (size_t j = 0; j < q.size(); ++j) {
+    const RobotRow& r = robot.joints[j];
+    if (!r.HasLimits()) continue;
+    clearance = std::min({clearance, q[j] - r.lower, r.upper - q[j]});
+  }
+  return clearance;
+}
+
+// Step 1: the controller's readings for the target. Without a seed, the
+// first start that reaches it with max_correction of room to every limit
+// (the compensation needs room to move), else the reached one with the most
+// room, else the closest miss.
 IkResult ControllerSolution(const Robot& robot, const Chain& nominal,
                             const CompensateTarget& t,
                             const std::vector<double>& previous,
@@ -92,11 +109,20 @@ IkResult ControllerSolution(const Robot& robot, const Chain& nominal,
   }
   IkResult best;
   best.position_error_mm = std::numeric_limits<double>::infinity();
+  double best_clearance = -std::numeric_limits<double>::infinity();
   for (const auto& start :
        StartCandidates(robot, previous, options.start, options.seed)) {
     IkResult r = SolveIk(nominal, t.target, start, IkContext{}, geometric);
-    if (r.reached) return r;
-    if (r.position_error_mm < best.position_error_mm) best = r;
+    if (r.reached) {
+      const double clearance = LimitClearance(robot, r.q);
+      if (clearance >= options.max_correction) return r;
+      if (!best.reached || clearance > best_clearance) {
+        best = r;
+        best_clearance = clearance;
+      }
+    } else if (!best.reached && r.position_error_mm < best.position_error_mm) {
+      best = r;
+    }
   }
   return best;
 }
@@ -132,8 +158,8 @@ std::vector<std::string> Extrapolation(const Robot& robot,
     const double slack = 1e-9 * std::max(1.0, std::abs(q[j]));
     if (q[j] < range[0] - slack || q[j] > range[1] + slack) {
       out.push_back(robot.joints[j].name + " at " + Fixed(q[j], 3) +
-                    " outside the fitted travel [" + Fixed(range[0], 3) +
-                    ", " + Fixed(range[1], 3) + "]");
+                    " outside the fitted travel [" + Fixed(range[0], 3) + ", " +
+                    Fixed(range[1], 3) + "]");
     }
   }
   if (rec.temp_lo_c == rec.temp_lo_c && temp_c == temp_c &&
@@ -170,8 +196,8 @@ void WarnAboutTheModel(const Robot& robot, const Chain& chain,
   bool hours = chain.drift[kDriftX] != 0 || chain.drift[kDriftY] != 0 ||
                chain.drift[kDriftZ] != 0;
   for (const auto& e : chain.joint_errors) {
-    hours = hours ||
-            (e[kThermal] != 0 && robot.fitted_on.thermal_input == "hours");
+    hours =
+        hours || (e[kThermal] != 0 && robot.fitted_on.thermal_input == "hours");
   }
   if (hours) {
     warnings->Add("time_terms_at_start",
@@ -179,6 +205,21 @@ void WarnAboutTheModel(const Robot& robot, const Chain& chain,
                   "they describe the measuring session and are compensated "
                   "at its start (t = 0)");
   }
+}
+
+// A target given in the measuring frame, in the base frame.
+IkTarget FromMeasuringFrame(const FitRecord& rec, const IkTarget& t) {
+  const Eigen::Vector3d w =
+      Eigen::Vector3d(rec.frame[0], rec.frame[1], rec.frame[2]) * M_PI / 180.0;
+  const Eigen::Matrix3d r =
+      w.norm() > 0
+          ? Eigen::AngleAxisd(w.norm(), w.normalized()).toRotationMatrix()
+          : Eigen::Matrix3d::Identity();
+  const Eigen::Vector3d tr(rec.frame[3], rec.frame[4], rec.frame[5]);
+  IkTarget out = t;
+  out.position_mm = r.transpose() * (t.position_mm - tr);
+  out.rotation = r.transpose() * t.rotation;
+  return out;
 }
 
 // The target of a joint program row: the nominal kinematics at its readings
@@ -215,9 +256,10 @@ void Judge(const Robot& robot, const Chain& chain, const IkContext& context,
                          Fixed(ik.position_error_mm, 4) + " mm)"
                    : "a joint limit stops it (" + ik.at_limit[0] + ")";
   } else if (largest > options.max_correction) {
-    out->why = "the compensated readings leave the configuration of the "
-               "controller's solution (" +
-               joint + " moves " + Fixed(largest, 2) + ")";
+    out->why =
+        "the compensated readings leave the configuration of the "
+        "controller's solution (" +
+        joint + " moves " + Fixed(largest, 2) + ")";
   } else {
     out->reached = true;
   }
@@ -241,6 +283,29 @@ double TipSigmaMm(const Robot& robot, const Chain& chain,
   if (p == 0) return kNaN;
   ModelState state;
   state.chain = chain;
+  for (int k = 0; k < 3; ++k) {
+    state.meas_from_base[k] = rec.frame[k] * M_PI / 180.0;
+    state.meas_from_base[k + 3] = rec.frame[k + 3];
+  }
+  // The tip in the measuring frame when the covariance carries the frame:
+  // the frame's correlation with the robot's parameters takes out what the
+  // registration absorbs (targets are located through the instrument).
+  bool frame = false;
+  for (const std::string& name : rec.covariance_params) {
+    frame = frame || name.rfind("frame.", 0) == 0;
+  }
+  if (frame && !rec.has_frame) {
+    throw InputError(
+        "covariance: names frame parameters but fitted_on has "
+        "no frame");
+  }
+  auto tip = [&] {
+    const Eigen::Vector3d b =
+        ModelPoseAtReadings(state.chain, q, context).block<3, 1>(0, 3);
+    return frame ? Eigen::Vector3d(
+                       ApplyFrame(state.meas_from_base.data(), Vec3<double>(b)))
+                 : b;
+  };
   Eigen::MatrixXd jac(3, p);
   for (int k = 0; k < p; ++k) {
     const ParamInfo info = FindParam(state, rec.covariance_params[k]);
@@ -249,11 +314,9 @@ double TipSigmaMm(const Robot& robot, const Chain& chain,
     // A step of 1e-4 interface units (mm, deg, the families' units).
     const double h = info.FromInterface(1e-4);
     *value = v0 + h;
-    const Eigen::Vector3d plus =
-        ModelPoseAtReadings(state.chain, q, context).block<3, 1>(0, 3);
+    const Eigen::Vector3d plus = tip();
     *value = v0 - h;
-    const Eigen::Vector3d minus =
-        ModelPoseAtReadings(state.chain, q, context).block<3, 1>(0, 3);
+    const Eigen::Vector3d minus = tip();
     *value = v0;
     jac.col(k) = (plus - minus) / 2e-4;
   }
@@ -268,6 +331,12 @@ CompensateResult Compensate(const Robot& robot,
   if (options.ik.limits.empty()) options.ik.limits = JointLimits(robot);
   const Chain chain = Chain::FromRobot(robot);
   const Chain nominal = NominalChain(robot);
+  if (options.targets_in_measuring_frame && !robot.fitted_on.has_frame) {
+    throw InputError(
+        "targets in the measuring frame: the robot file records no frame "
+        "(fitted_on.frame); calibrate or diagnose it with a current kincal, "
+        "or give the targets in the base frame");
+  }
   CompensateResult result;
   WarnAboutTheModel(robot, chain, &result.warnings);
   std::vector<double> previous = options.start, previous_s;
@@ -281,13 +350,16 @@ CompensateResult Compensate(const Robot& robot,
     IkContext context = ContextFor(robot, chain, temp_c, t.id);
     CompensateTarget target = t;
     IkResult controller;
+    if (options.targets_in_measuring_frame && !t.from_joints) {
+      target.target = FromMeasuringFrame(robot.fitted_on, t.target);
+    }
     if (t.from_joints) {
       target.target = ProgramTarget(nominal, t.seed);
       controller.reached = true;
       controller.q = t.seed;
     } else {
-      controller = ControllerSolution(robot, nominal, target, previous_nom,
-                                      options);
+      controller =
+          ControllerSolution(robot, nominal, target, previous_nom, options);
     }
     out.q_nom = controller.q;
     if (!controller.reached) {

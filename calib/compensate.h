@@ -37,8 +37,8 @@ namespace kincal {
 
 struct CompensateTarget {
   std::string id;
-  IkTarget target;            // in the robot's base frame
-  std::vector<double> seed;   // readings (mm | deg); empty = none
+  IkTarget target;           // in the robot's base frame
+  std::vector<double> seed;  // readings (mm | deg); empty = none
   // A joint program's readings: the target is the nominal kinematics there.
   bool from_joints = false;
   double temp_c = std::numeric_limits<double>::quiet_NaN();
@@ -53,8 +53,12 @@ struct CompensateOptions {
   std::vector<double> start;
   // Largest difference between the compensated and the controller's
   // readings, per joint (deg | mm): more is another configuration.
-  double max_correction = 5.0;
+  double max_correction = 10.0;
   uint64_t seed = 1;  // multi-start of the first target without a seed
+  // Targets (x,y,z and rotation) given in the measuring frame the model was
+  // registered in (robot.yaml fitted_on.frame), e.g. points a tracker
+  // measured; false = in the robot's base frame.
+  bool targets_in_measuring_frame = false;
 };
 
 struct CompensatedTarget {
@@ -91,8 +95,10 @@ CompensateResult Compensate(const Robot& robot,
                             const std::vector<CompensateTarget>& targets,
                             const CompensateOptions& options);
 
-// sigma of the model's tip at readings q (mm, 3D): sqrt(trace(J C J^T));
-// NaN when the robot carries no covariance. Throws InputError when a
+// sigma of the model's tip at readings q (mm, 3D): sqrt(trace(J C J^T)),
+// with the tip in the measuring frame when the covariance carries the frame
+// (the targets are located through it); NaN when the robot carries no
+// covariance. Throws InputError when a
 // covariance parameter names nothing in the model.
 double TipSigmaMm(const Robot& robot, const Chain& chain,
                   const std::vector<double>& q, const IkContext& context);

@@ -147,7 +147,7 @@ TEST(CompensateTest, SigmaPropagatesTheCovariance) {
 TEST(CompensateTest, ExtrapolationAndUnreachableTargetsAreNamed) {
   Robot real = ExtendedUr10();
   real.fitted_on.poses = 100;
-  real.fitted_on.joint_range = {{-60, 60},  {-130, -50}, {50, 130},
+  real.fitted_on.joint_range = {{-60, 60},   {-130, -50}, {50, 130},
                                 {-150, -30}, {-150, -30}, {-90, 90}};
   auto targets = RandomTargets(real, 2, false, 9);
   targets[1].target.position_mm = Eigen::Vector3d(3000, 0, 0);  // too far

@@ -121,63 +121,70 @@ IkResult SolveIk(const Chain& chain, const IkTarget& target,
   Eigen::VectorXd seed_q(n);
   for (int j = 0; j < n; ++j) seed_q[j] = q[j];
   Eigen::VectorXd r = residual_at(q);
-  double lambda = 1e-3;
   int it = 0;
   std::vector<bool> fixed(n, false);
-  // Stops when the target is reached and the seed pull has no component
-  // left that keeps the target (the nearest solution to the seed).
-  double null_motion = std::numeric_limits<double>::infinity();
-  double pull_gain = 1.0;  // shrinks with rejected steps, like 1 / lambda
-  for (; it < options.max_iterations && !(converged(r) && null_motion < 1e-9);
-       ++it) {
-    // Central-difference Jacobian (internal units).
-    Eigen::MatrixXd jac(r.size(), n);
-    for (int j = 0; j < n; ++j) {
-      constexpr double kH = 1e-6;
-      std::vector<double> plus = q, minus = q;
-      plus[j] += kH;
-      minus[j] -= kH;
-      // Columns per reading unit (deg | mm): steps and the seed pull are
-      // measured in the units the joints are read in.
-      jac.col(j) =
-          (residual_at(plus) - residual_at(minus)) / (2 * kH) * unit[j];
-    }
-    // Joints on a limit whose unconstrained step points outward are held.
-    std::fill(fixed.begin(), fixed.end(), false);
-    Eigen::VectorXd toward(n);
-    for (int j = 0; j < n; ++j) {
-      toward[j] = pull_gain * (seed_q[j] - q[j]) / unit[j];
-    }
-    Eigen::VectorXd step = DampedStep(jac, r, fixed, lambda, toward);
-    for (int j = 0; j < n; ++j) {
-      fixed[j] = (q[j] <= limits.lo[j] && step[j] < 0) ||
-                 (q[j] >= limits.hi[j] && step[j] > 0);
-    }
-    step = DampedStep(jac, r, fixed, lambda, toward);
-    null_motion =
-        (step - DampedStep(jac, r, fixed, lambda, Eigen::VectorXd::Zero(n)))
-            .norm();
-    // Limit the largest joint change per iteration (reading units).
-    const double largest = step.cwiseAbs().maxCoeff();
-    if (largest > options.max_step) step *= options.max_step / largest;
-    std::vector<double> trial = q;
-    for (int j = 0; j < n; ++j) {
-      trial[j] =
-          std::clamp(q[j] + step[j] * unit[j], limits.lo[j], limits.hi[j]);
-    }
-    const Eigen::VectorXd r_trial = residual_at(trial);
-    // Accepted when the residual falls, or stays within the tolerance while
-    // the null-space pull moves toward the seed.
-    if (r_trial.squaredNorm() < r.squaredNorm() ||
-        (converged(r_trial) && null_motion > 1e-9)) {
-      q = trial;
-      r = r_trial;
-      lambda = std::max(lambda / 3.0, 1e-9);
-      pull_gain = std::min(1.0, 2.0 * pull_gain);
-    } else {
-      lambda *= 4.0;
-      pull_gain *= 0.25;
-      if (lambda > 1e8) break;
+  // Phase 0 pulls toward the seed; phase 1, only when phase 0 ends short of
+  // the target, finishes from there without the pull (plain damped least
+  // squares converges where the pull and the task fight).
+  for (int phase = 0; phase < 2 && !(phase == 1 && converged(r)); ++phase) {
+    double lambda = 1e-3;
+    // Stops when the target is reached and the seed pull has no component
+    // left that keeps the target (the nearest solution to the seed).
+    double null_motion = std::numeric_limits<double>::infinity();
+    // Shrinks with rejected steps, like 1 / lambda; 0 in phase 1.
+    double pull_gain = phase == 0 ? 1.0 : 0.0;
+    for (int k = 0;
+         k < options.max_iterations && !(converged(r) && null_motion < 1e-9);
+         ++k, ++it) {
+      // Central-difference Jacobian (internal units).
+      Eigen::MatrixXd jac(r.size(), n);
+      for (int j = 0; j < n; ++j) {
+        constexpr double kH = 1e-6;
+        std::vector<double> plus = q, minus = q;
+        plus[j] += kH;
+        minus[j] -= kH;
+        // Columns per reading unit (deg | mm): steps and the seed pull are
+        // measured in the units the joints are read in.
+        jac.col(j) =
+            (residual_at(plus) - residual_at(minus)) / (2 * kH) * unit[j];
+      }
+      // Joints on a limit whose unconstrained step points outward are held.
+      std::fill(fixed.begin(), fixed.end(), false);
+      Eigen::VectorXd toward(n);
+      for (int j = 0; j < n; ++j) {
+        toward[j] = pull_gain * (seed_q[j] - q[j]) / unit[j];
+      }
+      Eigen::VectorXd step = DampedStep(jac, r, fixed, lambda, toward);
+      for (int j = 0; j < n; ++j) {
+        fixed[j] = (q[j] <= limits.lo[j] && step[j] < 0) ||
+                   (q[j] >= limits.hi[j] && step[j] > 0);
+      }
+      step = DampedStep(jac, r, fixed, lambda, toward);
+      null_motion =
+          (step - DampedStep(jac, r, fixed, lambda, Eigen::VectorXd::Zero(n)))
+              .norm();
+      // Limit the largest joint change per iteration (reading units).
+      const double largest = step.cwiseAbs().maxCoeff();
+      if (largest > options.max_step) step *= options.max_step / largest;
+      std::vector<double> trial = q;
+      for (int j = 0; j < n; ++j) {
+        trial[j] =
+            std::clamp(q[j] + step[j] * unit[j], limits.lo[j], limits.hi[j]);
+      }
+      const Eigen::VectorXd r_trial = residual_at(trial);
+      // Accepted when the residual falls, or stays within the tolerance while
+      // the null-space pull moves toward the seed.
+      if (r_trial.squaredNorm() < r.squaredNorm() ||
+          (converged(r_trial) && null_motion > 1e-9)) {
+        q = trial;
+        r = r_trial;
+        lambda = std::max(lambda / 3.0, 1e-9);
+        if (phase == 0) pull_gain = std::min(1.0, 2.0 * pull_gain);
+      } else {
+        lambda *= 4.0;
+        pull_gain *= 0.25;
+        if (lambda > 1e8) break;
+      }
     }
   }
   IkResult out;

@@ -6,9 +6,9 @@
 #include <cmath>
 
 #include "calib/calibrate.h"
-#include "synth/simulate.h"
 #include "data/error.h"
 #include "data/robot.h"
+#include "synth/simulate.h"
 #include "tests/testing/paths.h"
 
 namespace kincal {

@@ -377,8 +377,8 @@ void ReadNominal(const YamlReader& r, const YAML::Node& n, Robot* robot) {
 void ReadFittedOn(const YamlReader& r, const YAML::Node& f, Robot* robot) {
   r.ExpectMap(f, "fitted_on");
   r.CheckKeys(f,
-              {"poses", "joints", "temp_c", "thermal_input", "heldout_rms_mm",
-               "systematic_rms_mm"},
+              {"poses", "joints", "temp_c", "thermal_input", "frame",
+               "heldout_rms_mm", "systematic_rms_mm"},
               "fitted_on");
   FitRecord& rec = robot->fitted_on;
   rec.poses = r.Integer(r.Required(f, "poses", "fitted_on"), "fitted_on.poses");
@@ -406,6 +406,11 @@ void ReadFittedOn(const YamlReader& r, const YAML::Node& f, Robot* robot) {
     const auto t = r.Numbers(f["temp_c"], "fitted_on.temp_c", 2, 2);
     rec.temp_lo_c = t[0];
     rec.temp_hi_c = t[1];
+  }
+  if (f["frame"]) {
+    const auto v = r.Numbers(f["frame"], "fitted_on.frame", 6, 6);
+    rec.has_frame = true;
+    for (int k = 0; k < 6; ++k) rec.frame[k] = v[k];
   }
   if (f["thermal_input"]) {
     rec.thermal_input = r.String(f["thermal_input"], "fitted_on.thermal_input");
@@ -544,6 +549,13 @@ void FormatFitRecord(const Robot& robot, std::ostringstream& os) {
     if (rec.temp_lo_c == rec.temp_lo_c) {
       os << "  temp_c: [" << FormatDouble(rec.temp_lo_c) << ", "
          << FormatDouble(rec.temp_hi_c) << "]\n";
+    }
+    if (rec.has_frame) {
+      os << "  frame: [";  // meas_from_base: rotation vector deg, mm
+      for (int k = 0; k < 6; ++k) {
+        os << (k ? ", " : "") << FormatDouble(rec.frame[k]);
+      }
+      os << "]\n";
     }
     if (!rec.thermal_input.empty()) {
       os << "  thermal_input: " << rec.thermal_input << "\n";

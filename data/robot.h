@@ -81,13 +81,18 @@ struct FitRecord {
   // Input of the thermal extension: "temp_c" (per K of temp_c - 20) or
   // "hours" (per hour since the first timed row); "" = no thermal term.
   std::string thermal_input;
+  // The measuring frame the model was registered in (meas_from_base:
+  // rotation vector in deg, translation in mm); has_frame false = unknown.
+  bool has_frame = false;
+  std::array<double, 6> frame{};
   // Held-out tip RMS of the model (3D, mm) and the part of its residual above
   // the measurement noise (3D RMS, mm; 0 when none is detected); NaN = unknown.
   double heldout_rms_mm = std::numeric_limits<double>::quiet_NaN();
   double systematic_rms_mm = std::numeric_limits<double>::quiet_NaN();
   // Covariance of the fitted robot parameters (names as in
   // docs/CONVENTIONS.md "Parameter names", interface units: mm, deg, the
-  // families' units; the measuring frame excluded). Empty = unknown.
+  // families' units; frame.* is the measuring frame, fixed points are left
+  // out). Empty = unknown.
   std::vector<std::string> covariance_params;
   Eigen::MatrixXd covariance;
 

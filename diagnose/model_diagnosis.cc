@@ -11,6 +11,7 @@
 
 #include "calib/calibrate.h"
 #include "calib/exact_jacobian.h"
+#include "calib/fit_record.h"
 #include "calib/free_fit.h"
 #include "calib/holdout.h"
 #include "calib/identifiability.h"
@@ -811,10 +812,14 @@ std::vector<Candidate> SelectCandidates(const Selection& selection,
 }
 
 // Step 5: the selected model refitted on all poses; the findings' magnitudes
-// and 95 % intervals from its covariance. Returns the refitted model.
-ModelState FinalRefit(const Selection& selection, const CurrentModel& current,
-                      const std::vector<Candidate>& accepted,
-                      DiagnosisResult* out) {
+// and 95 % intervals from its covariance. Returns the refitted model and its
+// fit.
+struct Refit {
+  ModelState state;
+  FitSummary fit;
+};
+Refit FinalRefit(const Selection& selection, const CurrentModel& current,
+                 const std::vector<Candidate>& accepted, DiagnosisResult* out) {
   ModelState final_state = current.state;
   FitOptions fit_options = selection.problem.Boxed(current.free);
   fit_options.compute_covariance = true;
@@ -829,7 +834,7 @@ ModelState FinalRefit(const Selection& selection, const CurrentModel& current,
     out->findings[i].ci_low = m.ci_low;
     out->findings[i].ci_high = m.ci_high;
   }
-  return final_state;
+  return {final_state, final_fit};
 }
 
 // Step 6: the measurement noise per axis: stated, from repeated poses, or an
@@ -936,13 +941,42 @@ DiagnosisResult DiagnoseModel(const Robot& nominal, const Observations& obs,
       current.rss / std::max(1, selection.num_residuals -
                                     static_cast<int>(current.free.size())));
 
-  const ModelState final_state = FinalRefit(selection, current, accepted, &out);
+  const Refit refit = FinalRefit(selection, current, accepted, &out);
+  const ModelState& final_state = refit.state;
   EstimateNoise(options, problem, current.state, &out);
   UnexplainedRest(selection, current, &out);
   out.verdict = out.findings.empty() ? "no_significant_effect" : "effect_found";
   PerPoseResiduals(problem, final_state, &out);
   out.state = final_state;
-  out.extended = final_state.chain.ToRobot(nominal);
+  FitRecordInput record;
+  record.obs = &obs;
+  record.fit = &refit.fit;
+  record.state = &final_state;
+  record.heldout_rms_mm = out.final_heldout_rms_mm;
+  // The unexplained part of the residual: above a noise level that is known
+  // (stated, or from repeated poses), the systematic rest where the residual
+  // variance exceeds the noise's by more than 3 of its standard errors
+  // (s^2 / n^2 - 1 > 3 sqrt(2 / dof); below that it is the sampling scatter
+  // of s); above the nearest-pose estimate, which can fall either side of
+  // the noise, only an `unexplained` finding (else 0); unknown without a
+  // noise level.
+  const int dof =
+      selection.num_residuals - static_cast<int>(current.free.size());
+  if ((out.noise_source == "stated" || out.noise_source == "repeated poses") &&
+      dof > 0) {
+    const double excess = out.residual_sigma_mm * out.residual_sigma_mm /
+                              (out.noise_mm * out.noise_mm) -
+                          1.0;
+    record.systematic_rms_mm =
+        excess > 3.0 * std::sqrt(2.0 / dof) ? out.systematic_rms_mm : 0.0;
+  } else if (out.noise_source != "none") {
+    record.systematic_rms_mm = 0.0;
+    for (const Finding& f : out.findings) {
+      if (f.cause == "unexplained") record.systematic_rms_mm = f.magnitude;
+    }
+  }
+  out.extended =
+      WithFitRecord(final_state.chain.ToRobot(nominal), nominal, record);
   out.seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start)
           .count();

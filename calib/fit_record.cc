@@ -1,0 +1,88 @@
+#include "calib/fit_record.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "calib/chain.h"
+
+namespace kincal {
+
+FitRecord MakeFitRecord(const FitRecordInput& input) {
+  FitRecord rec;
+  const Observations& obs = *input.obs;
+  std::vector<int> rows = input.rows;
+  if (rows.empty()) {
+    for (size_t i = 0; i < obs.rows.size(); ++i) {
+      rows.push_back(static_cast<int>(i));
+    }
+  }
+  rec.poses = static_cast<int>(rows.size());
+  const size_t n = obs.joint_names.size();
+  rec.joint_range.assign(n, {std::numeric_limits<double>::infinity(),
+                             -std::numeric_limits<double>::infinity()});
+  for (int i : rows) {
+    const Observation& o = obs.rows[i];
+    for (size_t j = 0; j < n; ++j) {
+      rec.joint_range[j][0] = std::min(rec.joint_range[j][0], o.q[j]);
+      rec.joint_range[j][1] = std::max(rec.joint_range[j][1], o.q[j]);
+    }
+    if (o.HasTemp()) {
+      rec.temp_lo_c = rec.temp_lo_c == rec.temp_lo_c
+                          ? std::min(rec.temp_lo_c, o.temp_c)
+                          : o.temp_c;
+      rec.temp_hi_c = rec.temp_hi_c == rec.temp_hi_c
+                          ? std::max(rec.temp_hi_c, o.temp_c)
+                          : o.temp_c;
+    }
+  }
+  rec.thermal_input = ThermalUsesTemperature(obs) ? "temp_c" : "hours";
+  if (input.state != nullptr) {
+    rec.has_frame = true;
+    const auto& f = input.state->meas_from_base;
+    for (int k = 0; k < 3; ++k) {
+      rec.frame[k] = f[k] * 180.0 / M_PI;
+      rec.frame[k + 3] = f[k + 3];
+    }
+  }
+  rec.heldout_rms_mm = input.heldout_rms_mm;
+  rec.systematic_rms_mm = input.systematic_rms_mm;
+  const FitSummary* fit = input.fit;
+  if (fit == nullptr ||
+      fit->covariance.rows() != static_cast<int>(fit->params.size())) {
+    return rec;
+  }
+  std::vector<int> keep;
+  for (size_t k = 0; k < fit->params.size(); ++k) {
+    const ParamKind kind = fit->params[k].kind;
+    if (kind != ParamKind::kPoint) {
+      keep.push_back(static_cast<int>(k));
+    }
+  }
+  const int p = static_cast<int>(keep.size());
+  rec.covariance.resize(p, p);
+  for (int a = 0; a < p; ++a) {
+    const ParamInfo& pa = fit->params[keep[a]];
+    rec.covariance_params.push_back(pa.name);
+    for (int b = 0; b < p; ++b) {
+      const ParamInfo& pb = fit->params[keep[b]];
+      // Internal -> interface: ToInterface is linear (rad -> deg).
+      rec.covariance(a, b) = fit->covariance(keep[a], keep[b]) *
+                             pa.ToInterface(1.0) * pb.ToInterface(1.0);
+    }
+  }
+  if (!rec.covariance.allFinite()) {
+    rec.covariance_params.clear();
+    rec.covariance.resize(0, 0);
+  }
+  return rec;
+}
+
+Robot WithFitRecord(const Robot& calibrated, const Robot& nominal,
+                    const FitRecordInput& input) {
+  Robot out = calibrated;
+  out.SetNominal(nominal);
+  out.fitted_on = MakeFitRecord(input);
+  return out;
+}
+
+}  // namespace kincal

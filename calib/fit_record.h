@@ -1,0 +1,39 @@
+#ifndef KINCAL_CALIB_FIT_RECORD_H_
+#define KINCAL_CALIB_FIT_RECORD_H_
+
+// The record a calibrated robot file carries of what it was fitted on
+// (robot.yaml `nominal:`, `fitted_on:`, `covariance:`; data/robot.h
+// FitRecord): written by calibrate and diagnose, read by compensate.
+
+#include <limits>
+#include <vector>
+
+#include "calib/fit.h"
+#include "data/observations.h"
+#include "data/robot.h"
+
+namespace kincal {
+
+struct FitRecordInput {
+  const Observations* obs = nullptr;  // the rows the model was fitted on
+  std::vector<int> rows;              // their indices; empty = all rows
+  const FitSummary* fit = nullptr;    // covariance source; may be null
+  const ModelState* state = nullptr;  // its measuring frame; may be null
+  double heldout_rms_mm = std::numeric_limits<double>::quiet_NaN();
+  double systematic_rms_mm = std::numeric_limits<double>::quiet_NaN();
+};
+
+// The record: the rows' joint travel and temperature range, the thermal
+// input (temp_c when the rows' temperatures vary, else hours), the fit's
+// measuring frame, the covariance of the robot's and the frame's parameters
+// in interface units (fixed points left out: they are not part of the robot;
+// the frame stays, as the targets are located through it).
+FitRecord MakeFitRecord(const FitRecordInput& input);
+
+// `calibrated` with the record and `nominal`'s rows as its nominal.
+Robot WithFitRecord(const Robot& calibrated, const Robot& nominal,
+                    const FitRecordInput& input);
+
+}  // namespace kincal
+
+#endif  // KINCAL_CALIB_FIT_RECORD_H_
