@@ -18,6 +18,7 @@ namespace {
 
 struct ExportArgs {
   std::string robot, out, root, tip;
+  std::string robot_base = "base";  // ur-calibration
   bool json = false;
 };
 
@@ -78,15 +79,23 @@ nlohmann::json TcpJson(const UrTcp& tcp) {
 
 int RunExportUrCalibration(const ExportArgs& args) {
   const Robot robot = ReadRobot(args.robot, args.root, args.tip);
-  const UrCalibrationExport e = ExportUrCalibration(robot, args.robot);
+  Warnings warnings = CommandWarnings();
+  const UrCalibrationExport e = ExportUrCalibration(
+      robot, args.robot,
+      args.robot_base == "base_link" ? UrRobotBase::kBaseLink
+                                     : UrRobotBase::kBase,
+      &warnings);
   WriteFileAtomic(args.out, e.yaml);
   if (args.json) {
-    PrintJson({{"out", args.out},
-               {"robot", robot.name},
-               {"convention_in", ToString(robot.convention)},
-               {"hash", e.kinematics.hash},
-               {"tcp", TcpJson(e.tcp)},
-               {"not_exported", e.not_exported}});
+    nlohmann::json j = {{"out", args.out},
+                        {"robot", robot.name},
+                        {"convention_in", ToString(robot.convention)},
+                        {"robot_base", args.robot_base},
+                        {"hash", e.kinematics.hash},
+                        {"tcp", TcpJson(e.tcp)},
+                        {"not_exported", e.not_exported}};
+    AddWarnings(warnings, &j);
+    PrintJson(j);
     return 0;
   }
   std::printf("kincal export ur-calibration: %s (from %s) -> %s (%s)\n",
@@ -163,6 +172,12 @@ void AddExportCommand(CLI::App& app, Runner* run) {
       "extensions have no field there and are listed in 'not_exported'. "
       "Exit 2 unless the robot has exactly 6 revolute joints.");
   AddCommon(ur, ur_args.get(), "kinematics YAML to write (atomically)");
+  ur->add_option("--robot-base", ur_args->robot_base,
+                 "the robot file's base frame: base (the controller's Base, "
+                 "UR's DH, data/robots/ur10.yaml) or base_link (ROS, e.g. "
+                 "ur_description's URDF from base_link)")
+      ->check(CLI::IsMember({"base", "base_link"}))
+      ->capture_default_str();
   ur->footer(
       "Example:\n"
       "  kincal export ur-calibration --robot data/robots/ur10.yaml --out "

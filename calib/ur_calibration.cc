@@ -127,6 +127,7 @@ std::string TcpText(const UrTcp& tcp) {
 
 std::vector<std::string> HeaderComment(const Robot& robot,
                                        const std::string& robot_file,
+                                       UrRobotBase base,
                                        const UrCalibrationExport& e) {
   std::vector<std::string> c = {
       "written by " + ToolVersion() + ": " + CommandLine(),
@@ -137,8 +138,12 @@ std::vector<std::string> HeaderComment(const Robot& robot,
       "Per joint: its <origin> in the description, x y z in m, roll pitch "
       "yaw in rad (URDF: Rz(yaw) Ry(pitch) Rx(roll)); the joint turns about "
       "its z axis after it.",
-      "Base frame: the controller's Base (ROS `base`, base_link_inertia = "
-      "base_link turned 180 deg about z), the robot file's base frame.",
+      base == UrRobotBase::kBase
+          ? "Base frame: the controller's Base (ROS `base`, base_link_inertia "
+            "= base_link turned 180 deg about z), the robot file's base frame."
+          : "Base frame: the robot file's base is ROS base_link (--robot-base "
+            "base_link); the entries start at base_link_inertia, base_link "
+            "turned 180 deg about z.",
       "Use: ur_robot_driver kinematics_params_file:=<this file> (ROS 2) or "
       "kinematics_config:=<this file> (ROS 1).",
       "TCP offset to set on the pendant (tip in the tool flange frame "
@@ -154,6 +159,30 @@ std::vector<std::string> HeaderComment(const Robot& robot,
     }
   }
   return c;
+}
+
+// A UR arm at zero joint angles reaches out along -x of the controller's
+// Base (the upper arm and forearm have negative DH a) and along +x of
+// base_link: a flange far out on the other side names the likely mix-up.
+void CheckBaseFrame(const Chain& chain, UrRobotBase base, Warnings* warnings) {
+  const Eigen::Vector3d flange =
+      BaseFromTipAt(chain, std::vector<double>(kUrJoints, 0.0))
+          .block<3, 1>(0, 3);
+  const double out = base == UrRobotBase::kBase ? flange.x() : -flange.x();
+  if (out > 100.0 && std::abs(flange.x()) > std::abs(flange.y())) {
+    const bool at_base = base == UrRobotBase::kBase;
+    warnings->Add(
+        "ur_base_frame",
+        "at zero joint angles the tip of robot '" + chain.name +
+            "' is at x = " + Fixed(flange.x(), 1) +
+            " mm in its base frame; a UR arm at zero "
+            "reaches along " +
+            (at_base ? "-x of the controller's Base" : "+x of base_link") +
+            ": is the robot file's base " +
+            (at_base
+                 ? "ROS base_link? then give --robot-base base_link"
+                 : "the controller's Base? then leave --robot-base at base"));
+  }
 }
 
 std::uint64_t Fnv1a(const std::string& text) {
@@ -212,10 +241,14 @@ UrTcp TcpFromTransform(const Eigen::Matrix4d& tool0_from_tip) {
 }
 
 UrKinematics UrKinematicsFromChain(const Chain& chain,
-                                   Eigen::Matrix4d* tool0_from_tip) {
+                                   Eigen::Matrix4d* tool0_from_tip,
+                                   UrRobotBase base) {
   RequireUrArm(chain);
   UrKinematics k;
+  // Entry 1 starts at `base`: a robot file based at base_link is moved.
   Eigen::Matrix4d post_prev = Eigen::Matrix4d::Identity();
+  if (base == UrRobotBase::kBaseLink)
+    post_prev = UrBaseLinkFromBase().inverse();
   for (int j = 0; j < kUrJoints; ++j) {
     const SplitRow s =
         Split(chain.convention, chain.rows[j].p, chain.rows[j].axis);
@@ -243,10 +276,12 @@ std::string UrKinematicsHash(const UrKinematics& kinematics) {
 }
 
 UrCalibrationExport ExportUrCalibration(const Robot& robot,
-                                        const std::string& robot_file) {
+                                        const std::string& robot_file,
+                                        UrRobotBase base, Warnings* warnings) {
   const Chain chain = Chain::FromRobot(robot);
   UrCalibrationExport out;
-  out.kinematics = UrKinematicsFromChain(chain, &out.tool0_from_tip);
+  out.kinematics = UrKinematicsFromChain(chain, &out.tool0_from_tip, base);
+  if (warnings != nullptr) CheckBaseFrame(chain, base, warnings);
   out.tcp = TcpFromTransform(out.tool0_from_tip);
   for (const Extension& e : robot.extensions) {
     out.not_exported.push_back(DescribeExtension(e));
@@ -254,8 +289,8 @@ UrCalibrationExport ExportUrCalibration(const Robot& robot,
   out.not_exported.push_back(
       "tool (not part of UR's kinematics): set as the pendant's TCP offset " +
       TcpText(out.tcp));
-  out.yaml = FormatUrKinematicsYaml(out.kinematics,
-                                    HeaderComment(robot, robot_file, out));
+  out.yaml = FormatUrKinematicsYaml(
+      out.kinematics, HeaderComment(robot, robot_file, base, out));
   return out;
 }
 

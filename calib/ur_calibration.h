@@ -44,6 +44,7 @@
 
 #include "calib/chain.h"
 #include "data/robot.h"
+#include "data/warnings.h"
 
 namespace kincal {
 
@@ -78,15 +79,27 @@ struct UrCalibrationExport {
   std::string yaml;  // the file, with its comment header
 };
 
+// Which frame of the description the robot file's base frame is: `base`
+// (base_link_inertia, the controller's Base: UR's DH, data/robots/ur10.yaml)
+// or `base_link` (ROS REP-103, e.g. a chain read from ur_description's URDF
+// with root base_link).
+enum class UrRobotBase { kBase, kBaseLink };
+
 // The six entries (and tool0_from_tip, mm) of a chain with six revolute
 // joints; the joint error models are ignored. Throws InputError naming why
 // when the chain is not a 6-revolute-joint arm.
 UrKinematics UrKinematicsFromChain(const Chain& chain,
-                                   Eigen::Matrix4d* tool0_from_tip);
+                                   Eigen::Matrix4d* tool0_from_tip,
+                                   UrRobotBase base = UrRobotBase::kBase);
 
 // The export of `robot` (`robot_file` is named in the comment header).
+// `warnings` (may be null) gets "ur_base_frame" when the arm at zero joint
+// angles points along +x of the stated base: in the controller's Base a UR
+// arm at zero points along -x, in base_link along +x.
 UrCalibrationExport ExportUrCalibration(const Robot& robot,
-                                        const std::string& robot_file);
+                                        const std::string& robot_file,
+                                        UrRobotBase base = UrRobotBase::kBase,
+                                        Warnings* warnings = nullptr);
 
 // Deterministic hash of the 36 values (FNV-1a, 64 bit, over their shortest
 // round-trip text): "calib_<decimal>".

@@ -376,6 +376,37 @@ TEST(UrCalibrationTest, FileCarriesProvenanceTcpAndNotExported) {
             e.kinematics.hash);
 }
 
+// A robot file based at ROS base_link (the controller's Base turned 180 deg
+// about z: theta1 + 180 deg in DH) exports the same entries with
+// --robot-base base_link, and the wrong choice is named by a warning.
+TEST(UrCalibrationTest, RobotBasedAtBaseLink) {
+  const UrCalibrationExport nominal = ExportUrCalibration(Ur10(), "ur10.yaml");
+  Robot at_base_link = Ur10();
+  at_base_link.joints[0].theta_deg += 180.0;
+  Warnings none;
+  const UrCalibrationExport e = ExportUrCalibration(
+      at_base_link, "bl.yaml", UrRobotBase::kBaseLink, &none);
+  EXPECT_TRUE(none.empty());
+  for (int j = 0; j < kUrJoints; ++j) {
+    EXPECT_LT((UrEntryTransform(e.kinematics.entries[j]) -
+               UrEntryTransform(nominal.kinematics.entries[j]))
+                  .cwiseAbs()
+                  .maxCoeff(),
+              1e-9)
+        << kUrEntryNames[j];
+  }
+  EXPECT_THAT(e.yaml, HasSubstr("--robot-base base_link"));
+  Warnings wrong;
+  ExportUrCalibration(at_base_link, "bl.yaml", UrRobotBase::kBase, &wrong);
+  ASSERT_TRUE(wrong.Has("ur_base_frame"));
+  EXPECT_THAT(wrong.list()[0].message, HasSubstr("--robot-base base_link"));
+  Warnings right;
+  ExportUrCalibration(Ur10(), "ur10.yaml", UrRobotBase::kBase, &right);
+  EXPECT_TRUE(right.empty());
+  ExportUrCalibration(Ur10(), "ur10.yaml", UrRobotBase::kBaseLink, &right);
+  EXPECT_TRUE(right.Has("ur_base_frame"));
+}
+
 TEST(UrCalibrationTest, RobotsTheFormatCannotExpressAreRefused) {
   Robot five = Ur10();
   five.joints.pop_back();
