@@ -20,8 +20,9 @@
 // its own z axis. base_link_inertia has the orientation of the controller's
 // Base frame (ROS `base`, also base_link turned pi about z) and is the base
 // frame of kincal's UR robots (data/robots/ur10.yaml: UR's standard DH).
-// tool0 is the controller's tool flange frame: the pendant's TCP offset is
-// given in it.
+// wrist_3_link is the DH frame after joint 6; tool0 (wrist_3_link turned
+// pi about z) is the controller's tool flange frame, its all-zeros TCP: the
+// pendant's TCP offset is given in it.
 //
 // Export (any kincal convention): a joint row is split into a part before
 // its motion and a part after it, A_k(q) = pre_k Rz(q) post_k:
