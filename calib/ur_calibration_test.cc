@@ -275,6 +275,32 @@ TEST(UrCalibrationTest, RoundTripOfCalibratedDhVariants) {
   EXPECT_LT(worst_flange.rotation, 1e-12);
 }
 
+// Without betas the entries are the ones ur_calibration builds from a
+// controller's DH (calibration.cpp, buildChain / getSimplified):
+// entry 1 = Rz(theta1) Tz(d1), entry k = [Tx(a_k-1) Rx(alpha_k-1)]
+// [Rz(theta_k) Tz(d_k)].
+TEST(UrCalibrationTest, EntriesAreUrCalibrationsSegments) {
+  std::mt19937_64 rng(23);
+  for (int trial = 0; trial < 5; ++trial) {
+    Robot robot = PerturbedUr10(&rng, false);
+    for (RobotRow& row : robot.joints) row.beta_deg = 0.0;
+    const UrCalibrationExport e = ExportUrCalibration(robot, "cal.yaml");
+    Eigen::Matrix4d passive = Eigen::Matrix4d::Identity();
+    for (int k = 0; k < kUrJoints; ++k) {
+      const RobotRow& row = robot.joints[k];
+      const Eigen::Matrix4d active = internal::RotZ(row.theta_deg * kDeg) *
+                                     internal::Trans(0.0, 0.0, row.d_mm);
+      EXPECT_LT((UrEntryTransform(e.kinematics.entries[k]) - passive * active)
+                    .cwiseAbs()
+                    .maxCoeff(),
+                1e-9)
+          << kUrEntryNames[k];
+      passive = internal::Trans(row.a_mm, 0.0, 0.0) *
+                internal::RotX(row.alpha_deg * kDeg);
+    }
+  }
+}
+
 TEST(UrCalibrationTest, RoundTripOfMdhAndUrdfVariants) {
   // The MDH form has the nominal kinematics of the DH file.
   const Chain dh = Chain::FromRobot(Ur10());
