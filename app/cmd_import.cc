@@ -1,4 +1,5 @@
-// kincal import: converts public real-data sets into observations.csv.
+// kincal import: converts public real-data sets into observations.csv, and
+// a Universal Robots kinematics YAML into robot.yaml.
 //   kincal import ipa-ur10 --in Series_C/measurements_random_poses.csv --out
 //   O.csv kincal import mukca --dir mukca/data/panda_6/front --out O.csv
 
@@ -8,6 +9,7 @@
 
 #include "app/app_util.h"
 #include "app/command.h"
+#include "calib/ur_calibration.h"
 #include "data/atomic_file.h"
 #include "data/error.h"
 #include "data/import_ipa.h"
@@ -83,6 +85,35 @@ int RunMukca(const ImportArgs& args) {
                  "50 mm apart (use --fixed-distance hole_0,hole_1,50)"});
 }
 
+struct UrImportArgs {
+  std::string in, out, name = "UR";
+  bool json = false;
+};
+
+int RunUrCalibration(const UrImportArgs& args) {
+  const UrKinematics k = ReadUrKinematicsYaml(args.in);
+  const Robot robot = RobotFromUrKinematics(k, args.name);
+  WriteFileAtomic(
+      args.out,
+      FormatRobotYaml(
+          robot,
+          {"imported from " + args.in + " (Universal Robots kinematics YAML" +
+               (k.hash.empty() ? std::string() : ", " + k.hash) +
+               "): each joint's origin as a urdf row, m -> mm, rad -> deg",
+           "base frame: the controller's Base (ROS base_link_inertia); the "
+           "tool row ends at tool0 (zero TCP): put the tool's TCP after it"}));
+  if (args.json) {
+    PrintJson({{"out", args.out},
+               {"robot", robot.name},
+               {"joints", robot.JointNames()},
+               {"hash", k.hash}});
+  } else {
+    std::printf("kincal import ur-calibration: %s -> %s\n", args.in.c_str(),
+                args.out.c_str());
+  }
+  return 0;
+}
+
 void CommonOptions(CLI::App* sub, ImportArgs* args) {
   sub->add_option("--out", args->out, "observations.csv to write")->required();
   AddRobotOptions(sub, &args->robot, &args->root, &args->tip,
@@ -122,6 +153,21 @@ void AddImportCommand(CLI::App& app, Runner* run) {
       "Example:\n  kincal import mukca --dir "
       "../shared/data/mukca/data/panda_6/front --out panda_front.csv"));
   s2->callback([run, mukca] { *run = [mukca] { return RunMukca(*mukca); }; });
+
+  auto ur = std::make_shared<UrImportArgs>();
+  CLI::App* s3 = sub->add_subcommand(
+      "ur-calibration",
+      "Universal Robots kinematics YAML (ur_description "
+      "default_kinematics.yaml, ur_calibration's output) -> robot.yaml "
+      "(convention urdf, tool row = tool0)");
+  s3->add_option("--in", ur->in, "kinematics YAML")->required();
+  s3->add_option("--out", ur->out, "robot.yaml to write")->required();
+  s3->add_option("--name", ur->name, "robot name")->capture_default_str();
+  s3->add_flag("--json", ur->json, "print one JSON object");
+  s3->footer(HelpFooter(
+      "Example:\n  kincal import ur-calibration --in "
+      "my_robot_calibration.yaml --name UR10 --out ur10_factory.yaml"));
+  s3->callback([run, ur] { *run = [ur] { return RunUrCalibration(*ur); }; });
 }
 
 }  // namespace kincal::app

@@ -38,18 +38,6 @@ std::string CommentText(std::string s) {
   return s;
 }
 
-// R = Rz(yaw) Ry(pitch) Rx(roll) -> (roll, pitch, yaw), exact also at
-// pitch = +-90 deg (roll set to 0 there).
-Eigen::Vector3d MatrixToRpy(const Eigen::Matrix3d& r) {
-  const double c = std::hypot(r(0, 0), r(1, 0));
-  const double pitch = std::atan2(-r(2, 0), c);
-  if (c < 1e-10) {
-    return Eigen::Vector3d(0.0, pitch, std::atan2(-r(0, 1), r(1, 1)));
-  }
-  return Eigen::Vector3d(std::atan2(r(2, 1), r(2, 2)), pitch,
-                         std::atan2(r(1, 0), r(0, 0)));
-}
-
 std::string Origin(const Eigen::Matrix4d& m_mm) {
   const Eigen::Vector3d rpy = MatrixToRpy(m_mm.block<3, 3>(0, 0));
   const Eigen::Vector3d t = m_mm.block<3, 1>(0, 3) / 1000.0;
@@ -63,13 +51,23 @@ Eigen::Matrix4d RowAtZero(const Chain& chain, int i) {
                               chain.rows[i].p.data(), 0.0);
 }
 
+}  // namespace
+
+Eigen::Vector3d MatrixToRpy(const Eigen::Matrix3d& r) {
+  const double c = std::hypot(r(0, 0), r(1, 0));
+  const double pitch = std::atan2(-r(2, 0), c);
+  if (c < 1e-10) {
+    return Eigen::Vector3d(0.0, pitch, std::atan2(-r(0, 1), r(1, 1)));
+  }
+  return Eigen::Vector3d(std::atan2(r(2, 1), r(2, 2)), pitch,
+                         std::atan2(r(1, 0), r(0, 0)));
+}
+
 std::string DescribeExtension(const Extension& e) {
   std::string s = e.cause + (e.joint.empty() ? "" : " " + e.joint) + ":";
   for (const auto& [k, v] : e.values) s += " " + k + "=" + Short(v);
   return s;
 }
-
-}  // namespace
 
 UrdfExport ExportUrdf(const Robot& robot) {
   const Chain chain = Chain::FromRobot(robot);

@@ -21,6 +21,7 @@
 // `not_exported` and in a comment of the URDF. axis_tilt (a row's beta) is
 // geometry and is exported.
 
+#include <Eigen/Core>
 #include <string>
 #include <vector>
 
@@ -46,6 +47,14 @@ UrdfExport ExportUrdf(const Robot& robot);
 // bounds and extensions kept). Throws InputError when joint 1's axis is not
 // the base z axis (with the axis found).
 Robot ConvertToDh(const Robot& robot);
+
+// R = Rz(yaw) Ry(pitch) Rx(roll) -> (roll, pitch, yaw) in rad (URDF rpy),
+// exact also at pitch = +-90 deg (roll set to 0 there).
+Eigen::Vector3d MatrixToRpy(const Eigen::Matrix3d& r);
+
+// One model extension in words for `not_exported` lists, e.g.
+// "backlash j3: width=0.151".
+std::string DescribeExtension(const Extension& e);
 
 }  // namespace kincal
 

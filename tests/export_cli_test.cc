@@ -1,6 +1,7 @@
-// kincal export urdf | dh end to end: JSON fields, the URDF read back has the
-// robot file's kinematics, check_urdf accepts it, extensions are listed, bad
-// input exits 2 and writes nothing.
+// kincal export urdf | dh | ur-calibration end to end: JSON fields, the URDF
+// read back has the robot file's kinematics, check_urdf accepts it,
+// extensions are listed, bad input exits 2 and writes nothing; the UR
+// kinematics file imported back has the robot file's kinematics.
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -97,6 +98,49 @@ TEST(ExportCliTest, BadInputExitsTwoAndWritesNothing) {
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_THAT(r.err, HasSubstr("base z axis"));
   EXPECT_FALSE(Exists(dir + "/x.yaml"));
+}
+
+TEST(ExportCliTest, UrCalibrationWritesKinematicsAndImportsBack) {
+  const std::string dir = testing::MakeTempDir("export_ur");
+  std::ofstream(dir + "/cal.yaml")
+      << ReadFile(testing::SourceDir() + "/data/robots/ur10.yaml") +
+             "extensions:\n  - {cause: backlash, joint: elbow_joint, width: "
+             "0.02}\n";
+  const auto r = RunKincal("export ur-calibration --robot " + dir +
+                           "/cal.yaml --out " + dir + "/kin.yaml --json");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["out"], dir + "/kin.yaml");
+  ASSERT_EQ(j["not_exported"].size(), 2u);
+  EXPECT_THAT(j["not_exported"][0].get<std::string>(), HasSubstr("backlash"));
+  EXPECT_THAT(j["not_exported"][1].get<std::string>(), HasSubstr("TCP"));
+  EXPECT_NEAR(j["tcp"]["z_mm"].get<double>(), 93.0, 1e-9);
+  const std::string text = ReadFile(dir + "/kin.yaml");
+  EXPECT_THAT(text, HasSubstr("export ur-calibration"));  // provenance
+  EXPECT_THAT(text, HasSubstr("hash: " + j["hash"].get<std::string>()));
+  const auto i =
+      RunKincal("import ur-calibration --in " + dir +
+                "/kin.yaml --name UR10 --out " + dir + "/back.yaml --json");
+  ASSERT_EQ(i.exit_code, 0) << i.err;
+  // The import ends at tool0 (zero TCP); with the exported TCP put back as
+  // the tool row it is the robot file's kinematics.
+  Robot back = ReadRobotYaml(dir + "/back.yaml");
+  EXPECT_EQ(back.convention, Convention::kUrdf);
+  back.tool.xyz_mm = Eigen::Vector3d(0, 0, 93.0);  // wrist_3_link axes
+  back.tool.rpy_deg = Eigen::Vector3d::Zero();
+  Robot plain = ReadRobotYaml(dir + "/cal.yaml");
+  plain.extensions.clear();
+  EXPECT_LT(MaxTipDifference(plain, back), 1e-9);
+}
+
+TEST(ExportCliTest, UrCalibrationRefusesOtherArms) {
+  const std::string dir = testing::MakeTempDir("export_ur_bad");
+  const auto r =
+      RunKincal("export ur-calibration --robot " + testing::SourceDir() +
+                "/data/robots/bh7.yaml --out " + dir + "/k.yaml");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_THAT(r.err, HasSubstr("6 revolute joints"));
+  EXPECT_FALSE(Exists(dir + "/k.yaml"));
 }
 
 }  // namespace
