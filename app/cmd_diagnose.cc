@@ -203,6 +203,7 @@ int RunCompare(const CompareArgs& args) {
                 c.unit.c_str(), b, a, c.z, c.changed ? "yes" : "no");
   }
   std::printf("  verdict: %s (|z| > %.2f)\n", r.verdict.c_str(), r.z_critical);
+  std::printf("%s", CompareIso9283Text(r).c_str());
   return 0;
 }
 

@@ -29,6 +29,7 @@ void AddPlanCommand(CLI::App& app, Runner* run);
 void AddBundleCommand(CLI::App& app, Runner* run);
 void AddTargetCommand(CLI::App& app, Runner* run);
 void AddPrintCommand(CLI::App& app, Runner* run);
+void AddIso9283Command(CLI::App& app, Runner* run);
 
 // Prints a result object as one line of JSON on stdout, with the command line
 // and tool version added ("command", "kincal_version").
