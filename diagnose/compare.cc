@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 
 #include "calib/chain.h"
 #include "data/error.h"
@@ -100,14 +101,18 @@ CompareResult CompareClearance(const Robot& robot, const Observations& before,
   for (size_t j = 0; j < labels.size(); ++j) {
     if (std::isfinite(b[j].sigma) && std::isfinite(a[j].sigma)) ++compared;
   }
-  if (compared == 0) {
+  // ISO 9283 cycles alone (five poses) rarely determine a clearance: the
+  // comparison is then the ISO figures' only.
+  const bool iso_only = compared == 0 && r.has_iso9283;
+  if (compared == 0 && !iso_only) {
     throw InputError(before.source, 0, 0,
                      "no joint's clearance can be determined in both "
                      "sessions: the joints must move in both directions "
                      "between poses (rows in visit order)");
   }
-  r.z_critical = NormalUpperQuantile(0.025 / compared);
-  r.verdict = "unchanged";
+  r.z_critical = iso_only ? std::numeric_limits<double>::quiet_NaN()
+                          : NormalUpperQuantile(0.025 / compared);
+  r.verdict = iso_only ? "not_determined" : "unchanged";
   for (size_t j = 0; j < labels.size(); ++j) {
     JointClearanceChange c;
     c.joint = chain.rows[j].name;
@@ -137,7 +142,7 @@ nlohmann::json CompareJson(const CompareResult& r) {
   }
   nlohmann::json out = {{"verdict", r.verdict},
                         {"joints", joints},
-                        {"z_critical", r.z_critical},
+                        {"z_critical", Num(r.z_critical)},
                         {"before_sigma0_mm", Num(r.before_sigma0_mm)},
                         {"after_sigma0_mm", Num(r.after_sigma0_mm)}};
   if (r.has_iso9283) out["iso9283"] = Iso9283ComparisonJson(r);

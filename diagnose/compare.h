@@ -13,7 +13,10 @@
 // When both sessions have fixed_point labels with measured x,y,z (ISO 9283
 // cycles, diagnose/iso9283.h), the ISO 9283 pose accuracy AP and
 // repeatability RP of each are added, per pose and their maxima (each
-// session's measuring frame registered on its own poses).
+// session's measuring frame registered on its own poses). When no joint's
+// clearance can be determined in both sessions (ISO cycles alone: five
+// poses), the verdict is "not_determined" and the ISO figures are the
+// comparison; without ISO cycles that is an InputError.
 
 #include <nlohmann/json.hpp>
 #include <string>
@@ -39,7 +42,7 @@ struct CompareResult {
   std::vector<JointClearanceChange> joints;
   double z_critical = 0.0;
   double before_sigma0_mm = 0.0, after_sigma0_mm = 0.0;
-  std::string verdict;       // "changed" | "unchanged"
+  std::string verdict;       // "changed" | "unchanged" | "not_determined"
   bool has_iso9283 = false;  // both sessions have ISO 9283 cycles
   Iso9283Result iso9283_before, iso9283_after;
 };

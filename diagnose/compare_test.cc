@@ -110,5 +110,45 @@ TEST(CompareTest, IsoFiguresBeforeAndAfterWhenBothHaveCycles) {
   EXPECT_NE(CompareIso9283Text(r).find("RP before"), std::string::npos);
 }
 
+// ISO cycles alone: approached alternately from both sides of j2, the
+// cycles determine j2's clearance (changed after the repair); under the
+// standard's unidirectional cycle no clearance is determined and the
+// comparison is the ISO figures' (verdict not_determined); without labels
+// that is exit 2.
+TEST(CompareTest, IsoCyclesAloneCompareTheIsoFigures) {
+  const Robot bh7 = Bh7();
+  testing::IsoSimulation worn = testing::Bh7IsoSimulation();
+  worn.backlash_deg = 0.1;
+  worn.via_delta_deg = 5.0;
+  testing::IsoSimulation repaired = worn;
+  repaired.backlash_deg = 0.0;
+  repaired.seed = 8;
+  const CompareResult flipping =
+      CompareClearance(bh7, testing::SimulateIsoCycles(bh7, worn),
+                       testing::SimulateIsoCycles(bh7, repaired));
+  EXPECT_EQ(flipping.verdict, "changed");
+  for (const JointClearanceChange& c : flipping.joints) {
+    EXPECT_EQ(c.changed, c.joint == "j2") << c.joint;
+  }
+  ASSERT_TRUE(flipping.has_iso9283);
+  EXPECT_GT(flipping.iso9283_before.rp_max_mm, 0.15);
+  EXPECT_LT(flipping.iso9283_after.rp_max_mm, 0.05);
+
+  worn.via_delta_deg = 0.0;
+  repaired.via_delta_deg = 0.0;
+  const Observations standard_worn = testing::SimulateIsoCycles(bh7, worn);
+  const CompareResult standard = CompareClearance(
+      bh7, standard_worn, testing::SimulateIsoCycles(bh7, repaired));
+  EXPECT_EQ(standard.verdict, "not_determined");
+  ASSERT_TRUE(standard.has_iso9283);
+  EXPECT_LT(standard.iso9283_before.rp_max_mm, 0.05);
+  const nlohmann::json j = CompareJson(standard);
+  EXPECT_TRUE(j["z_critical"].is_null());
+  for (const auto& joint : j["joints"]) EXPECT_FALSE(joint["changed"]);
+  Observations unlabelled = standard_worn;
+  for (Observation& o : unlabelled.rows) o.fixed_point.clear();
+  EXPECT_THROW(CompareClearance(bh7, unlabelled, unlabelled), InputError);
+}
+
 }  // namespace
 }  // namespace kincal
