@@ -112,6 +112,21 @@ TEST(Iso9283Cli, BadInputIsExit2) {
       << once.err;
 }
 
+TEST(Iso9283Cli, FewerCyclesThanTheStandardsAreWarned) {
+  const std::string dir = testing::MakeTempDir("iso9283_few");
+  // Two comment lines, the header, the warm-up cycle, two measured cycles.
+  const RunResult r = testing::RunShell(
+      "head -18 " + Demo("cycles.csv") + " > " + dir + "/two.csv && " +
+      testing::KincalBinary() + " iso9283 --robot " + Robot() + " --obs " +
+      dir + "/two.csv --json");
+  const nlohmann::json j = Json(r);
+  ASSERT_EQ(j["poses"].size(), 5u);
+  EXPECT_EQ(j["poses"][0]["n"], 2);
+  ASSERT_TRUE(j.contains("warnings"));
+  EXPECT_EQ(j["warnings"].size(), 5u);
+  EXPECT_EQ(j["warnings"][0]["code"], "iso9283_few_cycles");
+}
+
 TEST(Iso9283Cli, ReportSectionAndCompare) {
   const std::string dir = testing::MakeTempDir("iso9283_report");
   const nlohmann::json report = Json(RunKincal(
