@@ -86,6 +86,30 @@ Rigid3 RegisterOnRows(const Chain& chain, const Observations& obs,
   return Rigid3FromPoseBlock(state.meas_from_base.data());
 }
 
+// One pose's characteristics from its rows: the commanded position is the
+// mean of the model's tips at the rows' readings, the attained ones the
+// measured points in the base frame.
+Iso9283Pose EvaluatePose(const Chain& chain, const Observations& obs,
+                         const std::vector<PoseInput>& inputs,
+                         const std::vector<int>& rows,
+                         const Rigid3& base_from_meas) {
+  std::vector<Eigen::Vector3d> tips, attained;
+  Eigen::Vector3d commanded = Eigen::Vector3d::Zero();
+  for (int i : rows) {
+    tips.push_back(TipInBase(chain, inputs[i]));
+    commanded += tips.back();
+    attained.push_back(base_from_meas * obs.rows[i].p_in_meas);
+  }
+  commanded /= static_cast<double>(tips.size());
+  Iso9283Pose p = PoseCharacteristics(commanded, attained);
+  p.rows = rows;
+  for (const Eigen::Vector3d& t : tips) {
+    p.commanded_spread_mm =
+        std::max(p.commanded_spread_mm, (t - commanded).norm());
+  }
+  return p;
+}
+
 }  // namespace
 
 Iso9283Pose PoseCharacteristics(const Eigen::Vector3d& commanded_mm,
@@ -140,21 +164,9 @@ Iso9283Result ComputeIso9283(const Robot& robot, const Observations& obs,
   r.tolerance_given =
       options.ap_tolerance_mm > 0 || options.rp_tolerance_mm > 0;
   for (size_t k = 0; k < groups.labels.size(); ++k) {
-    std::vector<Eigen::Vector3d> tips, attained;
-    Eigen::Vector3d commanded = Eigen::Vector3d::Zero();
-    for (int i : groups.rows[k]) {
-      tips.push_back(TipInBase(chain, inputs[i]));
-      commanded += tips.back();
-      attained.push_back(base_from_meas * obs.rows[i].p_in_meas);
-    }
-    commanded /= static_cast<double>(tips.size());
-    Iso9283Pose p = PoseCharacteristics(commanded, attained);
+    Iso9283Pose p =
+        EvaluatePose(chain, obs, inputs, groups.rows[k], base_from_meas);
     p.label = groups.labels[k];
-    p.rows = groups.rows[k];
-    for (const Eigen::Vector3d& t : tips) {
-      p.commanded_spread_mm =
-          std::max(p.commanded_spread_mm, (t - commanded).norm());
-    }
     if (options.ap_tolerance_mm > 0 && !(p.ap_mm <= options.ap_tolerance_mm))
       p.pass = false;
     if (options.rp_tolerance_mm > 0 && !(p.rp_mm <= options.rp_tolerance_mm))
