@@ -202,7 +202,15 @@ int RunCompare(const CompareArgs& args) {
     std::printf("  %-6s %-4s %24s %24s %8.2f %s\n", c.joint.c_str(),
                 c.unit.c_str(), b, a, c.z, c.changed ? "yes" : "no");
   }
-  std::printf("  verdict: %s (|z| > %.2f)\n", r.verdict.c_str(), r.z_critical);
+  if (r.verdict == "not_determined") {
+    std::printf(
+        "  verdict: not_determined (no joint's clearance can be determined "
+        "in both sessions)\n");
+  } else {
+    std::printf("  verdict: %s (|z| > %.2f)\n", r.verdict.c_str(),
+                r.z_critical);
+  }
+  std::printf("%s", CompareIso9283Text(r).c_str());
   return 0;
 }
 

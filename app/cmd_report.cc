@@ -52,6 +52,12 @@ int RunReport(const ReportArgs& args) {
         j["heldout_n"] = r.heldout_n;
       }
     }
+    if (r.has_iso9283) {
+      nlohmann::json iso = {{"ap_max_mm", r.iso9283_ap_max_mm},
+                            {"rp_max_mm", r.iso9283_rp_max_mm}};
+      if (r.tolerance_given) iso["pass"] = r.iso9283_pass;
+      j["iso9283"] = iso;
+    }
     PrintJson(j);
     return 0;
   }
@@ -66,6 +72,13 @@ int RunReport(const ReportArgs& args) {
                              : "FAIL",
         r.heldout_rms_mm, r.heldout_lo_mm, r.heldout_hi_mm, r.heldout_n,
         r.tolerance_mm);
+  }
+  if (r.has_iso9283) {
+    std::printf("  ISO 9283: max AP %.4g mm, max RP %.4g mm%s\n",
+                r.iso9283_ap_max_mm, r.iso9283_rp_max_mm,
+                !r.tolerance_given ? ""
+                : r.iso9283_pass   ? ": PASS"
+                                   : ": FAIL");
   }
   for (const auto& n : r.notes) std::printf("  note: %s\n", n.c_str());
   std::printf("%s\n", args.out.c_str());
@@ -109,7 +122,12 @@ void AddReportCommand(CLI::App& app, Runner* run) {
                   "and parameters instead of calibrating the points again");
   sub->add_option("--tolerance", o.tolerance_mm,
                   "mm: adds a pass/fail line, the final held-out RMS with its "
-                  "95 % interval against this (exit code stays 0)");
+                  "95 % interval against this, and with --iso9283 every "
+                  "pose's AP and RP against it (exit code stays 0)");
+  sub->add_option("--iso9283", o.iso9283,
+                  "observations.csv of ISO 9283 cycles (fixed_point = "
+                  "commanded pose P1..P5, x,y,z attained): adds the ISO 9283 "
+                  "section, AP and RP per pose (pass/fail with --tolerance)");
   sub->add_option("--root", o.root, "URDF root link");
   sub->add_option("--tip", o.tip, "URDF tip link");
   sub->add_option("--seed", o.seed,

@@ -30,6 +30,7 @@ void AddBundleCommand(CLI::App& app, Runner* run);
 void AddTargetCommand(CLI::App& app, Runner* run);
 void AddPrintCommand(CLI::App& app, Runner* run);
 void AddCompensateCommand(CLI::App& app, Runner* run);
+void AddIso9283Command(CLI::App& app, Runner* run);
 
 // Prints a result object as one line of JSON on stdout, with the command line
 // and tool version added ("command", "kincal_version").

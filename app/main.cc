@@ -57,6 +57,7 @@ int main(int argc, char** argv) {
   kincal::app::AddTargetCommand(app, &run);
   kincal::app::AddPrintCommand(app, &run);
   kincal::app::AddCompensateCommand(app, &run);
+  kincal::app::AddIso9283Command(app, &run);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {

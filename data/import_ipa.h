@@ -52,7 +52,16 @@ struct IpaSeries {
   std::vector<double> temperature_c;          // measurement_temperature
   std::vector<Eigen::Vector3d> std_mm;        // measurement_std_x/y/z
   std::vector<Eigen::Vector3d> rotation_deg;  // measurement_rx/ry/rz
-  std::vector<Eigen::Vector3d> goal_mm;       // Goal x/y/z, converted to mm
+  // Goal x/y/z, converted to mm: the commanded TCP, kept for the checks
+  // that need it (calib/real_data_test.cc compares it with the nominal
+  // chain's tip). `kincal import ipa-ur10` writes observations.csv, which
+  // has no column for it; the ISO 9283 figures (diagnose/iso9283.h) take
+  // the commanded position as the model's tip at the joint readings
+  // instead. A repeated goal is no ISO 9283 cycle here: series A repeats
+  // each grid goal (up to 23 times, consecutively) with other TCP
+  // orientations, and the measured point (93 mm out of the flange) is not
+  // the commanded TCP (109 mm), so its positions differ by millimetres.
+  std::vector<Eigen::Vector3d> goal_mm;
   bool has_time = false;  // true when Timestamp had full resolution
 };
 

@@ -49,6 +49,14 @@ void ReadRobotInputs(const ReportOptions& opt, ReportInputs* in) {
     in->obs = ReadObservationsCsv(opt.obs, in->JointRobot().JointNames());
     in->has_obs = true;
   }
+  if (!opt.iso9283.empty()) {
+    Require(in->has_robot || in->has_cal,
+            "--iso9283 needs --robot or --calibrated (the model of the "
+            "commanded positions)");
+    in->iso9283_obs =
+        ReadObservationsCsv(opt.iso9283, in->JointRobot().JointNames());
+    in->has_iso9283 = true;
+  }
   if (in->has_robot && in->has_cal) {
     Require(in->robot.JointNames() == in->cal.JointNames(),
             opt.calibrated + ": joints differ from " + opt.robot);
@@ -234,6 +242,15 @@ ReportAnalysis AnalyseReport(
     if (progress_fn) progress_fn(what);
   };
   ReportAnalysis an;
+  if (in.has_iso9283) {
+    progress("ISO 9283 pose accuracy and repeatability");
+    Iso9283Options io;
+    io.ap_tolerance_mm = opt.tolerance_mm;
+    io.rp_tolerance_mm = opt.tolerance_mm;
+    an.iso9283 = ComputeIso9283(in.JointRobot(), in.iso9283_obs, io);
+    an.iso9283_robot = in.has_robot ? opt.robot : opt.calibrated;
+    an.has_iso9283 = true;
+  }
   const bool can_fit = in.has_obs && (in.has_robot || in.has_cal);
   if (!can_fit) return an;
   an.nominal = in.has_robot ? in.robot : WithoutExtensions(in.cal);

@@ -17,6 +17,7 @@
 #include "data/observations.h"
 #include "data/robot.h"
 #include "diagnose/clearance.h"
+#include "diagnose/iso9283.h"
 #include "report/report.h"
 #include "report/residuals.h"
 
@@ -34,8 +35,10 @@ struct ReportInputs {
   bool has_diag = false, has_rig = false, has_bundle = false;
   Robot robot, cal;  // nominal; calibrated (possibly with extensions)
   Observations obs;
-  nlohmann::json diag;    // diagnose model --json
-  nlohmann::json bundle;  // bundle --json
+  bool has_iso9283 = false;
+  Observations iso9283_obs;  // --iso9283
+  nlohmann::json diag;       // diagnose model --json
+  nlohmann::json bundle;     // bundle --json
   BundleHeader cal_header;
   Rig rig;
   nlohmann::json camcal;  // camcal --json (null when not given)
@@ -82,6 +85,10 @@ struct ReportAnalysis {
   bool has_fixed_sensitivity = false;
   SensitivityResult sensitivity;
   std::vector<MeasuredCurve> measured_sensitivity;
+  // ISO 9283 figures of --iso9283, and the robot file they used.
+  bool has_iso9283 = false;
+  Iso9283Result iso9283;
+  std::string iso9283_robot;
   std::vector<std::string> notes;  // computations skipped and why
 };
 

@@ -10,6 +10,7 @@
 #include "report/analysis.h"
 #include "report/camera_sections.h"
 #include "report/html.h"
+#include "report/iso9283_section.h"
 #include "report/robot_sections.h"
 #include "report/verdict.h"
 
@@ -87,6 +88,7 @@ void AddProvenanceSection(const ReportInputs& in, const ReportOptions& opt,
   };
   add("robot", opt.robot);
   add("observations", opt.obs);
+  add("ISO 9283 cycles", opt.iso9283);
   add("calibrated robot", opt.calibrated);
   add("diagnosis", opt.diagnosis);
   add("bundle result", opt.bundle);
@@ -130,6 +132,7 @@ ReportResult BuildReport(
   AddClearanceSection(an, &page);
   AddIdentifiabilitySection(in, an, &page);
   AddParametersSection(in, an, opt, &page);
+  AddIso9283Section(an, opt, &page);
   if (in.has_rig) AddCameraSection(in.rig, in.camcal, in.camcal_path, &page);
   if (!in.points_path.empty()) {
     AddTrackingSection(in.points_path, Exists(in.points_path), &page);
@@ -152,6 +155,10 @@ ReportResult BuildReport(
   result.heldout_lo_mm = tolerance.lo_mm;
   result.heldout_hi_mm = tolerance.hi_mm;
   result.heldout_n = tolerance.heldout.n;
+  result.has_iso9283 = an.has_iso9283;
+  result.iso9283_ap_max_mm = an.iso9283.ap_max_mm;
+  result.iso9283_rp_max_mm = an.iso9283.rp_max_mm;
+  result.iso9283_pass = an.iso9283.pass;
   return result;
 }
 

@@ -16,6 +16,7 @@
 //   clearance        the seed's Section 4 sweeps (Fig. 4-6)
 //   identifiability  identifiable / redundant parameters, relations, sigma
 //   parameters       nominal -> calibrated +- sigma
+//   iso9283          ISO 9283 AP and RP per commanded pose (--iso9283)
 //   camera           rig intrinsics; per-view error and sigma (camcal JSON)
 //   tracking         tip quality per frame (points.csv of a session)
 //   provenance       the command and version that made every input
@@ -43,8 +44,14 @@ struct ReportOptions {
   double gamma = 3.0;     // clearance sweep half-range (deg | mm)
   // Markers per scatter series at most (evenly thinned above; said so).
   int max_points = 2000;
-  // > 0: a pass/fail line, the final held-out RMS against this (mm).
+  // > 0: a pass/fail line, the final held-out RMS against this (mm); with
+  // iso9283, also pass/fail of every pose's AP and RP against it.
   double tolerance_mm = 0.0;
+  // Observations of ISO 9283 cycles (fixed_point = commanded pose label):
+  // the ISO 9283 section. Needs --robot or --calibrated (the model whose tip
+  // at the commanded joints is the commanded position; the nominal robot
+  // when both are given).
+  std::string iso9283;
 };
 
 struct ReportResult {
@@ -59,6 +66,11 @@ struct ReportResult {
   double tolerance_mm = 0.0, heldout_rms_mm = 0.0;
   double heldout_lo_mm = 0.0, heldout_hi_mm = 0.0;
   int heldout_n = 0;
+  // --iso9283: the largest AP and RP (mm), and with --tolerance whether
+  // every pose passed.
+  bool has_iso9283 = false;
+  double iso9283_ap_max_mm = 0.0, iso9283_rp_max_mm = 0.0;
+  bool iso9283_pass = true;
 };
 
 // Reads the inputs (InputError with file:line:column on bad ones) and builds
