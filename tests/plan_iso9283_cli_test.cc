@@ -10,6 +10,7 @@
 
 #include <Eigen/Geometry>
 #include <nlohmann/json.hpp>
+#include <sstream>
 #include <string>
 
 #include "calib/chain.h"
@@ -154,6 +155,31 @@ TEST(PlanIso9283Cli, OptionsOfTheOtherModeAreRefused) {
   for (const char* f : {"/a.csv", "/b.csv", "/c.csv", "/d.csv"}) {
     EXPECT_FALSE(testing::Exists(dir + f)) << f;
   }
+}
+
+// Every `kincal plan ... --iso9283` command of docs/PLAN.md runs (from the
+// repository root's data, writing into a temporary folder) and exits 0.
+TEST(PlanIso9283Cli, DocCommandsRun) {
+  const std::string doc = ReadFile(testing::SourceDir() + "/docs/PLAN.md");
+  const std::string dir = testing::MakeTempDir("plan_iso9283_doc");
+  std::istringstream in(doc);
+  std::string line;
+  int commands = 0;
+  while (std::getline(in, line)) {
+    if (line.rfind("kincal plan ", 0) != 0 ||
+        line.find("--iso9283") == std::string::npos) {
+      continue;
+    }
+    ++commands;
+    const std::string command = "cd " + dir + " && ln -sfn " +
+                                testing::SourceDir() + "/data data && " +
+                                testing::KincalBinary() + line.substr(6);
+    const RunResult r = testing::RunShell(command);
+    EXPECT_EQ(r.exit_code, 0) << line << "\n" << r.err;
+  }
+  EXPECT_EQ(commands, 2);
+  EXPECT_TRUE(testing::Exists(dir + "/ur10_iso9283.csv"));
+  EXPECT_TRUE(testing::Exists(dir + "/bh7_iso9283.csv"));
 }
 
 }  // namespace
