@@ -4,6 +4,7 @@
 
 #include <Eigen/Geometry>
 #include <cmath>
+#include <limits>
 
 #include "calib/chain.h"
 #include "calib/inverse_kinematics.h"
@@ -217,6 +218,11 @@ TEST(IsoCubeTest, BadOptionsAreRefused) {
   options.orientation_deg.reset();
   options.cycles = 0;
   EXPECT_NE(Refusal(LoadRobot("bh7.yaml"), options).find("--cycles"),
+            std::string::npos);
+  options.cycles = 30;
+  Robot no_limits = LoadRobot("bh7.yaml");
+  no_limits.joints[2].lower = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_NE(Refusal(no_limits, options).find("joint 'j3' has no limits"),
             std::string::npos);
 }
 
