@@ -116,6 +116,13 @@ TEST(IsoCubeTest, Ur10HoldsPositionsAndOneOrientation) {
   ExpectPlanHolds(robot, options, plan);
   // The default centre is a feasible tip (within the arm's reach).
   EXPECT_LT(plan.center_mm.norm(), 1500.0);
+  // Whole turns moved toward the middle of the +-360 deg ranges: every
+  // joint's mean over the five poses within half a turn of 0.
+  for (size_t j = 0; j < robot.joints.size(); ++j) {
+    double mean = 0;
+    for (const IsoCubePose& pose : plan.poses) mean += pose.joints[j] / 5;
+    EXPECT_LE(std::abs(mean), 180.0) << robot.joints[j].name;
+  }
 }
 
 TEST(IsoCubeTest, Bh7HoldsPositionsWithoutOrientation) {
