@@ -1,5 +1,6 @@
 // kincal plan: choose the robot poses of a calibration experiment (design of
-// experiments on the identification Jacobian, plan/plan.h).
+// experiments on the identification Jacobian, plan/plan.h), or with
+// --iso9283 the poses of ISO 9283's pose-accuracy test (plan/iso9283_cube.h).
 
 #include <cmath>
 #include <cstdio>
@@ -15,6 +16,7 @@
 #include "data/rigid3.h"
 #include "data/urdf.h"
 #include "plan/confirm.h"
+#include "plan/iso9283_cube.h"
 #include "plan/obstacles.h"
 #include "plan/plan.h"
 #include "vision/target.h"
@@ -30,6 +32,14 @@ struct PlanArgs {
   PlanOptions options;
   bool json = false;
   bool no_self_collision = false;
+  // --iso9283: the cube's test poses instead of a calibration design.
+  bool iso9283 = false;
+  IsoCubeOptions cube;
+  std::vector<double> cube_center, orientation;
+  // Options given on the command line that only a calibration design uses.
+  std::vector<std::string> design_only;
+  bool n_given = false;
+  bool cube_option_given = false;  // --cube, --cycles, ...
 };
 
 // The JSON object of a plan (with --confirm: also simulated calibrations at
@@ -116,8 +126,113 @@ nlohmann::json PlanJson(const PlanArgs& args, const Robot& robot,
   return j;
 }
 
+// A 3-vector option (x,y,z) or nothing.
+std::optional<Eigen::Vector3d> Vector3Option(const std::vector<double>& v) {
+  if (v.empty()) return std::nullopt;
+  return Eigen::Vector3d(v[0], v[1], v[2]);
+}
+
+Eigen::Vector3d RotationVectorDeg(const Eigen::Matrix3d& rotation) {
+  return RotationVectorFromMatrix(rotation) * 180 / M_PI;
+}
+
+nlohmann::json Json3(const Eigen::Vector3d& v) {
+  return {Number(v.x()), Number(v.y()), Number(v.z())};
+}
+
+// The JSON object of an ISO 9283 cube plan.
+nlohmann::json IsoCubeJson(const PlanArgs& args, const Robot& robot,
+                           const IsoCubePlan& plan) {
+  nlohmann::json poses = nlohmann::json::array();
+  for (const IsoCubePose& pose : plan.poses) {
+    poses.push_back({{"pose", pose.label},
+                     {"position_mm", Json3(pose.position_mm)},
+                     {"joints", pose.joints}});
+  }
+  nlohmann::json order = nlohmann::json::array();
+  for (int index : IsoCubeCycleOrder())
+    order.push_back(plan.poses[index].label);
+  nlohmann::json joint_names = nlohmann::json::array();
+  for (const RobotRow& row : robot.joints) joint_names.push_back(row.name);
+  nlohmann::json j;
+  j["n"] = plan.rows.size();
+  j["out"] = args.out;
+  j["mode"] = "iso9283";
+  j["cube_mm"] = plan.cube_mm;
+  j["cube_center_mm"] = Json3(plan.center_mm);
+  j["orientation_deg"] = plan.fixed_orientation
+                             ? Json3(RotationVectorDeg(plan.rotation))
+                             : nlohmann::json(nullptr);
+  j["cycles"] = plan.cycles;
+  j["cycle_order"] = order;
+  j["joint_names"] = joint_names;
+  j["poses"] = poses;
+  j["limit_margin"] = args.cube.limit_margin;
+  j["link_radius_mm"] = args.cube.safety.link_radius_mm;
+  j["obstacles"] = args.obstacles;
+  j["seeds_tried"] = plan.seeds_tried;
+  j["draws"] = plan.draws;
+  j["seconds"] = plan.seconds;
+  return j;
+}
+
+int RunIsoCube(PlanArgs args, const Robot& robot) {
+  if (!args.design_only.empty()) {
+    std::string names;
+    for (const std::string& name : args.design_only) {
+      names += (names.empty() ? "" : ", ") + name;
+    }
+    throw InputError("--iso9283 plans the standard's five poses: " + names +
+                     " belong to a calibration design and are not used");
+  }
+  IsoCubeOptions& cube = args.cube;
+  cube.center_mm = Vector3Option(args.cube_center);
+  cube.orientation_deg = Vector3Option(args.orientation);
+  cube.limit_margin = args.options.limit_margin;
+  cube.seed = args.options.seed;
+  cube.safety = args.options.safety;
+  const IsoCubePlan plan = PlanIsoCube(robot, cube);
+  WriteFileAtomic(args.out, FormatIsoCubeCsv(robot, plan));
+  if (args.json) {
+    PrintJson(IsoCubeJson(args, robot, plan));
+    return 0;
+  }
+  std::printf(
+      "kincal plan: ISO 9283 cube %.6g mm centred at (%.1f, %.1f, %.1f) mm, "
+      "%d cycles of P5 P4 P3 P2 P1: %zu rows -> %s\n",
+      plan.cube_mm, plan.center_mm.x(), plan.center_mm.y(), plan.center_mm.z(),
+      plan.cycles, plan.rows.size(), args.out.c_str());
+  if (plan.fixed_orientation) {
+    const Eigen::Vector3d w = RotationVectorDeg(plan.rotation);
+    std::printf("  tool orientation (rotation vector) %.3f %.3f %.3f deg\n",
+                w.x(), w.y(), w.z());
+  }
+  for (const IsoCubePose& pose : plan.poses) {
+    std::printf("  %s  (%9.3f, %9.3f, %9.3f) mm  joints", pose.label.c_str(),
+                pose.position_mm.x(), pose.position_mm.y(),
+                pose.position_mm.z());
+    for (double q : pose.joints) std::printf(" %.4f", q);
+    std::printf("\n");
+  }
+  return 0;
+}
+
 int RunPlan(PlanArgs args) {
   const Robot robot = ReadRobot(args.robot, args.root, args.tip);
+  if (!args.obstacles.empty()) {
+    args.options.safety.obstacles = ReadObstaclesYaml(args.obstacles);
+  }
+  args.options.safety.self_collision = !args.no_self_collision;
+  if (args.iso9283) return RunIsoCube(args, robot);
+  if (!args.n_given) {
+    throw InputError(
+        "--n is required (or --iso9283 --cube MM for the ISO "
+        "9283 test poses)");
+  }
+  if (args.cube_option_given) {
+    throw InputError(
+        "--cube, --cycles, --cube-center and --orientation go with --iso9283");
+  }
   if (args.rig.empty() != args.target.empty()) {
     throw InputError("--rig and --target go together");
   }
@@ -143,10 +258,6 @@ int RunPlan(PlanArgs args) {
                           args.rig_from_base[5]);
     args.options.rig_from_base = r;
   }
-  if (!args.obstacles.empty()) {
-    args.options.safety.obstacles = ReadObstaclesYaml(args.obstacles);
-  }
-  args.options.safety.self_collision = !args.no_self_collision;
   if (args.criterion == "d") {
     args.options.criterion = PlanOptions::kDOptimal;
   } else if (args.criterion == "sigma") {
@@ -206,7 +317,8 @@ void AddPlanCommand(CLI::App& app, Runner* run) {
   AddRobotOptions(sub, &args->robot, &args->root, &args->tip,
                   "robot.yaml or .urdf with limits")
       ->required();
-  sub->add_option("--n", args->options.n, "number of poses")->required();
+  sub->add_option("--n", args->options.n,
+                  "number of poses (required without --iso9283)");
   sub->add_option("--out", args->out, "POSES.csv to write")->required();
   sub->add_option("--random-out", args->random_out,
                   "also write the N random feasible poses it compares with");
@@ -260,6 +372,29 @@ void AddPlanCommand(CLI::App& app, Runner* run) {
                   "also simulate this many sessions at the planned and at the "
                   "random poses, calibrate them and report the actual errors")
       ->check(CLI::Range(0, 1000));
+  sub->add_flag("--iso9283", args->iso9283,
+                "plan ISO 9283's pose-accuracy test instead: P1..P5 on the "
+                "diagonal plane of a cube of edge --cube, one tool "
+                "orientation, --cycles cycles of P5 P4 P3 P2 P1 "
+                "(docs/PLAN.md)");
+  sub->add_option("--cube", args->cube.cube_mm,
+                  "with --iso9283: the cube's edge length, mm")
+      ->check(CLI::PositiveNumber);
+  sub->add_option("--cycles", args->cube.cycles,
+                  "with --iso9283: cycles of the five poses (the standard's "
+                  "30)")
+      ->check(CLI::Range(1, 10000));
+  sub->add_option("--cube-center", args->cube_center,
+                  "with --iso9283: the cube's centre X,Y,Z in the base "
+                  "frame, mm; default: the middle of the reachable workspace")
+      ->expected(3)
+      ->delimiter(',');
+  sub->add_option("--orientation", args->orientation,
+                  "with --iso9283, arms with 6+ joints: the tool orientation "
+                  "rx,ry,rz (rotation vector of base_from_tip, deg); default: "
+                  "that of the seed configuration")
+      ->expected(3)
+      ->delimiter(',');
   sub->add_flag("--json", args->json, "print one JSON object");
   sub->footer(HelpFooter(
       "Example (60 poses for a UR10 seen by a stereo rig, and the gain over 60 "
@@ -267,7 +402,20 @@ void AddPlanCommand(CLI::App& app, Runner* run) {
       "data/robots/ur10.yaml --n 60 --rig rig.yaml --target target.yaml --out "
       "poses.csv --random-out random.csv --confirm 5 --json",
       "; poses.csv in the robot's joint units (deg | mm)"));
-  sub->callback([run, args] { *run = [args] { return RunPlan(*args); }; });
+  sub->callback([run, args, sub] {
+    args->n_given = sub->count("--n") > 0;
+    for (const char* name :
+         {"--cube", "--cycles", "--cube-center", "--orientation"}) {
+      args->cube_option_given = args->cube_option_given || sub->count(name);
+    }
+    for (const char* name :
+         {"--n", "--random-out", "--rig", "--target", "--rig-from-base",
+          "--candidates", "--noise-mm", "--fixed-point", "--min-tags",
+          "--max-obliquity", "--criterion", "--extreme", "--confirm"}) {
+      if (sub->count(name) > 0) args->design_only.push_back(name);
+    }
+    *run = [args] { return RunPlan(*args); };
+  });
 }
 
 }  // namespace kincal::app
