@@ -5,6 +5,7 @@
 #include <Eigen/Geometry>
 #include <chrono>
 #include <cstdio>
+#include <map>
 #include <memory>
 #include <sstream>
 
@@ -137,6 +138,30 @@ nlohmann::json TargetJson(const CompensatedTarget& t) {
   return j;
 }
 
+// Text mode: the unreachable targets (the first 10) and, per reason of
+// extrapolation (the joint or the temperature), how many targets and the
+// first one.
+void PrintTargetIssues(const CompensateResult& r) {
+  int shown = 0;
+  for (const auto& t : r.targets) {
+    if (!t.reached && shown++ < 10) {
+      std::printf("  unreachable %s: %s\n", t.id.c_str(), t.why.c_str());
+    }
+  }
+  std::map<std::string, std::pair<int, std::string>> reasons;
+  for (const auto& t : r.targets) {
+    for (const auto& why : t.extrapolated) {
+      const std::string key = why.substr(0, why.find(' '));
+      auto& [count, first] = reasons[key];
+      if (count++ == 0) first = t.id + ": " + why;
+    }
+  }
+  for (const auto& [key, value] : reasons) {
+    std::printf("  extrapolated (%s) at %d targets, e.g. %s\n", key.c_str(),
+                value.first, value.second.c_str());
+  }
+}
+
 int RunCompensate(const CompensateArgs& args) {
   const auto start = std::chrono::steady_clock::now();
   const Robot robot = ReadRobot(args.robot, args.root, args.tip);
@@ -245,13 +270,7 @@ int RunCompensate(const CompensateArgs& args) {
       r.predicted_rms_mm, r.predicted_max_mm);
   std::printf("  the controller's own readings would miss by RMS %.4f mm\n",
               r.uncompensated_rms_mm);
-  for (const auto& t : r.targets) {
-    if (!t.reached)
-      std::printf("  unreachable %s: %s\n", t.id.c_str(), t.why.c_str());
-    for (const auto& why : t.extrapolated) {
-      std::printf("  extrapolated %s: %s\n", t.id.c_str(), why.c_str());
-    }
-  }
+  PrintTargetIssues(r);
   if (!args.obs.empty()) {
     std::printf(
         "  replay of %s: the model misses the measured tips by RMS %.4f mm "

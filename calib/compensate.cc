@@ -398,6 +398,20 @@ CompensateResult Compensate(const Robot& robot,
     }
     result.targets.push_back(out);
   }
+  int extrapolated = 0;
+  for (const CompensatedTarget& t : result.targets) {
+    extrapolated += t.extrapolated.empty() ? 0 : 1;
+  }
+  if (extrapolated > 0) {
+    result.warnings.Add(
+        "targets_extrapolated",
+        std::to_string(extrapolated) + " of " +
+            std::to_string(result.targets.size()) +
+            " targets lie outside the travel or temperature the model was "
+            "fitted on: their predicted sigma covers the parameters' "
+            "uncertainty, not the model's error where it has no data; "
+            "measure there to know it (`extrapolated` per target)");
+  }
   if (result.reached > 0) {
     result.predicted_rms_mm = std::sqrt(sum_sq / result.reached);
     result.uncompensated_rms_mm = std::sqrt(sum_sq_nom / count_nom);

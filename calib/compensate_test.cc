@@ -139,6 +139,12 @@ TEST(CompensateTest, SigmaPropagatesTheCovariance) {
   real.fitted_on.systematic_rms_mm = 0.15;
   const CompensateResult s = Compensate(real, targets, CompensateOptions{});
   EXPECT_NEAR(s.targets[0].sigma_mm, 0.25, 1e-4);
+  // A calibrated row's beta is found although its alpha is no longer 0.
+  real.joints[2].alpha_deg = 0.01;
+  real.joints[2].beta_deg = 0.002;
+  real.fitted_on.covariance_params = {"elbow_joint.beta"};
+  EXPECT_GT(Compensate(real, targets, CompensateOptions{}).targets[0].sigma_mm,
+            0.0);
   // A covariance naming nothing in the model is refused.
   real.fitted_on.covariance_params = {"tool.q"};
   EXPECT_THROW(Compensate(real, targets, CompensateOptions{}), InputError);

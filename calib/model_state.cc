@@ -161,8 +161,12 @@ ParamInfo FindParam(const ModelState& state, const std::string& name) {
       all.push_back(JointErrorParam(state.chain, j, k));
     }
   }
-  for (int r : ParallelAxisRows(state.chain)) {
-    all.push_back(AxisTiltParam(state.chain, r));
+  // Every DH / MDH row carries a beta (a calibrated row's alpha is no longer
+  // exactly 0, so not only the nominally parallel ones).
+  if (state.chain.convention != Convention::kUrdf) {
+    for (int r = 0; r < state.chain.num_joints(); ++r) {
+      all.push_back(AxisTiltParam(state.chain, r));
+    }
   }
   for (const auto& p : all) {
     if (p.name == name) return p;

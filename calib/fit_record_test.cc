@@ -1,0 +1,96 @@
+#include "calib/fit_record.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "calib/chain.h"
+
+namespace kincal {
+namespace {
+
+Observations TwoRows() {
+  Observations obs;
+  obs.joint_names = {"j1", "j2"};
+  Observation a, b;
+  a.q = {10, -20};
+  a.temp_c = 21;
+  b.q = {-5, 30};
+  b.temp_c = 25;
+  obs.rows = {a, b};
+  return obs;
+}
+
+TEST(FitRecordTest, TravelTemperatureFrameAndCovarianceInInterfaceUnits) {
+  const Observations obs = TwoRows();
+  FitSummary fit;
+  ParamInfo angle;
+  angle.name = "j2.theta";
+  angle.angle = true;
+  ParamInfo length;
+  length.name = "j2.a";
+  ParamInfo frame;
+  frame.name = "frame.x";
+  frame.kind = ParamKind::kFrame;
+  ParamInfo point;
+  point.name = "point.P1.x";
+  point.kind = ParamKind::kPoint;
+  fit.params = {angle, length, frame, point};
+  fit.covariance = Eigen::MatrixXd::Identity(4, 4);
+  fit.covariance(0, 0) = 1e-6;  // rad^2
+  fit.covariance(0, 1) = fit.covariance(1, 0) = 2e-4;  // rad mm
+  ModelState state;
+  state.meas_from_base = {0, 0, M_PI / 2, 100, 200, 300};
+  FitRecordInput in;
+  in.obs = &obs;
+  in.fit = &fit;
+  in.state = &state;
+  in.heldout_rms_mm = 0.05;
+  const FitRecord rec = MakeFitRecord(in);
+  EXPECT_EQ(rec.poses, 2);
+  ASSERT_EQ(rec.joint_range.size(), 2u);
+  EXPECT_EQ(rec.joint_range[0][0], -5.0);
+  EXPECT_EQ(rec.joint_range[1][1], 30.0);
+  EXPECT_EQ(rec.temp_lo_c, 21.0);
+  EXPECT_EQ(rec.temp_hi_c, 25.0);
+  EXPECT_EQ(rec.thermal_input, "temp_c");
+  ASSERT_TRUE(rec.has_frame);
+  EXPECT_NEAR(rec.frame[2], 90.0, 1e-12);
+  EXPECT_EQ(rec.frame[5], 300.0);
+  // Fixed points are left out; the frame stays; deg and mm.
+  ASSERT_EQ(rec.covariance_params,
+            (std::vector<std::string>{"j2.theta", "j2.a", "frame.x"}));
+  const double deg = 180.0 / M_PI;
+  EXPECT_NEAR(rec.covariance(0, 0), 1e-6 * deg * deg, 1e-12);
+  EXPECT_NEAR(rec.covariance(0, 1), 2e-4 * deg, 1e-12);
+  EXPECT_EQ(rec.covariance(2, 2), 1.0);
+  EXPECT_EQ(rec.heldout_rms_mm, 0.05);
+}
+
+TEST(FitRecordTest, RowsSubsetAndRecordedNominal) {
+  const Observations obs = TwoRows();
+  FitRecordInput in;
+  in.obs = &obs;
+  in.rows = {1};
+  const FitRecord rec = MakeFitRecord(in);
+  EXPECT_EQ(rec.poses, 1);
+  EXPECT_EQ(rec.joint_range[0][0], -5.0);
+  EXPECT_EQ(rec.joint_range[0][1], -5.0);
+  EXPECT_TRUE(rec.covariance_params.empty());
+  EXPECT_FALSE(rec.has_frame);
+  Robot nominal;
+  nominal.joints.resize(2);
+  nominal.joints[0].name = "j1";
+  nominal.joints[1].name = "j2";
+  nominal.joints[1].a_mm = 200;
+  Robot calibrated = nominal;
+  calibrated.joints[1].a_mm = 200.3;
+  const Robot out = WithFitRecord(calibrated, nominal, in);
+  ASSERT_TRUE(out.HasNominal());
+  EXPECT_EQ(out.nominal_joints[1].a_mm, 200.0);
+  EXPECT_EQ(out.joints[1].a_mm, 200.3);
+  EXPECT_EQ(out.fitted_on.poses, 1);
+}
+
+}  // namespace
+}  // namespace kincal
