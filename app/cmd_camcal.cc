@@ -15,6 +15,7 @@
 #include "app/command.h"
 #include "app/front_end.h"
 #include "camcal/calibrate_cameras.h"
+#include "camcal/cameramodel.h"
 #include "camcal/rig.h"
 #include "data/error.h"
 #include "data/glob.h"
@@ -29,6 +30,11 @@ struct CamcalArgs {
   int distortion = 5;
   std::string loss = "huber";
   double loss_scale_px = 3.0;
+  // Projection uncertainty: distance (target units; 0 = infinity) and the
+  // valid-intrinsics threshold (px).
+  double uncertainty_distance = 0;
+  double valid_threshold_px = 1.0;
+  std::string out_cameramodel;  // PREFIX: PREFIX-<camera>.cameramodel
   bool json = false;
 };
 
@@ -69,6 +75,15 @@ CalibrationOptions ResolveOptions(const CamcalArgs& args) {
     throw InputError("--loss '" + args.loss +
                      "': expected huber, cauchy or none");
   }
+  if (args.uncertainty_distance < 0) {
+    throw InputError("--uncertainty-distance " +
+                     std::to_string(args.uncertainty_distance) +
+                     ": expected a distance > 0 (or 0 for infinity)");
+  }
+  if (args.uncertainty_distance > 0) {
+    options.uncertainty.distance = args.uncertainty_distance;
+  }
+  options.uncertainty.valid_threshold_px = args.valid_threshold_px;
   options.Check();
   return options;
 }
@@ -144,6 +159,31 @@ CalibrationProblem DetectTargets(
   return problem;
 }
 
+nlohmann::json PixelJson(const Eigen::Vector2d& pixel) {
+  return {pixel.x(), pixel.y()};
+}
+
+// The projection uncertainty map (worst-direction sigma, px).
+nlohmann::json UncertaintyJson(const ProjectionUncertaintyMap& map) {
+  nlohmann::json corners = nlohmann::json::array();
+  for (int k = 0; k < 4; ++k) {
+    corners.push_back({{"pixel", PixelJson(map.corner_pixels[k])},
+                       {"sigma_px", map.corner_px[k]}});
+  }
+  nlohmann::json region = nlohmann::json::array();
+  for (const Eigen::Vector2d& p : map.valid_region)
+    region.push_back(PixelJson(p));
+  return {
+      {"distance", Nullable(map.distance)},
+      {"centre",
+       {{"pixel", PixelJson(map.centre_pixel)}, {"sigma_px", map.centre_px}}},
+      {"corners", corners},
+      {"grid",
+       {{"cols", map.cols}, {"rows", map.rows}, {"sigma_px", map.grid_px}}},
+      {"valid_threshold_px", map.valid_threshold_px},
+      {"valid_intrinsics_region", region}};
+}
+
 nlohmann::json CameraJson(const CalibrationSummary& sum, size_t c) {
   const CameraCalibrationSummary& cs = sum.cameras[c];
   const CameraIntrinsics& in = cs.intrinsics;
@@ -175,6 +215,7 @@ nlohmann::json CameraJson(const CalibrationSummary& sum, size_t c) {
         {"distortion",
          std::vector<double>(cs.sigma.begin() + kK1,
                              cs.sigma.begin() + kK1 + in.distortion.size())}};
+    cj["projection_uncertainty"] = UncertaintyJson(cs.projection_uncertainty);
   }
   nlohmann::json per_view = nlohmann::json::array();
   for (double r : cs.view_rms_px) per_view.push_back(Nullable(r));
@@ -196,6 +237,29 @@ nlohmann::json CameraJson(const CalibrationSummary& sum, size_t c) {
   return cj;
 }
 
+// PREFIX-<camera>.cameramodel per camera.
+std::vector<std::string> CameraModelPaths(const CamcalArgs& args,
+                                          const CalibrationSummary& sum) {
+  std::vector<std::string> paths;
+  for (const Camera& cam : sum.rig.cameras) {
+    paths.push_back(args.out_cameramodel + "-" + cam.intrinsics.name +
+                    ".cameramodel");
+  }
+  return paths;
+}
+
+// mrcal models of the solved rig: extrinsics cam_from_rig in target units
+// (mrcal's convention: the units of the board), the valid intrinsics region
+// from the projection uncertainty.
+void WriteCameraModels(const CamcalArgs& args, const CalibrationSummary& sum) {
+  const std::vector<CameraModelFile> models =
+      CameraModelsFromRig(sum.rig, /*unit_mm=*/1.0);
+  const std::vector<std::string> paths = CameraModelPaths(args, sum);
+  for (size_t c = 0; c < models.size(); ++c) {
+    WriteCameraModel(paths[c], models[c]);
+  }
+}
+
 nlohmann::json SummaryJson(const CamcalArgs& args, const CalibTargetSpec& spec,
                            const CalibrationProblem& problem,
                            const std::vector<std::vector<std::string>>& files,
@@ -208,6 +272,11 @@ nlohmann::json SummaryJson(const CamcalArgs& args, const CalibTargetSpec& spec,
   j["baseline_sigma"] = Nullable(sum.baseline_sigma);
   j["target"] = spec.text;
   j["out"] = args.out;
+  if (!args.out_cameramodel.empty()) {
+    nlohmann::json files = nlohmann::json::array();
+    for (const std::string& f : CameraModelPaths(args, sum)) files.push_back(f);
+    j["out_cameramodel"] = files;
+  }
   j["views"] = nv;
   j["termination"] = sum.termination;
   j["converged"] = sum.converged;
@@ -278,6 +347,17 @@ void PrintSummary(const CamcalArgs& args, const CalibTargetSpec& spec,
     }
     std::printf("    worst view: %s (RMS %.4f px)\n", files[c][worst_v].c_str(),
                 worst);
+    if (!cs.sigma.empty()) {
+      const ProjectionUncertaintyMap& u = cs.projection_uncertainty;
+      std::printf(
+          "    projection uncertainty (1 sigma, worst direction) at %s: "
+          "centre %.3f px, corners %.3f %.3f %.3f %.3f px\n",
+          std::isinf(u.distance)
+              ? "infinity"
+              : (std::to_string(u.distance) + " units").c_str(),
+          u.centre_px, u.corner_px[0], u.corner_px[1], u.corner_px[2],
+          u.corner_px[3]);
+    }
   }
   if (nc == 2) {
     std::printf("  baseline %.4f +- %.4f (target units)\n", sum.baseline,
@@ -304,6 +384,7 @@ int RunCamcal(const CamcalArgs& args) {
     return 1;
   }
   WriteRigYaml(args.out, sum.rig);
+  if (!args.out_cameramodel.empty()) WriteCameraModels(args, sum);
   if (args.json) {
     PrintJson(SummaryJson(args, spec, problem, files, sum));
   } else {
@@ -334,6 +415,15 @@ void AddCamcalCommand(CLI::App& app, Runner* run) {
                   "robust loss: huber (default), cauchy or none");
   sub->add_option("--loss-scale", args->loss_scale_px,
                   "robust loss scale, px (default 3)");
+  sub->add_option("--uncertainty-distance", args->uncertainty_distance,
+                  "distance of the points whose projection uncertainty is "
+                  "reported, target units (mm); 0 (default) = infinity");
+  sub->add_option("--valid-threshold", args->valid_threshold_px,
+                  "valid intrinsics region: where the projection "
+                  "uncertainty stays below this, px (default 1)");
+  sub->add_option("--out-cameramodel", args->out_cameramodel,
+                  "also write mrcal models PREFIX-<camera>.cameramodel "
+                  "(translations in target units)");
   sub->add_flag("--json", args->json, "print one JSON object");
   sub->footer(HelpFooter(
       "Example: stereo rig from a 9x6 chessboard with 25 mm squares:\n  kincal "

@@ -2,6 +2,7 @@
 // a Universal Robots kinematics YAML into robot.yaml.
 //   kincal import ipa-ur10 --in Series_C/measurements_random_poses.csv --out
 //   O.csv kincal import mukca --dir mukca/data/panda_6/front --out O.csv
+// and mrcal camera models into rig.yaml (kincal import cameramodel).
 
 #include <cstdio>
 #include <memory>
@@ -10,6 +11,7 @@
 #include "app/app_util.h"
 #include "app/command.h"
 #include "calib/ur_calibration.h"
+#include "camcal/cameramodel.h"
 #include "data/atomic_file.h"
 #include "data/error.h"
 #include "data/import_ipa.h"
@@ -114,6 +116,39 @@ int RunUrCalibration(const UrImportArgs& args) {
   return 0;
 }
 
+struct CameraModelImportArgs {
+  std::vector<std::string> cameras;  // NAME=FILE
+  std::string out;
+  double unit_mm = 0;
+  bool json = false;
+};
+
+int RunCameraModelImport(const CameraModelImportArgs& args) {
+  std::vector<std::pair<std::string, CameraModelFile>> models;
+  for (const std::string& spec : args.cameras) {
+    const size_t eq = spec.find('=');
+    if (eq == std::string::npos || eq == 0 || eq + 1 == spec.size()) {
+      throw InputError("--camera '" + spec + "': expected NAME=FILE");
+    }
+    models.emplace_back(spec.substr(0, eq),
+                        ReadCameraModel(spec.substr(eq + 1)));
+  }
+  const Rig rig = RigFromCameraModels(models, args.unit_mm);
+  WriteRigYaml(args.out, rig);
+  if (args.json) {
+    nlohmann::json names = nlohmann::json::array();
+    for (const Camera& cam : rig.cameras) names.push_back(cam.intrinsics.name);
+    PrintJson({{"out", args.out},
+               {"cameras", names},
+               {"unit_mm", args.unit_mm},
+               {"baseline_mm", rig.BaselineMm()}});
+  } else {
+    std::printf("kincal import cameramodel: %zu camera(s) -> %s\n",
+                rig.cameras.size(), args.out.c_str());
+  }
+  return 0;
+}
+
 void CommonOptions(CLI::App* sub, ImportArgs* args) {
   sub->add_option("--out", args->out, "observations.csv to write")->required();
   AddRobotOptions(sub, &args->robot, &args->root, &args->tip,
@@ -168,6 +203,26 @@ void AddImportCommand(CLI::App& app, Runner* run) {
       "Example:\n  kincal import ur-calibration --in "
       "my_robot_calibration.yaml --name UR10 --out ur10_factory.yaml"));
   s3->callback([run, ur] { *run = [ur] { return RunUrCalibration(*ur); }; });
+
+  auto cm = std::make_shared<CameraModelImportArgs>();
+  CLI::App* s4 = sub->add_subcommand(
+      "cameramodel",
+      "mrcal .cameramodel files (LENSMODEL_PINHOLE, OPENCV4/5/8) -> rig.yaml; "
+      "the first camera is the rig frame");
+  s4->add_option("--camera", cm->cameras,
+                 "NAME=FILE.cameramodel, once per camera, first = reference")
+      ->required();
+  s4->add_option("--unit-mm", cm->unit_mm,
+                 "length of one unit of the models' translations in mm "
+                 "(1000 for metres, 1 for mm)")
+      ->required();
+  s4->add_option("--out", cm->out, "rig.yaml to write")->required();
+  s4->add_flag("--json", cm->json, "print one JSON object");
+  s4->footer(HelpFooter(
+      "Example:\n  kincal import cameramodel --camera left=left.cameramodel "
+      "--camera right=right.cameramodel --unit-mm 1000 --out rig.yaml"));
+  s4->callback(
+      [run, cm] { *run = [cm] { return RunCameraModelImport(*cm); }; });
 }
 
 }  // namespace kincal::app

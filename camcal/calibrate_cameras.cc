@@ -458,6 +458,10 @@ void CalibrationOptions::Check() const {
   Require(min_views >= 2, "calibration: min_views must be >= 2");
   Require(max_iterations > 0, "calibration: max_iterations must be > 0");
   Require(max_rms_px > 0, "calibration: max_rms_px must be > 0");
+  Require(uncertainty.distance > 0,
+          "calibration: the uncertainty distance must be > 0");
+  Require(uncertainty.valid_threshold_px > 0,
+          "calibration: the valid-region threshold must be > 0 px");
 }
 
 std::string SolveFailure(const CalibrationSummary& summary,
@@ -543,58 +547,111 @@ std::pair<double, double> ProjectionDifferencePx(const CameraIntrinsics& a,
 
 namespace {
 
-// Standard deviations of the intrinsics and, with two cameras, of the
-// extrinsics and the baseline, from the solved problem's covariance scaled
-// by the residual variance; a note instead when the Jacobian is rank
-// deficient.
-void AddCovariance(const State& s, size_t nc, double variance,
-                   ceres::Problem* problem, CalibrationSummary* out) {
+// The parameter blocks of the full covariance (every camera's intrinsics,
+// the extrinsics of the cameras after the first, every used view's pose)
+// and where each parameter sits in its tangent-space vector.
+struct CovarianceLayout {
+  std::vector<const double*> blocks;
+  std::vector<int> rotation_index;  // first entry of each quaternion block
+  CalibrationCovariance cal;        // the solve; indices; no covariance yet
+  int size = 0;
+};
+
+CovarianceLayout LayoutOf(const State& s, const ceres::Problem& problem) {
+  CovarianceLayout layout;
+  CalibrationCovariance& cal = layout.cal;
+  auto add_pose = [&](const PoseBlock& pose) {
+    layout.blocks.push_back(pose.q.data());
+    layout.blocks.push_back(pose.t.data());
+    layout.rotation_index.push_back(layout.size);
+    layout.size += 6;
+    return layout.size - 6;
+  };
+  for (size_t c = 0; c < s.intrinsics.size(); ++c) {
+    const double* block = s.intrinsics[c].data();
+    layout.blocks.push_back(block);
+    const ceres::Manifold* manifold = problem.GetManifold(block);
+    std::array<int, kNumIntrinsics> index;
+    index.fill(-1);
+    // A SubsetManifold holds the trailing coefficients beyond the model.
+    const int free = manifold ? manifold->TangentSize() : kNumIntrinsics;
+    for (int i = 0; i < free; ++i) index[i] = layout.size + i;
+    layout.size += free;
+    cal.intrinsics.push_back(s.intrinsics[c]);
+    cal.intrinsic_index.push_back(index);
+  }
+  for (size_t c = 0; c < s.intrinsics.size(); ++c) {
+    cal.cam_from_rig.push_back(c == 0 ? Rigid3()
+                                      : s.cam_from_rig[c].ToRigid3());
+    cal.cam_from_rig_index.push_back(c == 0 ? -1 : add_pose(s.cam_from_rig[c]));
+  }
+  for (size_t v = 0; v < s.rig_from_target.size(); ++v) {
+    if (!s.view_used[v]) continue;
+    cal.rig_from_target.push_back(s.rig_from_target[v].ToRigid3());
+    cal.rig_from_target_index.push_back(add_pose(s.rig_from_target[v]));
+  }
+  return layout;
+}
+
+// sigma of the intrinsics and, with two cameras, of the extrinsics and the
+// baseline, from the covariance of the tangent vector (rotations as
+// rotation vectors).
+void AddSigmas(const CalibrationCovariance& cal, CalibrationSummary* out) {
+  const Eigen::MatrixXd& cov = cal.covariance;
+  auto sigma = [&](int i) { return std::sqrt(std::max(0.0, cov(i, i))); };
+  for (size_t c = 0; c < cal.intrinsics.size(); ++c) {
+    for (int i = 0; i < kNumIntrinsics; ++i) {
+      const int index = cal.intrinsic_index[c][i];
+      out->cameras[c].sigma.push_back(index < 0 ? 0.0 : sigma(index));
+    }
+  }
+  if (cal.intrinsics.size() == 2) {
+    const int e = cal.cam_from_rig_index[1];
+    for (int i = 0; i < 3; ++i) {
+      out->extrinsic_rotation_sigma_deg.push_back(sigma(e + i) * 180.0 / M_PI);
+      out->extrinsic_translation_sigma.push_back(sigma(e + 3 + i));
+    }
+    // baseline = |t| (camera centre distance = |R^T t| = |t|).
+    const Eigen::Vector3d u = cal.cam_from_rig[1].t.normalized();
+    out->baseline_sigma = std::sqrt(u.dot(cov.block<3, 3>(e + 3, e + 3) * u));
+  }
+}
+
+// The full covariance of the solve scaled by the residual variance; from
+// it the parameter sigma and each camera's projection uncertainty map; a
+// note instead when the Jacobian is rank deficient.
+void AddCovariance(const State& s, double variance,
+                   const CalibrationOptions& options, ceres::Problem* problem,
+                   CalibrationSummary* out) {
+  CovarianceLayout layout = LayoutOf(s, *problem);
   ceres::Covariance::Options copt;
   copt.algorithm_type = ceres::DENSE_SVD;
   copt.num_threads = 1;
   ceres::Covariance covariance(copt);
-  std::vector<std::pair<const double*, const double*>> blocks;
-  for (size_t c = 0; c < nc; ++c) {
-    blocks.emplace_back(s.intrinsics[c].data(), s.intrinsics[c].data());
-  }
-  if (nc == 2) {
-    blocks.emplace_back(s.cam_from_rig[1].q.data(), s.cam_from_rig[1].q.data());
-    blocks.emplace_back(s.cam_from_rig[1].t.data(), s.cam_from_rig[1].t.data());
-  }
-  if (covariance.Compute(blocks, problem)) {
-    for (size_t c = 0; c < nc; ++c) {
-      Eigen::Matrix<double, kNumIntrinsics, kNumIntrinsics, Eigen::RowMajor>
-          cov;
-      covariance.GetCovarianceBlock(s.intrinsics[c].data(),
-                                    s.intrinsics[c].data(), cov.data());
-      for (int i = 0; i < kNumIntrinsics; ++i) {
-        out->cameras[c].sigma.push_back(
-            std::sqrt(std::max(0.0, cov(i, i) * variance)));
-      }
-    }
-    if (nc == 2) {
-      Eigen::Matrix<double, 3, 3, Eigen::RowMajor> cov_r, cov_t;
-      covariance.GetCovarianceBlockInTangentSpace(
-          s.cam_from_rig[1].q.data(), s.cam_from_rig[1].q.data(), cov_r.data());
-      covariance.GetCovarianceBlock(s.cam_from_rig[1].t.data(),
-                                    s.cam_from_rig[1].t.data(), cov_t.data());
-      // EigenQuaternionManifold's tangent is half the rotation vector.
-      for (int i = 0; i < 3; ++i) {
-        out->extrinsic_rotation_sigma_deg.push_back(
-            2.0 * std::sqrt(std::max(0.0, cov_r(i, i) * variance)) * 180.0 /
-            M_PI);
-        out->extrinsic_translation_sigma.push_back(
-            std::sqrt(std::max(0.0, cov_t(i, i) * variance)));
-      }
-      // baseline = |t| (camera centre distance = |R^T t| = |t|).
-      const Eigen::Vector3d t(s.cam_from_rig[1].t.data());
-      const Eigen::Vector3d u = t.normalized();
-      out->baseline_sigma = std::sqrt(u.dot(cov_t * u) * variance);
-    }
-  } else {
+  if (!covariance.Compute(layout.blocks, problem)) {
     out->covariance_note =
         "covariance not available: the Jacobian is rank deficient (the "
         "views do not determine every parameter)";
+    return;
+  }
+  Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> cov(
+      layout.size, layout.size);
+  covariance.GetCovarianceMatrixInTangentSpace(layout.blocks, cov.data());
+  cov *= variance;
+  // EigenQuaternionManifold's tangent is half the rotation vector.
+  for (int r : layout.rotation_index) {
+    cov.middleRows(r, 3) *= 2.0;
+    cov.middleCols(r, 3) *= 2.0;
+  }
+  CalibrationCovariance& cal = layout.cal;
+  cal.covariance = cov;
+  AddSigmas(cal, out);
+  for (size_t c = 0; c < out->cameras.size(); ++c) {
+    const CameraIntrinsics& in = out->cameras[c].intrinsics;
+    out->cameras[c].projection_uncertainty = MapProjectionUncertainty(
+        cal, static_cast<int>(c), in.width, in.height, options.uncertainty);
+    out->rig.cameras[c].valid_intrinsics_region =
+        out->cameras[c].projection_uncertainty.valid_region;
   }
 }
 
@@ -710,7 +767,7 @@ CalibrationSummary CalibrateCameras(const CalibrationProblem& input,
   out.residual_sigma_px = std::sqrt(variance);
 
   if (options.compute_covariance && dof > 0) {
-    AddCovariance(s, nc, variance, &problem, &out);
+    AddCovariance(s, variance, options, &problem, &out);
   }
   if (options.cross_validate) CrossValidateHalves(input, options, &out);
   out.seconds =

@@ -27,6 +27,7 @@
 #include <vector>
 
 #include "camcal/camera_model.h"
+#include "camcal/projection_uncertainty.h"
 #include "camcal/rig.h"
 
 namespace kincal {
@@ -73,8 +74,12 @@ struct CalibrationOptions {
   // A final RMS point residual above this (px) is no calibration: the
   // target's size or layout does not match the images (SolveFailure).
   double max_rms_px = 10.0;
-  // Compute parameter sigma (ceres::Covariance, DENSE_SVD).
+  // Compute parameter sigma (ceres::Covariance, DENSE_SVD) and the
+  // projection uncertainty map of each camera (projection_uncertainty.h).
   bool compute_covariance = true;
+  // Distance, grid and valid-region threshold of the projection
+  // uncertainty (default: points at infinity, 8 x 6 cells, 1 px).
+  UncertaintyOptions uncertainty;
   // Run the even/odd cross-validation (needs 2 * min_views views per camera).
   bool cross_validate = true;
   // Points with a residual above this many times the camera's RMS are
@@ -113,6 +118,9 @@ struct CameraCalibrationSummary {
   // sigma of fx, fy, cx, cy, k1..k6 (kNumIntrinsics, 0 for fixed ones), scaled
   // by the residual variance; empty when the covariance is not available.
   std::vector<double> sigma;
+  // Projection uncertainty (mrcal's definition) at the centre, corners and
+  // a grid; valid only when `sigma` is not empty.
+  ProjectionUncertaintyMap projection_uncertainty;
   // Cross-validation (NaN when not run): held-out reprojection RMS, each
   // half's cameras on the other half's views with only the view pose fitted.
   double holdout_rms_px = std::numeric_limits<double>::quiet_NaN();

@@ -136,6 +136,92 @@ TEST(CalibrateCameras, SyntheticStereoRecoversRigWithinSigma) {
                            4 * sum.extrinsic_rotation_sigma_deg[2]);
 }
 
+// The projection of a point at infinity seen at `pixel` of `camera` (the
+// truth), fixed relative to the targets, through a solved calibration:
+// Project(intrinsics, cam_from_rig * mean_i(rig_from_target_i * d_i)) with
+// rotations only, as projection_uncertainty.h defines it.
+Eigen::Vector2d ProjectThroughSolvedTargets(
+    const Synthetic& syn, const std::vector<Rigid3>& truth_poses,
+    const CalibrationSummary& sum, int camera, const Eigen::Vector2d& pixel) {
+  const Camera& truth = syn.truth.cameras[camera];
+  const Eigen::Vector3d dir = Unproject(truth.intrinsics, pixel);
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+  for (size_t v = 0; v < truth_poses.size(); ++v) {
+    const Eigen::Vector3d in_target =
+        (truth.cam_from_rig.R * truth_poses[v].R).transpose() * dir;
+    mean += sum.rig_from_target[v].R * in_target;
+  }
+  const Camera& solved = sum.rig.cameras[camera];
+  return Project(solved.intrinsics,
+                 solved.cam_from_rig.R * (mean / truth_poses.size()));
+}
+
+// Monte Carlo: the spread of that projection over noise draws matches the
+// predicted worst-direction sigma (which fails if the covariance's layout,
+// the rotation scaling or the view-pose terms are wrong).
+TEST(CalibrateCameras, ProjectionUncertaintyMatchesMonteCarlo) {
+  const double noise_px = 0.5;
+  const int views = 8, trials = 30;
+  const Synthetic base = MakeSynthetic(2, views, 0.0, 11);
+  // The true view poses: a noise-free solve recovers them exactly.
+  CalibrationOptions fast;
+  fast.cross_validate = false;
+  fast.compute_covariance = false;
+  fast.loss = CalibrationOptions::Loss::kTrivial;
+  const std::vector<Rigid3> truth_poses =
+      CalibrateCameras(base.problem, fast).rig_from_target;
+  std::mt19937_64 rng(5);
+  std::normal_distribution<double> noise(0.0, noise_px);
+  auto noisy = [&]() {
+    CalibrationProblem p = base.problem;
+    for (CalibrationView& view : p.views) {
+      for (TargetObservation& obs : view.observations) {
+        for (Eigen::Vector2d& px : obs.pixels) {
+          px += Eigen::Vector2d(noise(rng), noise(rng));
+        }
+      }
+    }
+    return p;
+  };
+  CalibrationOptions predict = fast;
+  predict.compute_covariance = true;
+  const CalibrationSummary predicted = CalibrateCameras(noisy(), predict);
+  struct Sample {
+    int camera;
+    Eigen::Vector2d pixel;
+    double sigma;
+  };
+  const ProjectionUncertaintyMap& left =
+      predicted.cameras[0].projection_uncertainty;
+  const ProjectionUncertaintyMap& right =
+      predicted.cameras[1].projection_uncertainty;
+  const std::vector<Sample> samples = {
+      {0, left.centre_pixel, left.centre_px},
+      {0, left.corner_pixels[0], left.corner_px[0]},
+      {1, right.corner_pixels[3], right.corner_px[3]}};
+  std::vector<std::vector<Eigen::Vector2d>> q(samples.size());
+  for (int k = 0; k < trials; ++k) {
+    const CalibrationSummary sum = CalibrateCameras(noisy(), fast);
+    for (size_t s = 0; s < samples.size(); ++s) {
+      q[s].push_back(ProjectThroughSolvedTargets(
+          base, truth_poses, sum, samples[s].camera, samples[s].pixel));
+    }
+  }
+  for (size_t s = 0; s < samples.size(); ++s) {
+    Eigen::Vector2d mean = Eigen::Vector2d::Zero();
+    for (const Eigen::Vector2d& x : q[s]) mean += x / trials;
+    Eigen::Matrix2d cov = Eigen::Matrix2d::Zero();
+    for (const Eigen::Vector2d& x : q[s]) {
+      cov += (x - mean) * (x - mean).transpose() / (trials - 1);
+    }
+    const double empirical = WorstDirectionSigma(cov);
+    EXPECT_GT(samples[s].sigma, 0.02) << s;
+    EXPECT_NEAR(empirical / samples[s].sigma, 1.0, 0.3)
+        << "sample " << s << ": predicted " << samples[s].sigma
+        << " px, Monte Carlo " << empirical << " px";
+  }
+}
+
 TEST(CalibrateCameras, RobustLossResistsOutliers) {
   Synthetic syn = MakeSynthetic(1, 10, 0.2, 11);
   // Corrupt 1% of the corners by 30 px.

@@ -54,6 +54,22 @@ Rigid3 ParsePose(const YamlReader& y, const YAML::Node& node,
   return pose;
 }
 
+// [[u, v], ...] in px.
+std::vector<Eigen::Vector2d> ParseRegion(const YamlReader& y,
+                                         const YAML::Node& node,
+                                         const std::string& what) {
+  y.ExpectSequence(node, what);
+  std::vector<Eigen::Vector2d> region;
+  for (size_t k = 0; k < node.size(); ++k) {
+    const std::vector<double> uv = y.Numbers(node[k], what, 2, 2);
+    if (!(std::abs(uv[0]) <= 1e6 && std::abs(uv[1]) <= 1e6)) {
+      y.Fail(node[k], what + ": expected pixels within +-1e6");
+    }
+    region.emplace_back(uv[0], uv[1]);
+  }
+  return region;
+}
+
 std::string Join(const std::vector<double>& v) {
   std::string s = "[";
   for (size_t i = 0; i < v.size(); ++i) {
@@ -105,7 +121,7 @@ Rig ParseRigYaml(const std::string& text, const std::string& file) {
     y.ExpectMap(c, what);
     y.CheckKeys(c,
                 {"name", "width", "height", "fx", "fy", "cx", "cy",
-                 "distortion", "cam_from_rig"},
+                 "distortion", "cam_from_rig", "valid_intrinsics_region"},
                 what);
     Camera cam;
     CameraIntrinsics& in = cam.intrinsics;
@@ -166,6 +182,10 @@ Rig ParseRigYaml(const std::string& text, const std::string& file) {
                        "expected R = identity, t = [0, 0, 0]");
     }
     if (i == 0) cam.cam_from_rig = Rigid3();
+    if (c["valid_intrinsics_region"]) {
+      cam.valid_intrinsics_region = ParseRegion(
+          y, c["valid_intrinsics_region"], what + ".valid_intrinsics_region");
+    }
     rig.cameras.push_back(std::move(cam));
   }
   return rig;
@@ -199,6 +219,14 @@ std::string RigToYaml(const Rig& rig) {
     const Eigen::Vector3d& t = cam.cam_from_rig.t;
     os << "    cam_from_rig: {R: " << Join(r)
        << ", t: " << Join({t.x(), t.y(), t.z()}) << "}  # R row-major, t mm\n";
+    if (!cam.valid_intrinsics_region.empty()) {
+      os << "    valid_intrinsics_region: [";
+      for (size_t k = 0; k < cam.valid_intrinsics_region.size(); ++k) {
+        const Eigen::Vector2d& p = cam.valid_intrinsics_region[k];
+        os << (k ? ", " : "") << Join({p.x(), p.y()});
+      }
+      os << "]  # px, projection uncertainty below the threshold\n";
+    }
   }
   return os.str();
 }

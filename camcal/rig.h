@@ -14,6 +14,12 @@
 //       cy: 511.5
 //       distortion: [k1, k2, p1, p2, k3]   # 0, 4, 5 or 8 numbers
 //       cam_from_rig: {R: [9 numbers, row-major], t: [x, y, z]}   # t in mm
+//       valid_intrinsics_region: [[u, v], ...]   # optional, px, closed
+//
+// valid_intrinsics_region (optional): the outline of the image region where
+// the projection uncertainty stays below camcal's threshold (mrcal's
+// valid_intrinsics_region; see camcal/projection_uncertainty.h); absent or
+// empty when unknown.
 
 #include <string>
 #include <vector>
@@ -25,6 +31,7 @@ namespace kincal {
 struct Camera {
   CameraIntrinsics intrinsics;
   Rigid3 cam_from_rig;  // p_in_cam = cam_from_rig * p_in_rig, t in mm
+  std::vector<Eigen::Vector2d> valid_intrinsics_region;  // px; may be empty
 };
 
 struct Rig {

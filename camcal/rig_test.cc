@@ -15,6 +15,7 @@ namespace kincal {
 namespace {
 
 using ::testing::HasSubstr;
+using ::testing::Not;
 
 const char* kSpecExample = R"(kincal_rig: 1
 cameras:
@@ -76,6 +77,8 @@ TEST(RigYaml, WriteReadRoundTripIsExact) {
       Eigen::AngleAxisd(0.1, Eigen::Vector3d(0.3, 1, 0.2).normalized())
           .toRotationMatrix();
   b.cam_from_rig.t = Eigen::Vector3d(-3.34, 0.0123, 0.1 / 3);
+  b.valid_intrinsics_region = {
+      {10.5, 20}, {600, 1.0 / 3}, {320, 470}, {10.5, 20}};
   rig.cameras = {a, b};
   const std::string dir = testing::MakeTempDir("rig");
   const std::string path = dir + "/rig.yaml";
@@ -99,7 +102,10 @@ TEST(RigYaml, WriteReadRoundTripIsExact) {
         (rig.cameras[i].cam_from_rig.R - back.cameras[i].cam_from_rig.R).norm(),
         1e-15);
     EXPECT_EQ(rig.cameras[i].cam_from_rig.t, back.cameras[i].cam_from_rig.t);
+    EXPECT_EQ(rig.cameras[i].valid_intrinsics_region,
+              back.cameras[i].valid_intrinsics_region);
   }
+  EXPECT_THAT(text, Not(HasSubstr("valid_intrinsics_region: []")));
 }
 
 struct BadCase {
@@ -146,6 +152,12 @@ INSTANTIATE_TEST_SUITE_P(
                 "480, fx: 800, fy: 800, cx: 320, cy: 240, distortion: [1,2,3], "
                 "cam_from_rig: {R: [1,0,0,0,1,0,0,0,1], t: [0,0,0]}}\n",
                 3, "0, 4, 5 or 8"},
+        BadCase{"region pair",
+                "kincal_rig: 1\ncameras:\n  - {name: l, width: 640, height: "
+                "480, fx: 800, fy: 800, cx: 320, cy: 240, distortion: [], "
+                "cam_from_rig: {R: [1,0,0,0,1,0,0,0,1], t: [0,0,0]},\n"
+                "     valid_intrinsics_region: [[1, 2], [3, 4, 5]]}\n",
+                4, "valid_intrinsics_region"},
         BadCase{"negative fx",
                 "kincal_rig: 1\ncameras:\n  - {name: l, width: 640, height: "
                 "480, fx: -800, fy: 800, cx: 320, cy: 240, distortion: [], "

@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
+#include "camcal/cameramodel.h"
 #include "camcal/rig.h"
 #include "tests/testing/paths.h"
 #include "tests/testing/run.h"
@@ -26,9 +27,11 @@ std::string StereoDir() {
 TEST(CamcalCli, StereoChessboardJsonAndRig) {
   KINCAL_REQUIRE_SHARED_DATA("opencv-stereo-left-right");
   const std::string out = testing::MakeTempDir("camcal") + "/rig.yaml";
-  const RunResult r = RunKincal(
-      "camcal --left '" + StereoDir() + "/left*.jpg' --right '" + StereoDir() +
-      "/right*.jpg' --target chessboard:9x6:1 --out " + out + " --json");
+  const std::string prefix = out.substr(0, out.size() - 9) + "/mrcal";
+  const RunResult r =
+      RunKincal("camcal --left '" + StereoDir() + "/left*.jpg' --right '" +
+                StereoDir() + "/right*.jpg' --target chessboard:9x6:1 --out " +
+                out + " --out-cameramodel " + prefix + " --json");
   ASSERT_EQ(r.exit_code, 0) << r.out;
   const nlohmann::json j = nlohmann::json::parse(r.out);
   EXPECT_LE(j.at("rms_px").get<double>(), 0.445);
@@ -77,6 +80,44 @@ TEST(CamcalCli, StereoChessboardJsonAndRig) {
   EXPECT_DOUBLE_EQ(rig.cameras[1].intrinsics.fx,
                    j["cameras"][1]["fx"].get<double>());
   EXPECT_NEAR(rig.BaselineMm(), j["baseline"].get<double>(), 1e-9);
+
+  // Projection uncertainty: smallest at the centre, a valid region around it
+  // (also in rig.yaml), and the mrcal models that import back to the rig.
+  for (size_t c = 0; c < 2; ++c) {
+    const auto& u = j["cameras"][c].at("projection_uncertainty");
+    EXPECT_TRUE(u.at("distance").is_null());  // infinity
+    const double centre = u["centre"]["sigma_px"].get<double>();
+    EXPECT_GT(centre, 0.01);
+    EXPECT_LT(centre, 1.0);
+    for (const auto& corner : u.at("corners")) {
+      EXPECT_GT(corner["sigma_px"].get<double>(), 2 * centre);
+    }
+    EXPECT_EQ(u["grid"]["sigma_px"].size(), 48u);
+    EXPECT_GE(u.at("valid_intrinsics_region").size(), 4u);
+    EXPECT_EQ(rig.cameras[c].valid_intrinsics_region.size(),
+              u["valid_intrinsics_region"].size());
+  }
+  const std::string imported = testing::MakeTempDir("camcal") + "/back.yaml";
+  ASSERT_EQ(RunKincal("import cameramodel --camera left=" + prefix +
+                      "-left.cameramodel --camera right=" + prefix +
+                      "-right.cameramodel --unit-mm 1 --out " + imported)
+                .exit_code,
+            0);
+  const Rig back = ReadRigYaml(imported);
+  ASSERT_EQ(back.cameras.size(), 2u);
+  for (size_t c = 0; c < 2; ++c) {
+    const CameraIntrinsics& a = rig.cameras[c].intrinsics;
+    const CameraIntrinsics& b = back.cameras[c].intrinsics;
+    EXPECT_EQ(a.fx, b.fx);
+    EXPECT_EQ(a.cy, b.cy);
+    EXPECT_EQ(a.distortion, b.distortion);
+    const Eigen::Vector3d p(0.3, -0.2, 25);
+    EXPECT_LT((Project(a, rig.cameras[c].cam_from_rig * p) -
+               Project(b, back.cameras[c].cam_from_rig * p))
+                  .norm(),
+              1e-9);
+  }
+  EXPECT_NEAR(back.BaselineMm(), rig.BaselineMm(), 1e-12);
 }
 
 TEST(CamcalCli, BadInputExitsTwoAndWritesNothing) {
