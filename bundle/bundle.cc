@@ -808,6 +808,39 @@ void EstimateCovariance(State* st, const std::vector<Obs>& train,
   }
 }
 
+// What the calibrated robot file records of the fit (data/robot.h
+// FitRecord): the nominal rows, the frames' joint travel, the rig as the
+// measuring frame and the held-out tip RMS. No covariance: the bundle's is
+// over pixels and cameras and is not propagated to the robot yet.
+void RecordFit(const Robot& nominal, const std::vector<BundleFrame>& frames,
+               BundleResult* res) {
+  Robot& cal = res->calibrated;
+  cal.SetNominal(nominal);
+  FitRecord& rec = cal.fitted_on;
+  const size_t n = nominal.joints.size();
+  rec.joint_range.assign(n, {std::numeric_limits<double>::infinity(),
+                             -std::numeric_limits<double>::infinity()});
+  for (const BundleFrame& f : frames) {
+    if (f.q_reading.size() != n) continue;
+    ++rec.poses;
+    for (size_t j = 0; j < n; ++j) {
+      rec.joint_range[j][0] = std::min(rec.joint_range[j][0], f.q_reading[j]);
+      rec.joint_range[j][1] = std::max(rec.joint_range[j][1], f.q_reading[j]);
+    }
+  }
+  if (rec.poses == 0) {
+    rec.joint_range.clear();
+    return;
+  }
+  const std::array<double, 6>& block = res->rig_from_base;
+  rec.has_frame = true;
+  for (int k = 0; k < 3; ++k) {
+    rec.frame[k] = block[k] * 180.0 / M_PI;
+    rec.frame[k + 3] = block[k + 3];
+  }
+  rec.heldout_rms_mm = res->heldout_tip_rms_mm;
+}
+
 // The solved state into the result: the tool row from the tip, the robot,
 // both frames and the refined rig.
 void WriteSolution(const Robot& nominal, const Rig& rig, const Target& target,
@@ -967,6 +1000,7 @@ BundleResult RunBundle(const Robot& nominal, const Rig& rig,
   WriteSolution(nominal, rig, target, with_errors, &st, &res);
   HeldOutTips(frames, target, opt, &res);
   NameIdentifiable(st.chain, scan.accepted, &res);
+  RecordFit(nominal, frames, &res);
   res.seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start)
           .count();

@@ -71,6 +71,14 @@ TEST(Bundle, ExactCornersGiveTheTrueTips) {
   EXPECT_EQ(r.dropped_tags, 0);
   // Tips of the calibrated robot vs the true ones, up to the base frame.
   EXPECT_LT(TipRmsAgainstTruth(s, r.calibrated, 100, 9), 1e-3);
+  // The record compensate reads: nominal rows, travel, the rig as frame.
+  ASSERT_TRUE(r.calibrated.HasNominal());
+  EXPECT_EQ(r.calibrated.nominal_joints[1].a_mm, s.nominal.joints[1].a_mm);
+  EXPECT_EQ(r.calibrated.fitted_on.poses, 60);
+  ASSERT_EQ(r.calibrated.fitted_on.joint_range.size(), s.nominal.joints.size());
+  EXPECT_LE(r.calibrated.fitted_on.joint_range[2][0], s.frames[0].q_reading[2]);
+  EXPECT_TRUE(r.calibrated.fitted_on.has_frame);
+  EXPECT_EQ(r.calibrated.fitted_on.frame[3], r.rig_from_base[3]);
 }
 
 // Noisy corners: parameter errors against the truth are within 1.5x of the
