@@ -230,6 +230,7 @@ int RunCalibrate(CalibrateArgs args) {
   Warnings warnings = CommandWarnings();
   const Observations obs =
       ReadCheckedObservations(args.obs, nominal, args.robot, &warnings);
+  RequireOneSeries(obs, "calibrate");
   args.options = FitOptions(args);
   Progress progress("kincal calibrate", args.json || obs.rows.size() < 500);
   progress.Stage("fitting " + std::to_string(obs.rows.size()) +
