@@ -9,6 +9,7 @@
 
 #include "app/app_util.h"
 #include "app/command.h"
+#include "calib/evaluate.h"
 #include "data/atomic_file.h"
 #include "data/error.h"
 #include "data/progress.h"
@@ -37,6 +38,7 @@ int RunModel(const ModelArgs& args) {
   const Observations obs =
       ReadCheckedObservations(args.obs, robot, args.robot, &warnings);
   RequireOneSeries(obs, "diagnose model");
+  RequireNoFrameJump(robot, obs, "diagnose model");
   DiagnoseOptions options = args.options;
   for (const std::string& v : args.validate) {
     options.validation.push_back(

@@ -1,6 +1,8 @@
 #include "calib/evaluate.h"
 
 #include <algorithm>
+#include <cmath>
+#include <sstream>
 #include <string>
 #include <utility>
 
@@ -94,7 +96,123 @@ ModelState MergeStates(const std::vector<ModelState>& states,
   return merged;
 }
 
+// RMS of the errors in [begin, end) of `errors_mm`.
+double RangeRms(const std::vector<double>& errors_mm, size_t begin,
+                size_t end) {
+  std::vector<double> part(errors_mm.begin() + begin, errors_mm.begin() + end);
+  return ComputeErrorStats(part).rms_mm;
+}
+
+// The split of `errors_mm` (errors against the frame of one end's block)
+// with the fewest rows on the wrong side of `threshold_mm`: small before
+// the split and large after it (`small_first`), or the reverse.
+size_t BestSplit(const std::vector<double>& errors_mm, double threshold_mm,
+                 bool small_first) {
+  const size_t n = errors_mm.size();
+  // wrong = rows before the split on the wrong side + rows after it.
+  size_t wrong_after = 0;
+  for (double e : errors_mm) {
+    wrong_after += ((e > threshold_mm) == small_first) ? 0 : 1;
+  }
+  size_t best = 0, best_wrong = wrong_after, wrong_before = 0;
+  for (size_t k = 0; k < n; ++k) {
+    const bool large = errors_mm[k] > threshold_mm;
+    wrong_before += (large == small_first) ? 1 : 0;
+    wrong_after -= (large == small_first) ? 0 : 1;
+    if (wrong_before + wrong_after < best_wrong) {
+      best_wrong = wrong_before + wrong_after;
+      best = k + 1;
+    }
+  }
+  return best;
+}
+
+// Both blocks of `ms` split at `split`, each registered on its own frame.
+bool TrySplit(const ModelState& start, const std::vector<Measurement>& ms,
+              size_t split, FrameJump* jump) {
+  constexpr size_t kMinRows = 6;
+  if (split < kMinRows || ms.size() - split < kMinRows) return false;
+  const std::vector<Measurement> before(ms.begin(), ms.begin() + split);
+  const std::vector<Measurement> after(ms.begin() + split, ms.end());
+  try {
+    jump->before_rms_mm =
+        Register(start, before, std::vector<char>(before.size(), 0))
+            .stats.rms_mm;
+    jump->after_rms_mm =
+        Register(start, after, std::vector<char>(after.size(), 0)).stats.rms_mm;
+  } catch (const InputError&) {
+    return false;  // a block too small or flat to register
+  }
+  jump->first_row_after = ms[split].row;
+  return true;
+}
+
 }  // namespace
+
+FrameJump FindFrameJump(const Robot& robot, const Observations& obs,
+                        const FrameJumpOptions& options) {
+  FrameJump jump;
+  ModelState start;
+  start.chain = Chain::FromRobot(robot);
+  std::vector<Measurement> ms;
+  for (const Measurement& m : MakeMeasurements(start.chain, obs, &start)) {
+    if (m.kind == Measurement::kMeasured) ms.push_back(m);
+  }
+  constexpr size_t kMinRows = 20;
+  if (ms.size() < kMinRows) return jump;
+  try {
+    jump.one_frame_rms_mm =
+        Register(start, ms, std::vector<char>(ms.size(), 0)).stats.rms_mm;
+  } catch (const InputError&) {
+    return jump;  // calibrate says what is wrong with the points
+  }
+  if (!(jump.one_frame_rms_mm > options.min_one_frame_rms_mm)) return jump;
+  const size_t block = std::max<size_t>(6, ms.size() / 10);
+  for (const bool from_start : {true, false}) {
+    const std::vector<Measurement> end_block(
+        from_start ? ms.begin() : ms.end() - block,
+        from_start ? ms.begin() + block : ms.end());
+    std::vector<double> errors;
+    try {
+      const ModelState frame =
+          Register(start, end_block, std::vector<char>(block, 0)).state;
+      for (const Measurement& m : ms)
+        errors.push_back(Residual(frame, m).norm());
+    } catch (const InputError&) {
+      continue;
+    }
+    const double block_rms =
+        from_start ? RangeRms(errors, 0, block)
+                   : RangeRms(errors, ms.size() - block, ms.size());
+    const double threshold = std::sqrt(block_rms * jump.one_frame_rms_mm);
+    const size_t split = BestSplit(errors, threshold, from_start);
+    if (!TrySplit(start, ms, split, &jump)) continue;
+    if (std::max(jump.before_rms_mm, jump.after_rms_mm) <
+        options.max_ratio * jump.one_frame_rms_mm) {
+      jump.found = true;
+      return jump;
+    }
+  }
+  return jump;
+}
+
+void RequireNoFrameJump(const Robot& robot, const Observations& obs,
+                        const std::string& command) {
+  const FrameJump jump = FindFrameJump(robot, obs);
+  if (!jump.found) return;
+  const Observation& row = obs.rows.at(jump.first_row_after);
+  std::ostringstream os;
+  os.precision(3);
+  os << std::fixed << "the rows before line " << row.line << " and from it on ("
+     << "pose '" << row.pose << "') look like two measurement campaigns with "
+     << "different measuring frames: one frame for all rows leaves "
+     << jump.one_frame_rms_mm << " mm RMS, one frame per block "
+     << jump.before_rms_mm << " and " << jump.after_rms_mm
+     << " mm; add a `series` column labelling each campaign (`kincal "
+        "evaluate` registers one frame per series; `kincal "
+     << command << "` needs the rows of one series per run)";
+  throw InputError(obs.source, row.line, 0, os.str());
+}
 
 EvaluateResult Evaluate(const Robot& robot, const Observations& obs,
                         double outlier_sigmas) {

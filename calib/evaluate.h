@@ -68,6 +68,40 @@ struct EvaluateResult {
 EvaluateResult Evaluate(const Robot& robot, const Observations& obs,
                         double outlier_sigmas = kDefaultOutlierSigmas);
 
+// Rows of two campaigns concatenated without a series label, the
+// instrument moved in between: one frame for all rows leaves a large error,
+// one frame for each of two contiguous blocks of rows does not.
+struct FrameJumpOptions {
+  // Searched only when the one-frame RMS (model held fixed) exceeds this:
+  // far above a nominal model's error, so data of one campaign are left
+  // alone.
+  double min_one_frame_rms_mm = 20.0;
+  // Found when both blocks' RMS, each on its own frame, stay below this
+  // fraction of the one-frame RMS.
+  double max_ratio = 0.1;
+};
+
+struct FrameJump {
+  bool found = false;
+  int first_row_after = 0;  // index in Observations::rows of the 2nd block
+  double one_frame_rms_mm = 0.0;
+  double before_rms_mm = 0.0;  // first block on its own frame
+  double after_rms_mm = 0.0;   // second block on its own frame
+};
+
+// Looks for the jump: the frame registered on the first (else the last)
+// tenth of the measured rows splits the rows into those it fits and those
+// it does not; both blocks are then registered on their own. Rows with only
+// a fixed_point label take no part.
+FrameJump FindFrameJump(const Robot& robot, const Observations& obs,
+                        const FrameJumpOptions& options = {});
+
+// Throws InputError (at the first row of the second block) when
+// FindFrameJump finds a jump: the hint is to add a `series` column.
+// `command` names the refusing command in the message.
+void RequireNoFrameJump(const Robot& robot, const Observations& obs,
+                        const std::string& command);
+
 }  // namespace kincal
 
 #endif  // KINCAL_CALIB_EVALUATE_H_

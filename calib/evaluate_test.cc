@@ -153,5 +153,45 @@ TEST(EvaluateTest, TooSmallSeriesIsInputErrorNamingIt) {
   }
 }
 
+// Two campaigns concatenated without labels (the second frame turned and
+// moved): the jump is found at the first row of the second campaign; one
+// campaign, or the nominal model on one, shows none.
+TEST(EvaluateTest, FindsFrameJumpOfUnlabelledCampaigns) {
+  const SimulatedSession a = Session();
+  SimulateOptions so;
+  so.poses = 60;
+  so.seed = 8;
+  so.noise_mm = 0.02;
+  so.meas_from_base = {a.meas_from_base[0],       a.meas_from_base[1],
+                       a.meas_from_base[2] + 0.5, a.meas_from_base[3] + 500,
+                       a.meas_from_base[4],       a.meas_from_base[5]};
+  const SimulatedSession b = Simulate(a.nominal, so);
+  Observations both = a.observations;
+  for (size_t i = 0; i < 40; ++i) {
+    Observation o = b.observations.rows[i];
+    o.pose = "b" + o.pose;
+    both.rows.push_back(o);
+  }
+  const FrameJump jump = FindFrameJump(a.nominal, both);
+  EXPECT_TRUE(jump.found);
+  EXPECT_EQ(jump.first_row_after, 60);
+  EXPECT_GT(jump.one_frame_rms_mm, 100.0);
+  EXPECT_LT(jump.before_rms_mm, 5.0);
+  EXPECT_LT(jump.after_rms_mm, 5.0);
+  // The second campaign first: found from the last rows' frame.
+  Observations swapped;
+  swapped.source = both.source;
+  swapped.joint_names = both.joint_names;
+  for (size_t i = 60; i < both.rows.size(); ++i)
+    swapped.rows.push_back(both.rows[i]);
+  for (size_t i = 0; i < 60; ++i) swapped.rows.push_back(both.rows[i]);
+  const FrameJump back = FindFrameJump(a.nominal, swapped);
+  EXPECT_TRUE(back.found);
+  EXPECT_EQ(back.first_row_after, 40);
+
+  EXPECT_FALSE(FindFrameJump(a.nominal, a.observations).found);
+  EXPECT_FALSE(FindFrameJump(a.truth, a.observations).found);
+}
+
 }  // namespace
 }  // namespace kincal

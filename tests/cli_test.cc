@@ -357,6 +357,15 @@ TEST_F(CliTest, SeriesOneFrameEachInEvaluateRefusedByCalibrate) {
                 " --json");
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_THAT(r.err, HasSubstr("`kincal diagnose model`"));
+  // The same rows without labels: the jump between the copies is found.
+  r = RunKincal("calibrate --robot " + Robot() + " --obs " + plain + " --out " +
+                out + " --json");
+  EXPECT_EQ(r.exit_code, 2);
+  // Provenance line, header, 120 rows of the first copy: line 123.
+  EXPECT_THAT(r.err, HasSubstr("series_unlabelled.csv:123: the rows before "
+                               "line 123 and from it on (pose 'b0')"));
+  EXPECT_THAT(r.err, HasSubstr("add a `series` column"));
+  EXPECT_FALSE(Exists(out));
 }
 
 }  // namespace
