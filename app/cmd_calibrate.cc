@@ -9,6 +9,7 @@
 #include "app/app_util.h"
 #include "app/command.h"
 #include "calib/calibrate.h"
+#include "calib/evaluate.h"
 #include "data/atomic_file.h"
 #include "data/csv.h"
 #include "data/error.h"
@@ -230,6 +231,8 @@ int RunCalibrate(CalibrateArgs args) {
   Warnings warnings = CommandWarnings();
   const Observations obs =
       ReadCheckedObservations(args.obs, nominal, args.robot, &warnings);
+  RequireOneSeries(obs, "calibrate");
+  RequireNoFrameJump(nominal, obs, "calibrate");
   args.options = FitOptions(args);
   Progress progress("kincal calibrate", args.json || obs.rows.size() < 500);
   progress.Stage("fitting " + std::to_string(obs.rows.size()) +

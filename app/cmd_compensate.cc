@@ -189,6 +189,7 @@ int RunCompensate(const CompensateArgs& args) {
   if (!args.obs.empty()) {
     const Observations obs =
         ReadCheckedObservations(args.obs, robot, args.robot, &warnings);
+    RequireOneSeries(obs, "compensate --obs");
     replay = Evaluate(robot, obs);
     if (robot.HasNominal()) {
       replay_nominal_rms = Evaluate(robot.Nominal(), obs).stats.rms_mm;

@@ -9,6 +9,7 @@
 
 #include "app/app_util.h"
 #include "app/command.h"
+#include "calib/evaluate.h"
 #include "data/atomic_file.h"
 #include "data/error.h"
 #include "data/progress.h"
@@ -36,10 +37,13 @@ int RunModel(const ModelArgs& args) {
   Warnings warnings = CommandWarnings();
   const Observations obs =
       ReadCheckedObservations(args.obs, robot, args.robot, &warnings);
+  RequireOneSeries(obs, "diagnose model");
+  RequireNoFrameJump(robot, obs, "diagnose model");
   DiagnoseOptions options = args.options;
   for (const std::string& v : args.validate) {
     options.validation.push_back(
         ReadCheckedObservations(v, robot, args.robot, &warnings));
+    RequireOneSeries(options.validation.back(), "diagnose model --validate");
   }
   Progress progress("kincal diagnose model", args.json);
   progress.Stage("fitting candidate extensions with the geometry, " +
@@ -139,6 +143,7 @@ int RunClearance(const ClearanceArgs& args) {
   Warnings warnings = CommandWarnings();
   const Observations obs =
       ReadCheckedObservations(args.obs, robot, args.robot, &warnings);
+  RequireOneSeries(obs, "diagnose clearance");
   const ClearanceResult r = DiagnoseClearance(robot, obs, args.options);
   if (!args.csv.empty()) WriteFileAtomic(args.csv, ClearanceCsv(r));
   if (!args.plot.empty()) WriteFileAtomic(args.plot, ClearanceSvg(r));
@@ -182,6 +187,8 @@ int RunCompare(const CompareArgs& args) {
       ReadCheckedObservations(args.before, robot, args.robot, &warnings);
   const Observations after =
       ReadCheckedObservations(args.after, robot, args.robot, &warnings);
+  RequireOneSeries(before, "diagnose compare");
+  RequireOneSeries(after, "diagnose compare");
   const CompareResult r = CompareClearance(robot, before, after);
   if (args.json) {
     nlohmann::json j = CompareJson(r);

@@ -66,26 +66,61 @@ void AddPointsJson(const ModelState& st, const Observations& obs,
   (*j)["point_distances"] = dist;
 }
 
+// Per series (spec v3): its figures and its registered frame (rotation
+// vector deg, translation mm).
+nlohmann::json SeriesJson(const EvaluateResult& r) {
+  nlohmann::json list = nlohmann::json::array();
+  for (const SeriesEvaluation& s : r.series) {
+    nlohmann::json j = {{"name", s.name}};
+    j.update(StatsJson(s.stats));
+    const auto& f = s.state.meas_from_base;
+    j["frame"] = {{"rotation_deg",
+                   {f[0] * 180 / M_PI, f[1] * 180 / M_PI, f[2] * 180 / M_PI}},
+                  {"translation_mm", {f[3], f[4], f[5]}}};
+    if (s.has_robust) j["without_outliers"] = StatsJson(s.robust_stats);
+    list.push_back(j);
+  }
+  return list;
+}
+
+void WriteResiduals(const std::string& path, const Observations& obs,
+                    const EvaluateResult& r) {
+  const bool series = obs.AnySeriesLabel();
+  std::ostringstream os;
+  os << "# written by " << ToolVersion() << ": " << CommandLine() << "\n";
+  os << "pose,error_mm" << (series ? ",series" : "") << "\n";
+  for (size_t i = 0; i < r.rows.size(); ++i) {
+    const Observation& o = obs.rows[r.rows[i]];
+    os << CsvQuote(o.pose) << "," << FormatDouble(r.errors_mm[i]);
+    if (series) os << "," << CsvQuote(o.series);
+    os << "\n";
+  }
+  WriteFileAtomic(path, os.str());
+}
+
+void PrintSeries(const EvaluateResult& r) {
+  for (const SeriesEvaluation& s : r.series) {
+    std::printf(
+        "  series '%s': %d poses, own frame: RMS %.4f mm, mean %.4f, max "
+        "%.4f, std %.4f\n",
+        s.name.c_str(), s.stats.n, s.stats.rms_mm, s.stats.mean_mm,
+        s.stats.max_mm, s.stats.std_mm);
+  }
+}
+
 int RunEvaluate(const EvaluateArgs& args) {
   const Robot robot = ReadRobot(args.robot, args.root, args.tip);
   Warnings warnings = CommandWarnings();
   const Observations obs =
       ReadCheckedObservations(args.obs, robot, args.robot, &warnings);
   const EvaluateResult r = Evaluate(robot, obs, args.outlier_sigmas);
-  if (!args.residuals.empty()) {
-    std::ostringstream os;
-    os << "# written by " << ToolVersion() << ": " << CommandLine() << "\n";
-    os << "pose,error_mm\n";
-    for (size_t i = 0; i < r.rows.size(); ++i) {
-      os << CsvQuote(obs.rows[r.rows[i]].pose) << ","
-         << FormatDouble(r.errors_mm[i]) << "\n";
-    }
-    WriteFileAtomic(args.residuals, os.str());
-  }
+  if (!args.residuals.empty()) WriteResiduals(args.residuals, obs, r);
+  const bool labelled = obs.AnySeriesLabel();
   if (args.json) {
     nlohmann::json j = StatsJson(r.stats);
     j["extensions"] = robot.extensions.size();
     AddPointsJson(r.state, obs, r.rows, r.errors_mm, {}, &j);
+    if (labelled) j["series"] = SeriesJson(r);
     j["outlier_sigmas"] = args.outlier_sigmas;
     j["outliers"] = OutliersJson(r.outliers);
     if (r.has_robust) {
@@ -99,9 +134,18 @@ int RunEvaluate(const EvaluateArgs& args) {
     PrintJson(j);
     return 0;
   }
-  std::printf("kincal evaluate: %d poses, frame registered only\n", r.stats.n);
+  if (r.series.size() > 1) {
+    std::printf(
+        "kincal evaluate: %d poses in %zu series, one frame per series "
+        "registered only\n",
+        r.stats.n, r.series.size());
+  } else {
+    std::printf("kincal evaluate: %d poses, frame registered only\n",
+                r.stats.n);
+  }
   std::printf("  RMS %.4f mm, mean %.4f, max %.4f, std %.4f\n", r.stats.rms_mm,
               r.stats.mean_mm, r.stats.max_mm, r.stats.std_mm);
+  if (labelled) PrintSeries(r);
   PrintOutliers(r.outliers, r.outlier_axis_sigma_mm, args.outlier_sigmas);
   if (r.has_robust) {
     const ErrorStats& w = r.robust.stats;
@@ -119,8 +163,9 @@ void AddEvaluateCommand(CLI::App& app, Runner* run) {
   auto args = std::make_shared<EvaluateArgs>();
   CLI::App* sub = app.add_subcommand(
       "evaluate",
-      "Register only the measuring frame and report the tip position error "
-      "of a robot model (with its extensions) on observations");
+      "Register only the measuring frame (one per series) and report the tip "
+      "position error of a robot model (with its extensions) on "
+      "observations");
   AddRobotOptions(sub, &args->robot, &args->root, &args->tip,
                   "robot.yaml (calibrated) or .urdf")
       ->required();

@@ -48,10 +48,12 @@ int RunIso9283(const Iso9283Args& args) {
   Warnings warnings = CommandWarnings();
   const Observations obs =
       ReadCheckedObservations(args.obs, robot, args.robot, &warnings);
+  RequireOneSeries(obs, "iso9283");
   Iso9283Options options;
   if (!args.frame_from.empty()) {
     const Observations frame_obs =
         ReadCheckedObservations(args.frame_from, robot, args.robot, &warnings);
+    RequireOneSeries(frame_obs, "iso9283 --frame-from");
     options = RegisterMeasuringFrame(robot, frame_obs, options);
   }
   options.ap_tolerance_mm = args.tolerance_mm;

@@ -66,6 +66,7 @@ int RunSensitivity(const SensitivityArgs& args) {
   Warnings warnings = CommandWarnings();
   const Observations obs =
       ReadCheckedObservations(args.obs, robot, args.robot, &warnings);
+  RequireOneSeries(obs, "sensitivity");
   const SensitivityResult r = AnalyzeSensitivity(robot, obs, args.options);
   if (!args.out_csv.empty()) WriteFileAtomic(args.out_csv, CurvesCsv(r));
   if (!args.plot.empty()) {

@@ -39,6 +39,49 @@ bool Observations::AnyTemp() const {
   return false;
 }
 
+bool Observations::AnySeriesLabel() const {
+  for (const auto& r : rows) {
+    if (!r.series.empty()) return true;
+  }
+  return false;
+}
+
+std::vector<std::string> Observations::SeriesNames() const {
+  std::vector<std::string> names;
+  std::set<std::string> seen;
+  for (const auto& r : rows) {
+    if (seen.insert(r.series).second) names.push_back(r.series);
+  }
+  return names;
+}
+
+std::vector<int> Observations::SeriesRows(const std::string& name) const {
+  std::vector<int> out;
+  for (size_t i = 0; i < rows.size(); ++i) {
+    if (rows[i].series == name) out.push_back(static_cast<int>(i));
+  }
+  return out;
+}
+
+void RequireOneSeries(const Observations& obs, const std::string& command) {
+  const std::vector<std::string> names = obs.SeriesNames();
+  if (names.size() < 2) return;
+  std::string list;
+  for (const auto& n : names) {
+    list += (list.empty() ? "'" : ", '") + n + "' (" +
+            std::to_string(obs.SeriesRows(n).size()) + " rows)";
+  }
+  const Observation& first_other = obs.rows.at(obs.SeriesRows(names[1]).at(0));
+  throw InputError(
+      obs.source, first_other.line, 0,
+      "the rows belong to " + std::to_string(names.size()) +
+          " series (column 'series': " + list + "), each with its own " +
+          "measuring frame; `kincal " + command +
+          "` fits one frame and needs the rows of one series per run (e.g. "
+          "keep one series' rows), while `kincal evaluate` registers one "
+          "frame per series");
+}
+
 namespace {
 std::string JoinNames(const std::vector<std::string>& names) {
   std::string s;
@@ -47,7 +90,7 @@ std::string JoinNames(const std::vector<std::string>& names) {
 }
 
 // What a column of observations.csv holds.
-enum Role { kPose, kJoint, kX, kY, kZ, kFixed, kTime, kTemp };
+enum Role { kPose, kJoint, kX, kY, kZ, kFixed, kTime, kTemp, kSeries };
 struct Column {
   Role role;
   int joint = -1;
@@ -75,16 +118,19 @@ Column HeaderColumn(const CsvField& f, const CsvLine& header,
     c.role = kTime;
   } else if (name == "temp_c") {
     c.role = kTemp;
+  } else if (name == "series") {
+    c.role = kSeries;
   } else {
     c.role = kJoint;
     for (size_t j = 0; j < joint_names.size(); ++j) {
       if (joint_names[j] == name) c.joint = static_cast<int>(j);
     }
     if (c.joint < 0) {
-      throw InputError(
-          file, header.line, f.column,
-          "unknown column '" + name + "': expected pose, the robot's joints (" +
-              JoinNames(joint_names) + "), x, y, z, fixed_point, t or temp_c");
+      throw InputError(file, header.line, f.column,
+                       "unknown column '" + name +
+                           "': expected pose, the robot's joints (" +
+                           JoinNames(joint_names) +
+                           "), x, y, z, fixed_point, t, temp_c or series");
     }
   }
   return c;
@@ -220,6 +266,9 @@ class RowParser {
         }
         o->temp_c = v;
         break;
+      case kSeries:
+        o->series = f.text;
+        break;
     }
   }
 
@@ -291,6 +340,7 @@ Observations ReadObservationsCsv(const std::string& path,
 std::string FormatObservationsCsv(const Observations& obs,
                                   const std::vector<std::string>& comment) {
   bool points = false, fixed = false, time = false, temp = false;
+  const bool series = obs.AnySeriesLabel();
   for (const auto& r : obs.rows) {
     points = points || r.has_point;
     fixed = fixed || !r.fixed_point.empty();
@@ -306,6 +356,7 @@ std::string FormatObservationsCsv(const Observations& obs,
   if (fixed) os << ",fixed_point";
   if (time) os << ",t";
   if (temp) os << ",temp_c";
+  if (series) os << ",series";
   os << "\n";
   for (const auto& r : obs.rows) {
     os << CsvQuote(r.pose);
@@ -320,6 +371,7 @@ std::string FormatObservationsCsv(const Observations& obs,
     if (fixed) os << "," << CsvQuote(r.fixed_point);
     if (time) os << "," << (r.HasTime() ? FormatDouble(r.t_s) : "");
     if (temp) os << "," << (r.HasTemp() ? FormatDouble(r.temp_c) : "");
+    if (series) os << "," << CsvQuote(r.series);
     os << "\n";
   }
   return os.str();

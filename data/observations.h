@@ -21,6 +21,10 @@ struct Observation {
   // Temperature at the measurement (spec v2 column temp_c), deg C; NaN =
   // unknown.
   double temp_c = std::numeric_limits<double>::quiet_NaN();
+  // Measurement campaign (spec v3 column series): rows of one series share a
+  // measuring frame. "" = unlabelled (a file without the column is one
+  // series; empty cells in the column form one more).
+  std::string series;
   int line = 0;  // line in the source file (1-based), for messages
 
   bool HasTime() const { return t_s == t_s; }
@@ -36,7 +40,20 @@ struct Observations {
   int CountWithFixedPoint() const;
   bool AnyTime() const;
   bool AnyTemp() const;
+  // Whether any row carries a non-empty series label.
+  bool AnySeriesLabel() const;
+  // The distinct series labels in first-seen order ("" included when some
+  // row is unlabelled); one entry for a file without the column.
+  std::vector<std::string> SeriesNames() const;
+  // Indices of the rows of one series, in visit order.
+  std::vector<int> SeriesRows(const std::string& name) const;
 };
+
+// Throws InputError unless every row belongs to one series: for commands
+// that fit one measuring frame to all rows. `command` names the command in
+// the message (e.g. "calibrate"); the message names the series and points
+// to `kincal evaluate`, which registers one frame per series.
+void RequireOneSeries(const Observations& obs, const std::string& command);
 
 // Reads observations.csv (../shared/spec/formats.md) for a robot with the
 // given joint names. Strict: any invalid cell, column or row throws
@@ -48,8 +65,8 @@ Observations ParseObservationsCsv(const std::string& text,
                                   const std::vector<std::string>& joint_names);
 
 // Writes the rows as observations.csv; `comment` lines become "# ..." lines
-// after the provenance line. Columns x,y,z / fixed_point / t / temp_c appear
-// when any row has them.
+// after the provenance line. Columns x,y,z / fixed_point / t / temp_c /
+// series appear when any row has them.
 std::string FormatObservationsCsv(const Observations& obs,
                                   const std::vector<std::string>& comment = {});
 

@@ -9,6 +9,7 @@ namespace kincal {
 namespace {
 
 using ::testing::HasSubstr;
+using ::testing::Not;
 
 const std::vector<std::string> kJoints = {"j1", "j2", "j3", "j4", "j5"};
 
@@ -142,6 +143,67 @@ TEST(ObservationsTest, ReadsAndWritesTempC) {
               HasSubstr("column 'temp_c'"));
   EXPECT_THAT(ErrorOf("pose,j1,j2,j3,j4,j5,temp_c\n0,1,2,3,4,5,-300\n"),
               HasSubstr("column 'temp_c'"));
+}
+
+// Spec v3: optional series column; labels in first-seen order, rows per
+// series, kept on output; a file without it is one unlabelled series.
+TEST(ObservationsTest, ReadsAndWritesSeries) {
+  const Observations obs = ParseObservationsCsv(
+      "pose,j1,j2,j3,j4,j5,x,y,z,series\n"
+      "0,1,2,3,4,5,1,2,3,C\n"
+      "1,1,2,3,4,6,1,2,3,B\n"
+      "2,1,2,3,4,7,1,2,3,C\n"
+      "3,1,2,3,4,8,1,2,3,\n",
+      "o.csv", kJoints);
+  ASSERT_EQ(obs.rows.size(), 4u);
+  EXPECT_EQ(obs.rows[0].series, "C");
+  EXPECT_EQ(obs.rows[1].series, "B");
+  EXPECT_EQ(obs.rows[3].series, "");
+  EXPECT_TRUE(obs.AnySeriesLabel());
+  EXPECT_EQ(obs.SeriesNames(), (std::vector<std::string>{"C", "B", ""}));
+  EXPECT_EQ(obs.SeriesRows("C"), (std::vector<int>{0, 2}));
+  EXPECT_EQ(obs.SeriesRows("B"), (std::vector<int>{1}));
+  EXPECT_TRUE(obs.SeriesRows("A").empty());
+  const std::string text = FormatObservationsCsv(obs);
+  EXPECT_THAT(text, HasSubstr(",x,y,z,series\n"));
+  const Observations back = ParseObservationsCsv(text, "back.csv", kJoints);
+  ASSERT_EQ(back.rows.size(), 4u);
+  for (size_t i = 0; i < obs.rows.size(); ++i)
+    EXPECT_EQ(back.rows[i].series, obs.rows[i].series);
+  EXPECT_EQ(Subset(obs, {1, 2}).SeriesNames(),
+            (std::vector<std::string>{"B", "C"}));
+
+  const Observations plain = ParseObservationsCsv(kGood, "o.csv", kJoints);
+  EXPECT_FALSE(plain.AnySeriesLabel());
+  EXPECT_EQ(plain.SeriesNames(), (std::vector<std::string>{""}));
+  EXPECT_EQ(plain.SeriesRows("").size(), 3u);
+  EXPECT_THAT(FormatObservationsCsv(plain), Not(HasSubstr("series")));
+  EXPECT_THAT(ErrorOf("pose,j1,j2,j3,j4,j5,series,series\n0,1,2,3,4,5,a,a\n"),
+              HasSubstr("duplicate column 'series'"));
+}
+
+// Commands fitting one frame refuse 2+ series with the series named, at the
+// first row of the second series.
+TEST(ObservationsTest, RequireOneSeriesNamesTheSeries) {
+  const std::string h = "pose,j1,j2,j3,j4,j5,series\n";
+  EXPECT_NO_THROW(RequireOneSeries(
+      ParseObservationsCsv(h + "0,1,2,3,4,5,B\n1,1,2,3,4,6,B\n", "o.csv",
+                           kJoints),
+      "calibrate"));
+  EXPECT_NO_THROW(RequireOneSeries(
+      ParseObservationsCsv(kGood, "o.csv", kJoints), "calibrate"));
+  const Observations two = ParseObservationsCsv(
+      h + "0,1,2,3,4,5,B\n1,1,2,3,4,6,B\n2,1,2,3,4,7,C\n", "o.csv", kJoints);
+  try {
+    RequireOneSeries(two, "calibrate");
+    FAIL() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.line(), 4);
+    EXPECT_THAT(e.what(), HasSubstr("o.csv:4: the rows belong to 2 series"));
+    EXPECT_THAT(e.what(), HasSubstr("'B' (2 rows), 'C' (1 rows)"));
+    EXPECT_THAT(e.what(), HasSubstr("`kincal calibrate`"));
+    EXPECT_THAT(e.what(), HasSubstr("`kincal evaluate` registers one frame"));
+  }
 }
 
 }  // namespace

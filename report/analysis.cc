@@ -47,6 +47,7 @@ void ReadRobotInputs(const ReportOptions& opt, ReportInputs* in) {
     Require(in->has_robot || in->has_cal,
             "--obs needs --robot or --calibrated (the joint names)");
     in->obs = ReadObservationsCsv(opt.obs, in->JointRobot().JointNames());
+    RequireOneSeries(in->obs, "report --obs");
     in->has_obs = true;
   }
   if (!opt.iso9283.empty()) {

@@ -5,12 +5,15 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <Eigen/Geometry>
+#include <cmath>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <vector>
 
 #include "data/atomic_file.h"
+#include "data/observations.h"
 #include "data/robot.h"
 #include "tests/testing/paths.h"
 #include "tests/testing/run.h"
@@ -279,6 +282,90 @@ TEST_F(CliTest, FailedRunKeepsExistingOutput) {
                                 " --obs /nonexistent.csv --out " + out);
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_EQ(ReadFile(out), "previous\n");
+}
+
+// Spec v3 `series`: the session twice, the second copy in a measuring frame
+// turned 30 deg about z and moved 500 mm. evaluate registers one frame per
+// series (each series' figures equal the single copy's), one frame for the
+// unlabelled rows is far off; calibrate refuses 2+ series (exit 2, no
+// output).
+TEST_F(CliTest, SeriesOneFrameEachInEvaluateRefusedByCalibrate) {
+  const std::vector<std::string> joints = {"j1", "j2", "j3", "j4", "j5"};
+  const Observations one = ReadObservationsCsv(Obs(), joints);
+  Observations both = one;
+  const Eigen::Matrix3d turn =
+      Eigen::AngleAxisd(30.0 * M_PI / 180.0, Eigen::Vector3d::UnitZ())
+          .toRotationMatrix();
+  for (Observation& o : both.rows) o.series = "A";
+  for (Observation o : one.rows) {
+    o.pose = "b" + o.pose;
+    o.series = "B";
+    o.p_in_meas = turn * o.p_in_meas + Eigen::Vector3d(500, 0, 0);
+    both.rows.push_back(o);
+  }
+  const std::string labelled = Dir() + "/series.csv";
+  WriteText(labelled, FormatObservationsCsv(both));
+  Observations unlabelled = both;
+  for (Observation& o : unlabelled.rows) o.series.clear();
+  const std::string plain = Dir() + "/series_unlabelled.csv";
+  WriteText(plain, FormatObservationsCsv(unlabelled));
+
+  RunResult r =
+      RunKincal("evaluate --robot " + Robot() + " --obs " + Obs() + " --json");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const double single_rms = nlohmann::json::parse(r.out)["rms_mm"];
+  EXPECT_FALSE(nlohmann::json::parse(r.out).contains("series"));
+  r = RunKincal("evaluate --robot " + Robot() + " --obs " + labelled +
+                " --json");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const nlohmann::json j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["n"], 2 * static_cast<int>(one.rows.size()));
+  ASSERT_EQ(j["series"].size(), 2u);
+  for (const auto& s : j["series"]) {
+    EXPECT_EQ(s["n"], static_cast<int>(one.rows.size()));
+    EXPECT_NEAR(s["rms_mm"].get<double>(), single_rms, 1e-6);
+    for (const char* f : {"name", "mean_mm", "max_mm", "std_mm", "frame"})
+      EXPECT_TRUE(s.contains(f)) << f;
+  }
+  EXPECT_EQ(j["series"][0]["name"], "A");
+  EXPECT_EQ(j["series"][1]["name"], "B");
+  // meas_B_from_base = turn * meas_A_from_base.
+  const auto rotation = [&](int s) {
+    const auto& v = j["series"][s]["frame"]["rotation_deg"];
+    const Eigen::Vector3d w(v[0].get<double>(), v[1].get<double>(),
+                            v[2].get<double>());
+    return Eigen::AngleAxisd(w.norm() * M_PI / 180.0, w.normalized())
+        .toRotationMatrix();
+  };
+  const Eigen::AngleAxisd relative(rotation(1) * rotation(0).transpose());
+  EXPECT_NEAR(relative.angle() * 180.0 / M_PI, 30.0, 0.05);
+  EXPECT_NEAR(relative.axis().z(), 1.0, 1e-3);
+  EXPECT_NEAR(j["rms_mm"].get<double>(), single_rms, 1e-6);
+  r = RunKincal("evaluate --robot " + Robot() + " --obs " + plain + " --json");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_GT(nlohmann::json::parse(r.out)["rms_mm"].get<double>(), 50.0);
+
+  const std::string out = Dir() + "/series_cal.yaml";
+  r = RunKincal("calibrate --robot " + Robot() + " --obs " + labelled +
+                " --out " + out + " --json");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_THAT(r.err, HasSubstr("2 series"));
+  EXPECT_THAT(r.err, HasSubstr("'A' (120 rows), 'B' (120 rows)"));
+  EXPECT_THAT(r.err, HasSubstr("kincal evaluate"));
+  EXPECT_FALSE(Exists(out));
+  r = RunKincal("diagnose model --robot " + Robot() + " --obs " + labelled +
+                " --json");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_THAT(r.err, HasSubstr("`kincal diagnose model`"));
+  // The same rows without labels: the jump between the copies is found.
+  r = RunKincal("calibrate --robot " + Robot() + " --obs " + plain + " --out " +
+                out + " --json");
+  EXPECT_EQ(r.exit_code, 2);
+  // Provenance line, header, 120 rows of the first copy: line 123.
+  EXPECT_THAT(r.err, HasSubstr("series_unlabelled.csv:123: the rows before "
+                               "line 123 and from it on (pose 'b0')"));
+  EXPECT_THAT(r.err, HasSubstr("add a `series` column"));
+  EXPECT_FALSE(Exists(out));
 }
 
 }  // namespace
