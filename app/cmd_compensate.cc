@@ -18,6 +18,7 @@
 #include "data/error.h"
 #include "data/observation_checks.h"
 #include "data/provenance.h"
+#include "data/rigid3.h"
 #include "data/robot_program.h"
 #include "data/targets_csv.h"
 #include "data/urdf.h"
@@ -57,12 +58,9 @@ std::vector<CompensateTarget> TargetsFromFile(const Robot& robot,
                              " joints, too few to reach an orientation; give "
                              "x, y, z only");
       }
-      const Eigen::Vector3d r = row.rotation_deg * M_PI / 180.0;
       t.target.has_rotation = true;
       t.target.rotation =
-          r.norm() > 0
-              ? Eigen::AngleAxisd(r.norm(), r.normalized()).toRotationMatrix()
-              : Eigen::Matrix3d::Identity();
+          RotationMatrixFromVector(row.rotation_deg * M_PI / 180.0);
     }
     if (!row.joints.empty()) {
       for (size_t j = 0; j < row.joints.size(); ++j) {
@@ -82,16 +80,10 @@ std::vector<CompensateTarget> TargetsFromFile(const Robot& robot,
 // Targets from measured observations: each measured tip brought into the
 // base frame by the frame the model registers on them, seeded with the
 // readings the robot reached it with (the replay check).
-std::vector<CompensateTarget> TargetsFromObservations(const Robot& robot,
-                                                      const Observations& obs,
+std::vector<CompensateTarget> TargetsFromObservations(const Observations& obs,
                                                       const EvaluateResult& e) {
-  const auto& f = e.state.meas_from_base;
-  const Eigen::Vector3d w(f[0], f[1], f[2]);
-  const Eigen::Matrix3d r =
-      w.norm() > 0
-          ? Eigen::AngleAxisd(w.norm(), w.normalized()).toRotationMatrix()
-          : Eigen::Matrix3d::Identity();
-  const Eigen::Vector3d t(f[3], f[4], f[5]);
+  const Rigid3 base_from_meas =
+      Rigid3FromPoseBlock(e.state.meas_from_base.data()).Inverse();
   std::vector<CompensateTarget> out;
   for (int i : e.rows) {
     const Observation& o = obs.rows[i];
@@ -99,10 +91,9 @@ std::vector<CompensateTarget> TargetsFromObservations(const Robot& robot,
     c.id = o.pose;
     c.seed = o.q;
     c.temp_c = o.temp_c;
-    c.target.position_mm = r.transpose() * (o.p_in_meas - t);
+    c.target.position_mm = base_from_meas * o.p_in_meas;
     out.push_back(c);
   }
-  (void)robot;
   return out;
 }
 
@@ -194,7 +185,7 @@ int RunCompensate(const CompensateArgs& args) {
     if (robot.HasNominal()) {
       replay_nominal_rms = Evaluate(robot.Nominal(), obs).stats.rms_mm;
     }
-    targets = TargetsFromObservations(robot, obs, replay);
+    targets = TargetsFromObservations(obs, replay);
   } else {
     targets = TargetsFromFile(robot, args, &warnings);
   }

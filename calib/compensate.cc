@@ -8,6 +8,7 @@
 
 #include "calib/model_state.h"
 #include "data/error.h"
+#include "data/rigid3.h"
 
 namespace kincal {
 namespace {
@@ -207,18 +208,19 @@ void WarnAboutTheModel(const Robot& robot, const Chain& chain,
   }
 }
 
+// The recorded measuring frame (fitted_on.frame: rotation vector deg, mm).
+Rigid3 RecordedMeasFromBase(const FitRecord& rec) {
+  std::array<double, 6> block = rec.frame;
+  for (int k = 0; k < 3; ++k) block[k] *= M_PI / 180.0;
+  return Rigid3FromPoseBlock(block.data());
+}
+
 // A target given in the measuring frame, in the base frame.
 IkTarget FromMeasuringFrame(const FitRecord& rec, const IkTarget& t) {
-  const Eigen::Vector3d w =
-      Eigen::Vector3d(rec.frame[0], rec.frame[1], rec.frame[2]) * M_PI / 180.0;
-  const Eigen::Matrix3d r =
-      w.norm() > 0
-          ? Eigen::AngleAxisd(w.norm(), w.normalized()).toRotationMatrix()
-          : Eigen::Matrix3d::Identity();
-  const Eigen::Vector3d tr(rec.frame[3], rec.frame[4], rec.frame[5]);
+  const Rigid3 base_from_meas = RecordedMeasFromBase(rec).Inverse();
   IkTarget out = t;
-  out.position_mm = r.transpose() * (t.position_mm - tr);
-  out.rotation = r.transpose() * t.rotation;
+  out.position_mm = base_from_meas * t.position_mm;
+  out.rotation = base_from_meas.R * t.rotation;
   return out;
 }
 
