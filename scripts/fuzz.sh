@@ -7,7 +7,7 @@
 # regression test.
 # Usage: scripts/fuzz.sh [SECONDS] [target ...]   (targets: robot_yaml urdf
 #        observations_csv rig_yaml target_yaml session_frames_csv
-#        session_folder joint_log; default: all)
+#        session_folder joint_log targets_csv cameramodel; default: all)
 # The figures of the last long runs are in docs/FUZZING.md.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -15,7 +15,7 @@ SECONDS_PER_TARGET=${1:-60}
 shift || true
 TARGETS=("$@")
 ALL=(robot_yaml urdf observations_csv rig_yaml target_yaml session_frames_csv
-  session_folder joint_log)
+  session_folder joint_log targets_csv cameramodel)
 [ ${#TARGETS[@]} -eq 0 ] && TARGETS=("${ALL[@]}")
 B=build-fuzz
 CC=clang CXX=clang++ cmake -S . -B $B -DCMAKE_BUILD_TYPE=RelWithDebInfo \
