@@ -50,6 +50,7 @@ int RunModel(const ModelArgs& args) {
                  std::to_string(obs.rows.size()) + " poses");
   const DiagnosisResult r = DiagnoseModel(robot, obs, options);
   progress.Done();
+  for (const Warning& w : r.warnings) warnings.Add(w.code, w.message);
   if (!args.out.empty()) {
     std::ostringstream note;
     note << "diagnose model from " << args.obs << ": verdict " << r.verdict

@@ -18,6 +18,7 @@
 #include "data/error.h"
 #include "diagnose/cross_validation.h"
 #include "diagnose/nonparametric.h"
+#include "diagnose/travel_gaps.h"
 
 namespace kincal {
 namespace {
@@ -977,6 +978,16 @@ DiagnosisResult DiagnoseModel(const Robot& nominal, const Observations& obs,
   }
   out.extended =
       WithFitRecord(final_state.chain.ToRobot(nominal), nominal, record);
+  std::vector<std::string> series_joints, units;
+  for (const Finding& f : out.findings) {
+    const int j = nominal.JointIndex(f.joint);
+    // The cause label carries the series length (transmission8, ...).
+    if (f.cause.rfind("transmission", 0) != 0 || j < 0) continue;
+    series_joints.push_back(f.joint);
+    units.push_back(nominal.joints[j].type == JointType::kPrismatic ? "mm"
+                                                                    : "deg");
+  }
+  out.warnings = TravelGapWarnings(obs, series_joints, units);
   out.seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start)
           .count();

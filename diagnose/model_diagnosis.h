@@ -42,6 +42,7 @@
 #include "calib/model_state.h"
 #include "data/observations.h"
 #include "data/robot.h"
+#include "data/warnings.h"
 #include "diagnose/catalogue.h"
 #include "diagnose/statistics.h"
 
@@ -179,7 +180,11 @@ struct DiagnosisResult {
   std::vector<int> rows;
   std::vector<bool> heldout;
   std::vector<Eigen::Vector3d> residuals;
-  Robot extended;    // nominal + fitted geometry + extensions
+  Robot extended;  // nominal + fitted geometry + extensions
+  // What the selected model rests on that the data do not support (e.g.
+  // transmission_gap: a gap in a joint's readings inside its series'
+  // travel, diagnose/travel_gaps.h).
+  std::vector<Warning> warnings;
   ModelState state;  // final model (all poses)
   double seconds = 0.0;
 };
