@@ -163,6 +163,14 @@ std::vector<std::string> Extrapolation(const Robot& robot,
                     Fixed(range[1], 3) + "]");
     }
   }
+  for (size_t j = 0; j < rec.joint_gap.size() && j < q.size(); ++j) {
+    const auto& gap = rec.joint_gap[j];
+    if (gap[0] == gap[0] && q[j] > gap[0] && q[j] < gap[1]) {
+      out.push_back(robot.joints[j].name + " at " + Fixed(q[j], 3) +
+                    " inside a gap of the fitted readings (" +
+                    Fixed(gap[0], 3) + " .. " + Fixed(gap[1], 3) + ")");
+    }
+  }
   if (rec.temp_lo_c == rec.temp_lo_c && temp_c == temp_c &&
       (temp_c < rec.temp_lo_c || temp_c > rec.temp_hi_c)) {
     out.push_back("temperature " + Fixed(temp_c, 2) +

@@ -171,6 +171,15 @@ TEST(CompensateTest, ExtrapolationAndUnreachableTargetsAreNamed) {
   ASSERT_EQ(e.targets[0].extrapolated.size(), 1u);
   EXPECT_THAT(e.targets[0].extrapolated[0],
               HasSubstr("shoulder_pan_joint at 100"));
+  // A target inside a gap of the fitted readings is named too.
+  real.fitted_on.joint_range[0] = {-60, 120};
+  real.fitted_on.joint_gap.assign(6, {NAN, NAN});
+  real.fitted_on.joint_gap[0] = {80, 110};
+  const CompensateResult g = Compensate(real, {far}, CompensateOptions{});
+  ASSERT_EQ(g.targets[0].extrapolated.size(), 1u);
+  EXPECT_THAT(g.targets[0].extrapolated[0],
+              HasSubstr("inside a gap of the fitted readings (80.000 .. "
+                        "110.000)"));
 }
 
 TEST(CompensateTest, ThermalModelNeedsATemperature) {

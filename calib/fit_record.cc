@@ -7,6 +7,34 @@
 
 namespace kincal {
 
+TravelGap LargestGap(const Observations& obs, int joint,
+                     const std::vector<int>& rows) {
+  std::vector<double> q;
+  if (rows.empty()) {
+    for (const Observation& o : obs.rows) q.push_back(o.q[joint]);
+  } else {
+    for (int i : rows) q.push_back(obs.rows[i].q[joint]);
+  }
+  std::sort(q.begin(), q.end());
+  TravelGap g;
+  if (q.empty()) return g;
+  g.lo = q.front();
+  g.hi = q.back();
+  g.from = g.to = g.lo;
+  for (size_t i = 1; i < q.size(); ++i) {
+    if (q[i] - q[i - 1] > g.to - g.from) {
+      g.from = q[i - 1];
+      g.to = q[i];
+    }
+  }
+  return g;
+}
+
+bool IsWideGap(const TravelGap& g, double fraction, double min_gap) {
+  const double gap = g.to - g.from, travel = g.hi - g.lo;
+  return travel > 0 && gap > fraction * travel && gap > min_gap;
+}
+
 FitRecord MakeFitRecord(const FitRecordInput& input) {
   FitRecord rec;
   const Observations& obs = *input.obs;
@@ -34,6 +62,12 @@ FitRecord MakeFitRecord(const FitRecordInput& input) {
                           ? std::max(rec.temp_hi_c, o.temp_c)
                           : o.temp_c;
     }
+  }
+  constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+  rec.joint_gap.assign(n, {kNaN, kNaN});
+  for (size_t j = 0; j < n; ++j) {
+    const TravelGap g = LargestGap(obs, static_cast<int>(j), rows);
+    if (IsWideGap(g)) rec.joint_gap[j] = {g.from, g.to};
   }
   rec.thermal_input = ThermalUsesTemperature(obs) ? "temp_c" : "hours";
   if (input.state != nullptr) {

@@ -14,6 +14,25 @@
 
 namespace kincal {
 
+// The largest gap between consecutive readings of one joint.
+struct TravelGap {
+  double lo = 0.0, hi = 0.0;    // the travel (reading units)
+  double from = 0.0, to = 0.0;  // the largest gap between readings
+};
+
+// The largest gap between consecutive readings of `joint` (index in
+// obs.joint_names) over `rows` (empty = all); from == to with fewer than two
+// readings.
+TravelGap LargestGap(const Observations& obs, int joint,
+                     const std::vector<int>& rows = {});
+
+// A gap wide enough that a function fitted along the travel is not held
+// there: over `fraction` of the travel and `min_gap` reading units.
+constexpr double kWideGapFraction = 0.1;
+constexpr double kWideGapMin = 5.0;
+bool IsWideGap(const TravelGap& g, double fraction = kWideGapFraction,
+               double min_gap = kWideGapMin);
+
 struct FitRecordInput {
   const Observations* obs = nullptr;  // the rows the model was fitted on
   std::vector<int> rows;              // their indices; empty = all rows
@@ -23,7 +42,8 @@ struct FitRecordInput {
   double systematic_rms_mm = std::numeric_limits<double>::quiet_NaN();
 };
 
-// The record: the rows' joint travel and temperature range, the thermal
+// The record: the rows' joint travel, its wide gaps (IsWideGap) and the
+// temperature range, the thermal
 // input (temp_c when the rows' temperatures vary, else hours), the fit's
 // measuring frame, the covariance of the robot's and the frame's parameters
 // in interface units (fixed points left out: they are not part of the robot;

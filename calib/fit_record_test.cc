@@ -37,7 +37,7 @@ TEST(FitRecordTest, TravelTemperatureFrameAndCovarianceInInterfaceUnits) {
   point.kind = ParamKind::kPoint;
   fit.params = {angle, length, frame, point};
   fit.covariance = Eigen::MatrixXd::Identity(4, 4);
-  fit.covariance(0, 0) = 1e-6;  // rad^2
+  fit.covariance(0, 0) = 1e-6;                         // rad^2
   fit.covariance(0, 1) = fit.covariance(1, 0) = 2e-4;  // rad mm
   ModelState state;
   state.meas_from_base = {0, 0, M_PI / 2, 100, 200, 300};
@@ -65,6 +65,30 @@ TEST(FitRecordTest, TravelTemperatureFrameAndCovarianceInInterfaceUnits) {
   EXPECT_NEAR(rec.covariance(0, 1), 2e-4 * deg, 1e-12);
   EXPECT_EQ(rec.covariance(2, 2), 1.0);
   EXPECT_EQ(rec.heldout_rms_mm, 0.05);
+}
+
+TEST(FitRecordTest, WideGapsInTheTravelAreRecorded) {
+  Observations obs;
+  obs.joint_names = {"j1"};
+  for (double q : {-100.0, -95.0, -90.0, 0.0, 10.0, 20.0, 50.0}) {
+    Observation o;
+    o.q = {q};
+    obs.rows.push_back(o);
+  }
+  const TravelGap g = LargestGap(obs, 0);
+  EXPECT_EQ(g.from, -90.0);
+  EXPECT_EQ(g.to, 0.0);
+  EXPECT_TRUE(IsWideGap(g));
+  FitRecordInput in;
+  in.obs = &obs;
+  const FitRecord rec = MakeFitRecord(in);
+  ASSERT_EQ(rec.joint_gap.size(), 1u);
+  EXPECT_EQ(rec.joint_gap[0][0], -90.0);
+  EXPECT_EQ(rec.joint_gap[0][1], 0.0);
+  // Steps of 5 deg: no gap worth naming.
+  in.rows = {0, 1, 2};
+  EXPECT_FALSE(MakeFitRecord(in).joint_gap[0][0] ==
+               MakeFitRecord(in).joint_gap[0][0]);
 }
 
 TEST(FitRecordTest, RowsSubsetAndRecordedNominal) {

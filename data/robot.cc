@@ -377,7 +377,7 @@ void ReadNominal(const YamlReader& r, const YAML::Node& n, Robot* robot) {
 void ReadFittedOn(const YamlReader& r, const YAML::Node& f, Robot* robot) {
   r.ExpectMap(f, "fitted_on");
   r.CheckKeys(f,
-              {"poses", "joints", "temp_c", "thermal_input", "frame",
+              {"poses", "joints", "gaps", "temp_c", "thermal_input", "frame",
                "heldout_rms_mm", "systematic_rms_mm"},
               "fitted_on");
   FitRecord& rec = robot->fitted_on;
@@ -400,6 +400,25 @@ void ReadFittedOn(const YamlReader& r, const YAML::Node& f, Robot* robot) {
         r.Fail(kv.second, "fitted_on.joints." + name + ": expected [lo, hi]");
       }
       rec.joint_range[index] = {range[0], range[1]};
+    }
+  }
+  if (f["gaps"]) {
+    const YAML::Node g = f["gaps"];
+    r.ExpectMap(g, "fitted_on.gaps");
+    rec.joint_gap.assign(robot->joints.size(),
+                         {std::numeric_limits<double>::quiet_NaN(),
+                          std::numeric_limits<double>::quiet_NaN()});
+    for (const auto& kv : g) {
+      const std::string name = kv.first.Scalar();
+      const int index = robot->JointIndex(name);
+      if (index < 0) {
+        r.Fail(kv.first, "fitted_on.gaps: no joint named '" + name + "'");
+      }
+      const auto gap = r.Numbers(kv.second, "fitted_on.gaps." + name, 2, 2);
+      if (!(gap[1] > gap[0])) {
+        r.Fail(kv.second, "fitted_on.gaps." + name + ": expected [from, to]");
+      }
+      rec.joint_gap[index] = {gap[0], gap[1]};
     }
   }
   if (f["temp_c"]) {
@@ -543,6 +562,20 @@ void FormatFitRecord(const Robot& robot, std::ostringstream& os) {
         os << (j ? ", " : "") << robot.joints[j].name << ": ["
            << FormatDouble(rec.joint_range[j][0]) << ", "
            << FormatDouble(rec.joint_range[j][1]) << "]";
+      }
+      os << "}\n";
+    }
+    bool any_gap = false;
+    for (const auto& g : rec.joint_gap) any_gap = any_gap || g[0] == g[0];
+    if (any_gap) {
+      os << "  gaps: {";
+      bool first = true;
+      for (size_t j = 0; j < rec.joint_gap.size(); ++j) {
+        if (!(rec.joint_gap[j][0] == rec.joint_gap[j][0])) continue;
+        os << (first ? "" : ", ") << robot.joints[j].name << ": ["
+           << FormatDouble(rec.joint_gap[j][0]) << ", "
+           << FormatDouble(rec.joint_gap[j][1]) << "]";
+        first = false;
       }
       os << "}\n";
     }

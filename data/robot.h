@@ -75,6 +75,10 @@ struct FitRecord {
   // Per joint (robot order), the readings' range [lo, hi] in the data (reading
   // units); empty = unknown.
   std::vector<std::array<double, 2>> joint_range;
+  // Per joint, the widest gap (from, to) between readings inside the travel
+  // when it is wide (over 10 % of the travel and 5 deg | mm; NaN = none):
+  // a function fitted along the travel is not held there. Empty = unknown.
+  std::vector<std::array<double, 2>> joint_gap;
   // temp_c range of the data (NaN = no temperature column).
   double temp_lo_c = std::numeric_limits<double>::quiet_NaN();
   double temp_hi_c = std::numeric_limits<double>::quiet_NaN();

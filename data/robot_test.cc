@@ -97,6 +97,8 @@ TEST(RobotYamlTest, NominalFitRecordAndCovarianceRoundTrip) {
   r.SetNominal(nominal);
   r.fitted_on.poses = 40;
   r.fitted_on.joint_range = {{0, 50}, {-90, 90}, {-45, 45}, {-30, 30}, {0, 0}};
+  r.fitted_on.joint_gap.assign(5, {NAN, NAN});
+  r.fitted_on.joint_gap[1] = {10, 60};
   r.fitted_on.temp_lo_c = 21.5;
   r.fitted_on.temp_hi_c = 27.0;
   r.fitted_on.thermal_input = "temp_c";
@@ -116,6 +118,10 @@ TEST(RobotYamlTest, NominalFitRecordAndCovarianceRoundTrip) {
   ASSERT_EQ(back.fitted_on.joint_range.size(), 5u);
   EXPECT_EQ(back.fitted_on.joint_range[1][0], -90.0);
   EXPECT_EQ(back.fitted_on.temp_hi_c, 27.0);
+  ASSERT_EQ(back.fitted_on.joint_gap.size(), 5u);
+  EXPECT_EQ(back.fitted_on.joint_gap[1][1], 60.0);
+  EXPECT_FALSE(back.fitted_on.joint_gap[0][0] ==
+               back.fitted_on.joint_gap[0][0]);
   EXPECT_EQ(back.fitted_on.thermal_input, "temp_c");
   EXPECT_TRUE(back.fitted_on.has_frame);
   EXPECT_EQ(back.fitted_on.frame[3], 1000.0);

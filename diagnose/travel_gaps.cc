@@ -5,24 +5,6 @@
 
 namespace kincal {
 
-TravelGap LargestGap(const Observations& obs, int joint) {
-  std::vector<double> q;
-  for (const Observation& o : obs.rows) q.push_back(o.q[joint]);
-  std::sort(q.begin(), q.end());
-  TravelGap g;
-  if (q.empty()) return g;
-  g.lo = q.front();
-  g.hi = q.back();
-  g.from = g.to = g.lo;
-  for (size_t i = 1; i < q.size(); ++i) {
-    if (q[i] - q[i - 1] > g.to - g.from) {
-      g.from = q[i - 1];
-      g.to = q[i];
-    }
-  }
-  return g;
-}
-
 std::vector<Warning> TravelGapWarnings(const Observations& obs,
                                        const std::vector<std::string>& joints,
                                        const std::vector<std::string>& units,
@@ -35,7 +17,7 @@ std::vector<Warning> TravelGapWarnings(const Observations& obs,
     const TravelGap g =
         LargestGap(obs, static_cast<int>(it - obs.joint_names.begin()));
     const double gap = g.to - g.from, travel = g.hi - g.lo;
-    if (!(travel > 0) || gap <= fraction * travel || gap <= min_gap) continue;
+    if (!IsWideGap(g, fraction, min_gap)) continue;
     char msg[512];
     std::snprintf(msg, sizeof msg,
                   "%s: the transmission series is fitted over the travel "

@@ -20,16 +20,6 @@ Observations Readings(const std::vector<double>& a,
   return obs;
 }
 
-TEST(TravelGapsTest, LargestGapBetweenSortedReadings) {
-  const Observations obs =
-      Readings({50, -100, 0, 10, 20, -90}, {0, 1, 2, 3, 4, 5});
-  const TravelGap g = LargestGap(obs, 0);
-  EXPECT_EQ(g.lo, -100);
-  EXPECT_EQ(g.hi, 50);
-  EXPECT_EQ(g.from, -90);
-  EXPECT_EQ(g.to, 0);
-}
-
 TEST(TravelGapsTest, WarnsWhereTheGapIsALargeShareOfTheTravel) {
   // j1: a 90 deg gap in 150 deg of travel; j2: evenly covered.
   const Observations obs =
