@@ -140,9 +140,9 @@ State Initialize(const CalibrationProblem& problem,
       break;
     case 8:
       // The rational terms start at 0 (OpenCV's 5-coefficient fit): OpenCV's
-      // own rational fit often pairs large numerator and denominator terms
-      // that cancel, from which the regularised solve cannot walk back to
-      // small k4..k6 without crossing a pole of 1 + k4 r^2 + k5 r^4 + k6 r^6.
+      // own rational fit pairs large numerator and denominator terms that
+      // cancel, and from there the solve did not converge within 200
+      // iterations even regularised (docs/CAMCAL.md).
       break;
     default:
       break;
