@@ -326,6 +326,10 @@ void PrintSummary(const CamcalArgs& args, const CalibTargetSpec& spec,
               options.num_distortion);
   std::printf("  Ceres: %s after %d iterations, %.2f s\n",
               sum.termination.c_str(), sum.iterations, sum.seconds);
+  if (sum.regularization_cost > 0) {
+    std::printf("  k4..k6 regulariser: weight %g, %.3g of the cost\n",
+                options.regularization, sum.regularization_share);
+  }
   for (size_t c = 0; c < nc; ++c) {
     const CameraCalibrationSummary& cs = sum.cameras[c];
     const CameraIntrinsics& in = cs.intrinsics;
