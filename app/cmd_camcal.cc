@@ -30,6 +30,8 @@ struct CamcalArgs {
   int distortion = 5;
   std::string loss = "huber";
   double loss_scale_px = 3.0;
+  // Distortion regulariser weight (CalibrationOptions::regularization).
+  double regularization = CalibrationOptions().regularization;
   // Projection uncertainty: distance (target units; 0 = infinity) and the
   // valid-intrinsics threshold (px).
   double uncertainty_distance = 0;
@@ -65,6 +67,11 @@ CalibrationOptions ResolveOptions(const CamcalArgs& args) {
   CalibrationOptions options;
   options.num_distortion = args.distortion;
   options.loss_scale_px = args.loss_scale_px;
+  if (args.regularization < 0) {
+    throw InputError("--regularize " + std::to_string(args.regularization) +
+                     ": expected a weight >= 0 (0 = none)");
+  }
+  options.regularization = args.regularization;
   if (args.loss == "huber") {
     options.loss = CalibrationOptions::Loss::kHuber;
   } else if (args.loss == "cauchy") {
@@ -281,6 +288,9 @@ nlohmann::json SummaryJson(const CamcalArgs& args, const CalibTargetSpec& spec,
   j["termination"] = sum.termination;
   j["converged"] = sum.converged;
   j["iterations"] = sum.iterations;
+  j["regularization"] = {{"weight", args.regularization},
+                         {"cost", sum.regularization_cost},
+                         {"share", sum.regularization_share}};
   j["residual_sigma_px"] = sum.residual_sigma_px;
   j["seconds"] = sum.seconds;
   if (!sum.covariance_note.empty()) j["covariance_note"] = sum.covariance_note;
@@ -316,6 +326,10 @@ void PrintSummary(const CamcalArgs& args, const CalibTargetSpec& spec,
               options.num_distortion);
   std::printf("  Ceres: %s after %d iterations, %.2f s\n",
               sum.termination.c_str(), sum.iterations, sum.seconds);
+  if (sum.regularization_cost > 0) {
+    std::printf("  k4..k6 regulariser: weight %g, %.3g of the cost\n",
+                options.regularization, sum.regularization_share);
+  }
   for (size_t c = 0; c < nc; ++c) {
     const CameraCalibrationSummary& cs = sum.cameras[c];
     const CameraIntrinsics& in = cs.intrinsics;
@@ -411,6 +425,9 @@ void AddCamcalCommand(CLI::App& app, Runner* run) {
   sub->add_option("--out", args->out, "rig.yaml to write")->required();
   sub->add_option("--distortion", args->distortion,
                   "distortion coefficients: 0, 4, 5 (default) or 8");
+  sub->add_option("--regularize", args->regularization,
+                  "distortion regulariser weight, mrcal-style (default "
+                  "0.005; 0 = none)");
   sub->add_option("--loss", args->loss,
                   "robust loss: huber (default), cauchy or none");
   sub->add_option("--loss-scale", args->loss_scale_px,

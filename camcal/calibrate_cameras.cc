@@ -139,7 +139,10 @@ State Initialize(const CalibrationProblem& problem,
       flags = cv::CALIB_FIX_K3;
       break;
     case 8:
-      flags = cv::CALIB_RATIONAL_MODEL;
+      // The rational terms start at 0 (OpenCV's 5-coefficient fit): OpenCV's
+      // own rational fit pairs large numerator and denominator terms that
+      // cancel, and from there the solve did not converge within 200
+      // iterations even regularised (docs/CAMCAL.md).
       break;
     default:
       break;
@@ -296,6 +299,51 @@ int BuildProblem(const std::vector<CalibrationView>& views,
     }
   }
   return num_points;
+}
+
+// Adds the rational-term regulariser of every camera (RationalDistortion-
+// RegularizationError) to `problem`; returns per camera its scale s (0 when
+// none is added: regularisation off, a model without k4..k6, or a camera
+// that saw nothing).
+std::vector<double> AddDistortionRegularizer(
+    const std::vector<CalibrationView>& views,
+    const CalibrationOptions& options, State* s, ceres::Problem* problem) {
+  using Regularizer = RationalDistortionRegularizationError;
+  const size_t nc = s->intrinsics.size();
+  std::vector<double> scale(nc, 0.0);
+  if (options.regularization <= 0 ||
+      kK1 + options.num_distortion <= Regularizer::kK4) {
+    return scale;
+  }
+  for (size_t c = 0; c < nc; ++c) {
+    double* intrinsics = s->intrinsics[c].data();
+    if (!problem->HasParameterBlock(intrinsics)) continue;
+    int num_pixel_residuals = 0;
+    for (size_t v = 0; v < views.size(); ++v) {
+      const TargetObservation& obs = views[v].observations[c];
+      if (s->view_used[v] && UsableObservation(obs, options)) {
+        num_pixel_residuals += 2 * static_cast<int>(obs.pixels.size());
+      }
+    }
+    scale[c] = std::sqrt(options.regularization * num_pixel_residuals /
+                         Regularizer::kNumRational);
+    problem->AddResidualBlock(Regularizer::Create(scale[c]), nullptr,
+                              intrinsics);
+  }
+  return scale;
+}
+
+// The regulariser's part of the final cost: 1/2 s_c^2 |k4..k6 of c|^2.
+double RegularizationCost(const State& s, const std::vector<double>& scale) {
+  double cost = 0;
+  for (size_t c = 0; c < s.intrinsics.size(); ++c) {
+    for (int i = RationalDistortionRegularizationError::kK4; i < kNumIntrinsics;
+         ++i) {
+      const double r = scale[c] * s.intrinsics[c][i];
+      cost += 0.5 * r * r;
+    }
+  }
+  return cost;
 }
 
 ceres::Solver::Options SolverOptions(const CalibrationOptions& options) {
@@ -458,6 +506,7 @@ void CalibrationOptions::Check() const {
   Require(min_views >= 2, "calibration: min_views must be >= 2");
   Require(max_iterations > 0, "calibration: max_iterations must be > 0");
   Require(max_rms_px > 0, "calibration: max_rms_px must be > 0");
+  Require(regularization >= 0, "calibration: regularization must be >= 0");
   Require(uncertainty.distance > 0,
           "calibration: the uncertainty distance must be > 0");
   Require(uncertainty.valid_threshold_px > 0,
@@ -704,6 +753,8 @@ CalibrationSummary CalibrateCameras(const CalibrationProblem& input,
   ceres::Problem problem;
   const int num_points = BuildProblem(input.views, options,
                                       /*refine_cameras=*/true, &s, &problem);
+  const std::vector<double> regularization_scale =
+      AddDistortionRegularizer(input.views, options, &s, &problem);
   ceres::Solver::Summary solver_summary;
   ceres::Solve(SolverOptions(options), &problem, &solver_summary);
   out.termination = TerminationName(solver_summary.termination_type);
@@ -711,6 +762,10 @@ CalibrationSummary CalibrateCameras(const CalibrationProblem& input,
   out.iterations = static_cast<int>(solver_summary.iterations.size()) - 1;
   out.initial_cost = solver_summary.initial_cost;
   out.final_cost = solver_summary.final_cost;
+  out.regularization_cost = RegularizationCost(s, regularization_scale);
+  if (out.final_cost > 0) {
+    out.regularization_share = out.regularization_cost / out.final_cost;
+  }
 
   // Rig and per-camera summaries.
   const Residuals res = ComputeResiduals(input.views, options, s);

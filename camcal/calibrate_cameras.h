@@ -71,6 +71,18 @@ struct CalibrationOptions {
   // Each camera needs the target in at least this many views.
   int min_views = 3;
   int max_iterations = 200;
+  // Weight of the regulariser of the rational distortion terms k4 k5 k6
+  // (0 = none; only the 8-coefficient model has them), sized as mrcal sizes
+  // its distortion regularisation: each camera's cost gains 1/2 s^2
+  // (k4^2 + k5^2 + k6^2) with s^2 = regularization * (pixel residuals of the
+  // camera) / 3, so k4..k6 of magnitude 1 would cost `regularization` times
+  // the cost of 1 px errors on every corner. The views cannot separate
+  // k4..k6 from k1..k3 (the unregularised solve drifts along that valley
+  // for 200 iterations); the penalty holds them near 0 and moves a
+  // well-determined solve by far less than its sigma. Default 0.005 (mrcal
+  // aims its regularisation at ~0.5 % of the cost); the 5-coefficient
+  // default model has no k4..k6 and is unaffected.
+  double regularization = 0.005;
   // A final RMS point residual above this (px) is no calibration: the
   // target's size or layout does not match the images (SolveFailure).
   double max_rms_px = 10.0;
@@ -147,6 +159,10 @@ struct CalibrationSummary {
   bool converged = false;
   int iterations = 0;
   double initial_cost = 0, final_cost = 0;
+  // Part of final_cost due to the distortion regulariser, and its share of
+  // final_cost (0 when the regulariser is off).
+  double regularization_cost = 0;
+  double regularization_share = 0;
   std::string covariance_note;  // why sigma is missing, if it is
   // Per view: rig_from_target (NaN-free only for used views) and whether used.
   std::vector<Rigid3> rig_from_target;

@@ -398,10 +398,8 @@ TargetObservation DetectChessboard(const std::string& path, cv::Size size) {
   return obs;
 }
 
-// OpenCV's stereo sample data: 13 pairs, 9x6 board, square = 1. OpenCV's
-// stereo_calib reaches RMS 0.445 px; the baseline is about 3.34 squares.
-TEST(CalibrateCamerasRealData, StereoLeftRightReachesOpenCvRms) {
-  KINCAL_REQUIRE_SHARED_DATA("opencv-stereo-left-right");
+// OpenCV's stereo sample data: 13 pairs, 9x6 board, square = 1.
+CalibrationProblem StereoLeftRightProblem() {
   const std::string dir =
       testing::SharedDataDir() + "/opencv-stereo-left-right";
   CalibrationProblem problem;
@@ -417,6 +415,14 @@ TEST(CalibrateCamerasRealData, StereoLeftRightReachesOpenCvRms) {
     }
     problem.views.push_back(view);
   }
+  return problem;
+}
+
+// OpenCV's stereo_calib reaches RMS 0.445 px; the baseline is about 3.34
+// squares.
+TEST(CalibrateCamerasRealData, StereoLeftRightReachesOpenCvRms) {
+  KINCAL_REQUIRE_SHARED_DATA("opencv-stereo-left-right");
+  const CalibrationProblem problem = StereoLeftRightProblem();
   const CalibrationSummary sum = CalibrateCameras(problem);
   EXPECT_TRUE(sum.converged) << sum.termination;
   EXPECT_LE(sum.rms_px, 0.445);
@@ -468,6 +474,64 @@ TEST(CalibrateCamerasRealData, StereoLeftRightReachesOpenCvRms) {
       sum.cameras[0].holdout_rms_px, sum.cameras[1].holdout_rms_px,
       sum.cameras[0].half_diff_rms_px, sum.cameras[1].half_diff_rms_px,
       sum.iterations, sum.seconds);
+}
+
+// The 8-coefficient (rational) model converges with the distortion
+// regulariser, and without it stops at max_iterations; the regulariser
+// leaves the 5-coefficient solve unchanged (it has no k4..k6).
+TEST(CalibrateCamerasRealData, StereoRationalModelConvergesRegularized) {
+  KINCAL_REQUIRE_SHARED_DATA("opencv-stereo-left-right");
+  const CalibrationProblem problem = StereoLeftRightProblem();
+  CalibrationOptions options;
+  options.compute_covariance = false;
+  options.cross_validate = false;
+  const CalibrationSummary five = CalibrateCameras(problem, options);
+  CalibrationOptions plain = options;
+  plain.regularization = 0;
+  const CalibrationSummary five_plain = CalibrateCameras(problem, plain);
+  options.num_distortion = 8;
+  const CalibrationSummary eight = CalibrateCameras(problem, options);
+  plain.num_distortion = 8;
+  const CalibrationSummary eight_plain = CalibrateCameras(problem, plain);
+
+  EXPECT_FALSE(eight_plain.converged) << eight_plain.termination;
+  EXPECT_EQ(eight_plain.regularization_cost, 0.0);
+  ASSERT_TRUE(eight.converged) << eight.termination;
+  EXPECT_TRUE(SolveFailure(eight, options).empty());
+  EXPECT_LT(eight.iterations, options.max_iterations);
+  EXPECT_GT(eight.regularization_share, 0.0);
+  EXPECT_LT(eight.regularization_share, 0.05);
+  EXPECT_LT(eight.rms_px, 0.46);
+  for (size_t c = 0; c < 2; ++c) {
+    const CameraIntrinsics& a = five.cameras[c].intrinsics;
+    const CameraIntrinsics& b = eight.cameras[c].intrinsics;
+    const CameraIntrinsics& p = five_plain.cameras[c].intrinsics;
+    EXPECT_LT(std::abs(a.fx - p.fx), 0.01) << c;
+    EXPECT_LT(std::abs(five.cameras[c].rms_px - five_plain.cameras[c].rms_px),
+              0.01)
+        << c;
+    EXPECT_LT(std::abs(b.fx - a.fx), 1.0) << c;
+    EXPECT_LT(std::abs(b.cx - a.cx), 1.0) << c;
+    EXPECT_LT(std::abs(b.cy - a.cy), 1.0) << c;
+    std::printf(
+        "camera %zu: 5 coeff fx %.3f cx %.3f cy %.3f rms %.4f (unregularised "
+        "fx %.3f rms %.4f); 8 coeff fx %.3f cx %.3f cy %.3f rms %.4f\n",
+        c, a.fx, a.cx, a.cy, five.cameras[c].rms_px, p.fx,
+        five_plain.cameras[c].rms_px, b.fx, b.cx, b.cy,
+        eight.cameras[c].rms_px);
+  }
+  std::printf(
+      "8 coeff: %d iterations (%s), rms %.4f px, regulariser share %.4g; "
+      "unregularised: %d iterations (%s)\n",
+      eight.iterations, eight.termination.c_str(), eight.rms_px,
+      eight.regularization_share, eight_plain.iterations,
+      eight_plain.termination.c_str());
+}
+
+TEST(CalibrateCameras, NegativeRegularizationIsInputError) {
+  CalibrationOptions options;
+  options.regularization = -0.1;
+  EXPECT_THROW(options.Check(), InputError);
 }
 
 }  // namespace

@@ -100,6 +100,38 @@ class RigTargetReprojectionError {
   const Eigen::Vector2d pixel_;
 };
 
+// Quadratic regulariser of the rational distortion coefficients k4 k5 k6
+// (intrinsics[kK4..]), pulling them toward 0 as mrcal regularises its
+// distortions:
+//   residual_i = scale * intrinsics[kK4 + i],  i = 0, 1, 2
+// so the cost adds 1/2 scale^2 (k4^2 + k5^2 + k6^2). `scale` is sized by the
+// caller relative to the number of pixel residuals (calibrate_cameras.cc).
+class RationalDistortionRegularizationError {
+ public:
+  static constexpr int kNumRational = 3;
+  static constexpr int kK4 = kNumIntrinsics - kNumRational;
+
+  explicit RationalDistortionRegularizationError(double scale)
+      : scale_(scale) {}
+
+  template <typename T>
+  bool operator()(const T* intrinsics, T* residuals) const {
+    for (int i = 0; i < kNumRational; ++i) {
+      residuals[i] = T(scale_) * intrinsics[kK4 + i];
+    }
+    return true;
+  }
+
+  static ceres::CostFunction* Create(double scale) {
+    return new ceres::AutoDiffCostFunction<
+        RationalDistortionRegularizationError, kNumRational, kNumIntrinsics>(
+        new RationalDistortionRegularizationError(scale));
+  }
+
+ private:
+  const double scale_;
+};
+
 // A ray at infinity of one model, rotated, projected by another model:
 //   residual = ProjectPoint(intrinsics_b, R(rotation_aa) * ray_a) - pixel
 class RotatedRayError {

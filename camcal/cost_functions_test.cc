@@ -37,6 +37,20 @@ TEST(CostFunctionsTest, TargetReprojectionIsPixelDifference) {
   EXPECT_NEAR(r[1], -1.0, 1e-12);
 }
 
+TEST(CostFunctionsTest, RationalRegularizationScalesK4ToK6) {
+  CameraIntrinsics cam = Pinhole();
+  cam.distortion = {0.1, -0.2, 0.01, 0.02, 0.3, 0.4, -0.5, 0.6};
+  const std::array<double, kNumIntrinsics> intr = cam.ToArray();
+  std::unique_ptr<ceres::CostFunction> cost(
+      RationalDistortionRegularizationError::Create(2.0));
+  ASSERT_EQ(cost->num_residuals(), 3);
+  double r[3];
+  ASSERT_TRUE(Evaluate(*cost, {intr.data()}, r));
+  EXPECT_DOUBLE_EQ(r[0], 0.8);
+  EXPECT_DOUBLE_EQ(r[1], -1.0);
+  EXPECT_DOUBLE_EQ(r[2], 1.2);
+}
+
 TEST(CostFunctionsTest, RigTargetAppliesCamFromRig) {
   const std::array<double, kNumIntrinsics> intr = Pinhole().ToArray();
   const double q_identity[4] = {0, 0, 0, 1};

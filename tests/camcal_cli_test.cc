@@ -6,6 +6,7 @@
 #include <array>
 #include <cmath>
 #include <cstdio>
+#include <fstream>
 #include <nlohmann/json.hpp>
 #include <string>
 
@@ -118,6 +119,36 @@ TEST(CamcalCli, StereoChessboardJsonAndRig) {
               1e-9);
   }
   EXPECT_NEAR(back.BaselineMm(), rig.BaselineMm(), 1e-12);
+}
+
+// The 8-coefficient model converges with the default regulariser of k4..k6
+// and reports its share of the cost; without it the solve stops at 200
+// iterations and writes nothing (exit 1); a negative weight is bad input.
+TEST(CamcalCli, RationalModelConvergesWithRegularizer) {
+  KINCAL_REQUIRE_SHARED_DATA("opencv-stereo-left-right");
+  const std::string dir = testing::MakeTempDir("camcal_opencv8");
+  const std::string out = dir + "/rig.yaml";
+  const std::string images =
+      "camcal --left '" + StereoDir() + "/left*.jpg' --right '" + StereoDir() +
+      "/right*.jpg' --target chessboard:9x6:1 --out " + out + " --distortion 8";
+  const RunResult r = RunKincal(images + " --json");
+  ASSERT_EQ(r.exit_code, 0) << r.out;
+  const nlohmann::json j = nlohmann::json::parse(r.out);
+  EXPECT_TRUE(j.at("converged").get<bool>());
+  EXPECT_LT(j.at("iterations").get<int>(), 200);
+  EXPECT_LE(j.at("rms_px").get<double>(), 0.445);
+  const auto& reg = j.at("regularization");
+  EXPECT_DOUBLE_EQ(reg.at("weight").get<double>(), 0.005);
+  EXPECT_GT(reg.at("share").get<double>(), 0.0);
+  EXPECT_LT(reg.at("share").get<double>(), 0.001);
+  for (const auto& c : j.at("cameras")) {
+    EXPECT_EQ(c.at("distortion").size(), 8u);
+    EXPECT_LT(c.at("half_diff_rms_px").get<double>(), 10.0);
+  }
+  std::remove(out.c_str());
+  EXPECT_EQ(RunKincal(images + " --regularize 0").exit_code, 1);
+  EXPECT_FALSE(std::ifstream(out).good());
+  EXPECT_EQ(RunKincal(images + " --regularize -1").exit_code, 2);
 }
 
 TEST(CamcalCli, BadInputExitsTwoAndWritesNothing) {
