@@ -302,11 +302,11 @@ TEST(CompensateCli, DocsExampleRuns) {
   const std::string dir = testing::MakeTempDir("compensate_docs");
   const std::string cd = "cd " + testing::SourceDir() + " && ";
   const std::string k = testing::KincalBinary();
-  RunResult r = testing::RunShell(
-      cd + k +
-      " diagnose model --robot data/robots/bh7.yaml --obs "
-      "data/sessions/bh7_demo/observations.csv --out " +
-      dir + "/extended.yaml");
+  RunResult r =
+      testing::RunShell(cd + k +
+                        " diagnose model --robot data/robots/bh7.yaml --obs "
+                        "data/sessions/bh7_demo/observations.csv --out " +
+                        dir + "/extended.yaml");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   r = testing::RunShell(cd + k +
                         " plan --robot data/robots/bh7.yaml --n 20 --seed 3 "
