@@ -4,24 +4,16 @@
 #include <algorithm>
 #include <cmath>
 #include <random>
-#include <sstream>
 
 #include "calib/model_state.h"
 #include "data/error.h"
 #include "data/rigid3.h"
+#include "data/yaml_util.h"
 
 namespace kincal {
 namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-
-std::string Fixed(double v, int digits) {
-  std::ostringstream os;
-  os.setf(std::ios::fixed);
-  os.precision(digits);
-  os << v;
-  return os.str();
-}
 
 // The controller's kinematics: the recorded nominal rows, else the
 // calibrated geometry without its extensions.
@@ -158,24 +150,26 @@ std::vector<std::string> Extrapolation(const Robot& robot,
     if (!(range[0] == range[0])) continue;
     const double slack = 1e-9 * std::max(1.0, std::abs(q[j]));
     if (q[j] < range[0] - slack || q[j] > range[1] + slack) {
-      out.push_back(robot.joints[j].name + " at " + Fixed(q[j], 3) +
-                    " outside the fitted travel [" + Fixed(range[0], 3) + ", " +
-                    Fixed(range[1], 3) + "]");
+      out.push_back(robot.joints[j].name + " at " + FormatFixed(q[j], 3) +
+                    " outside the fitted travel [" + FormatFixed(range[0], 3) +
+                    ", " + FormatFixed(range[1], 3) + "]");
     }
   }
   for (size_t j = 0; j < rec.joint_gap.size() && j < q.size(); ++j) {
     const auto& gap = rec.joint_gap[j];
     if (gap[0] == gap[0] && q[j] > gap[0] && q[j] < gap[1]) {
-      out.push_back(robot.joints[j].name + " at " + Fixed(q[j], 3) +
+      out.push_back(robot.joints[j].name + " at " + FormatFixed(q[j], 3) +
                     " inside a gap of the fitted readings (" +
-                    Fixed(gap[0], 3) + " .. " + Fixed(gap[1], 3) + ")");
+                    FormatFixed(gap[0], 3) + " .. " + FormatFixed(gap[1], 3) +
+                    ")");
     }
   }
   if (rec.temp_lo_c == rec.temp_lo_c && temp_c == temp_c &&
       (temp_c < rec.temp_lo_c || temp_c > rec.temp_hi_c)) {
-    out.push_back("temperature " + Fixed(temp_c, 2) +
-                  " C outside the fitted range [" + Fixed(rec.temp_lo_c, 2) +
-                  ", " + Fixed(rec.temp_hi_c, 2) + "]");
+    out.push_back("temperature " + FormatFixed(temp_c, 2) +
+                  " C outside the fitted range [" +
+                  FormatFixed(rec.temp_lo_c, 2) + ", " +
+                  FormatFixed(rec.temp_hi_c, 2) + "]");
   }
   return out;
 }
@@ -216,16 +210,18 @@ void WarnAboutTheModel(const Robot& robot, const Chain& chain,
   }
 }
 
-// The recorded measuring frame (fitted_on.frame: rotation vector deg, mm).
-Rigid3 RecordedMeasFromBase(const FitRecord& rec) {
-  std::array<double, 6> block = rec.frame;
+// The recorded measuring frame (fitted_on.frame: rotation vector deg, mm)
+// as a pose block (rad, mm).
+std::array<double, kFrameBlockSize> RecordedFrameBlock(const FitRecord& rec) {
+  std::array<double, kFrameBlockSize> block = rec.frame;
   for (int k = 0; k < 3; ++k) block[k] *= M_PI / 180.0;
-  return Rigid3FromPoseBlock(block.data());
+  return block;
 }
 
 // A target given in the measuring frame, in the base frame.
 IkTarget FromMeasuringFrame(const FitRecord& rec, const IkTarget& t) {
-  const Rigid3 base_from_meas = RecordedMeasFromBase(rec).Inverse();
+  const Rigid3 base_from_meas =
+      Rigid3FromPoseBlock(RecordedFrameBlock(rec).data()).Inverse();
   IkTarget out = t;
   out.position_mm = base_from_meas * t.position_mm;
   out.rotation = base_from_meas.R * t.rotation;
@@ -244,9 +240,9 @@ IkTarget ProgramTarget(const Chain& nominal, const std::vector<double>& q) {
 }
 
 // Steps 3-5 for one solved target.
-void Judge(const Robot& robot, const Chain& chain, const IkContext& context,
-           const IkResult& ik, double temp_c, const CompensateOptions& options,
-           CompensatedTarget* out) {
+void Judge(const Robot& robot, const TipUncertainty& uncertainty,
+           const IkContext& context, const IkResult& ik, double temp_c,
+           const CompensateOptions& options, CompensatedTarget* out) {
   out->q = ik.q;
   out->residual_mm = ik.position_error_mm;
   out->rotation_residual_deg = ik.rotation_error_deg;
@@ -263,18 +259,18 @@ void Judge(const Robot& robot, const Chain& chain, const IkContext& context,
     out->why = ik.at_limit.empty()
                    ? "the model's inverse kinematics does not reach it "
                      "(residual " +
-                         Fixed(ik.position_error_mm, 4) + " mm)"
+                         FormatFixed(ik.position_error_mm, 4) + " mm)"
                    : "a joint limit stops it (" + ik.at_limit[0] + ")";
   } else if (largest > options.max_correction) {
     out->why =
         "the compensated readings leave the configuration of the "
         "controller's solution (" +
-        joint + " moves " + Fixed(largest, 2) + ")";
+        joint + " moves " + FormatFixed(largest, 2) + ")";
   } else {
     out->reached = true;
   }
   out->extrapolated = Extrapolation(robot, ik.q, temp_c);
-  out->sigma_mm = TipSigmaMm(robot, chain, ik.q, context);
+  out->sigma_mm = uncertainty.SigmaMm(ik.q, context);
   const double systematic = robot.fitted_on.systematic_rms_mm;
   if (out->sigma_mm == out->sigma_mm && systematic == systematic) {
     out->sigma_mm = std::hypot(out->sigma_mm, systematic);
@@ -286,43 +282,44 @@ void Judge(const Robot& robot, const Chain& chain, const IkContext& context,
 
 }  // namespace
 
-double TipSigmaMm(const Robot& robot, const Chain& chain,
-                  const std::vector<double>& q, const IkContext& context) {
+TipUncertainty::TipUncertainty(const Robot& robot, const Chain& chain)
+    : covariance_(&robot.fitted_on.covariance) {
   const FitRecord& rec = robot.fitted_on;
-  const int p = static_cast<int>(rec.covariance_params.size());
-  if (p == 0) return kNaN;
-  ModelState state;
-  state.chain = chain;
-  for (int k = 0; k < 3; ++k) {
-    state.meas_from_base[k] = rec.frame[k] * M_PI / 180.0;
-    state.meas_from_base[k + 3] = rec.frame[k + 3];
-  }
+  state_.chain = chain;
+  state_.meas_from_base = RecordedFrameBlock(rec);
   // The tip in the measuring frame when the covariance carries the frame:
   // the frame's correlation with the robot's parameters takes out what the
   // registration absorbs (targets are located through the instrument).
-  bool frame = false;
   for (const std::string& name : rec.covariance_params) {
-    frame = frame || name.rfind("frame.", 0) == 0;
+    in_measuring_frame_ = in_measuring_frame_ || name.rfind("frame.", 0) == 0;
+    params_.push_back(FindParam(state_, name));
   }
-  if (frame && !rec.has_frame) {
+  if (in_measuring_frame_ && !rec.has_frame) {
     throw InputError(
         "covariance: names frame parameters but fitted_on has "
         "no frame");
   }
+}
+
+double TipUncertainty::SigmaMm(const std::vector<double>& q,
+                               const IkContext& context) const {
+  const int p = static_cast<int>(params_.size());
+  if (p == 0) return kNaN;
+  ModelState state = state_;
   auto tip = [&] {
     const Eigen::Vector3d b =
         ModelPoseAtReadings(state.chain, q, context).block<3, 1>(0, 3);
-    return frame ? Eigen::Vector3d(
-                       ApplyFrame(state.meas_from_base.data(), Vec3<double>(b)))
-                 : b;
+    return in_measuring_frame_
+               ? Eigen::Vector3d(
+                     ApplyFrame(state.meas_from_base.data(), Vec3<double>(b)))
+               : b;
   };
   Eigen::MatrixXd jac(3, p);
   for (int k = 0; k < p; ++k) {
-    const ParamInfo info = FindParam(state, rec.covariance_params[k]);
-    double* value = ParamAddress(&state, info);
+    double* value = ParamAddress(&state, params_[k]);
     const double v0 = *value;
     // A step of 1e-4 interface units (mm, deg, the families' units).
-    const double h = info.FromInterface(1e-4);
+    const double h = params_[k].FromInterface(1e-4);
     *value = v0 + h;
     const Eigen::Vector3d plus = tip();
     *value = v0 - h;
@@ -330,7 +327,7 @@ double TipSigmaMm(const Robot& robot, const Chain& chain,
     *value = v0;
     jac.col(k) = (plus - minus) / 2e-4;
   }
-  const double variance = (jac * rec.covariance * jac.transpose()).trace();
+  const double variance = (jac * *covariance_ * jac.transpose()).trace();
   return std::sqrt(std::max(0.0, variance));
 }
 
@@ -341,6 +338,7 @@ CompensateResult Compensate(const Robot& robot,
   if (options.ik.limits.empty()) options.ik.limits = JointLimits(robot);
   const Chain chain = Chain::FromRobot(robot);
   const Chain nominal = NominalChain(robot);
+  const TipUncertainty uncertainty(robot, chain);
   if (options.targets_in_measuring_frame && !robot.fitted_on.has_frame) {
     throw InputError(
         "targets in the measuring frame: the robot file records no frame "
@@ -376,7 +374,7 @@ CompensateResult Compensate(const Robot& robot,
       out.q = controller.q;
       out.residual_mm = controller.position_error_mm;
       out.why = "the nominal kinematics do not reach it (residual " +
-                Fixed(controller.position_error_mm, 3) + " mm" +
+                FormatFixed(controller.position_error_mm, 3) + " mm" +
                 (controller.at_limit.empty()
                      ? ""
                      : ", limit of " + controller.at_limit[0]) +
@@ -387,7 +385,7 @@ CompensateResult Compensate(const Robot& robot,
     previous_nom = controller.q;
     const IkResult ik = ModelSolution(chain, target, controller.q, previous,
                                       previous_s, &context, options.ik);
-    Judge(robot, chain, context, ik, temp_c, options, &out);
+    Judge(robot, uncertainty, context, ik, temp_c, options, &out);
     // What commanding the controller's readings would miss by.
     IkContext nominal_context = context;
     nominal_context.s = ApproachDirections(previous, controller.q, previous_s);

@@ -30,6 +30,7 @@
 #include <vector>
 
 #include "calib/inverse_kinematics.h"
+#include "calib/model_state.h"
 #include "data/robot.h"
 #include "data/warnings.h"
 
@@ -95,13 +96,25 @@ CompensateResult Compensate(const Robot& robot,
                             const std::vector<CompensateTarget>& targets,
                             const CompensateOptions& options);
 
-// sigma of the model's tip at readings q (mm, 3D): sqrt(trace(J C J^T)),
-// with the tip in the measuring frame when the covariance carries the frame
-// (the targets are located through it); NaN when the robot carries no
-// covariance. Throws InputError when a
-// covariance parameter names nothing in the model.
-double TipSigmaMm(const Robot& robot, const Chain& chain,
-                  const std::vector<double>& q, const IkContext& context);
+// The uncertainty of the model's tip, prepared once per robot (the
+// covariance's parameter names resolved, the recorded frame set):
+// sigma = sqrt(trace(J C J^T)) at readings q, J by central differences of the
+// tip, in the measuring frame when the covariance carries the frame (the
+// targets are located through it).
+class TipUncertainty {
+ public:
+  // Throws InputError when a covariance parameter names nothing in the model,
+  // or names the frame while fitted_on records none.
+  TipUncertainty(const Robot& robot, const Chain& chain);
+  // mm, 3D; NaN when the robot carries no covariance.
+  double SigmaMm(const std::vector<double>& q, const IkContext& context) const;
+
+ private:
+  const Eigen::MatrixXd* covariance_;
+  ModelState state_;
+  std::vector<ParamInfo> params_;
+  bool in_measuring_frame_ = false;
+};
 
 }  // namespace kincal
 

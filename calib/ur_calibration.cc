@@ -109,10 +109,8 @@ void RequireUrArm(const Chain& chain) {
 }
 
 std::string Fixed(double v, int digits) {
-  char buf[48];
   if (std::abs(v) < 0.5 * std::pow(10.0, -digits)) v = 0.0;  // no "-0.0000"
-  std::snprintf(buf, sizeof(buf), "%.*f", digits, v);
-  return buf;
+  return FormatFixed(v, digits);
 }
 
 std::string TcpText(const UrTcp& tcp) {

@@ -19,6 +19,7 @@
 #include "data/csv.h"
 #include "data/error.h"
 #include "data/provenance.h"
+#include "data/yaml_util.h"
 
 namespace kincal::capture {
 namespace {
@@ -49,12 +50,6 @@ std::string UtcNow() {
   ::gmtime_r(&now, &tm);
   char buf[32];
   std::strftime(buf, sizeof(buf), "%Y-%m-%dT%H:%M:%SZ", &tm);
-  return buf;
-}
-
-std::string Fixed(double v, int digits) {
-  char buf[64];
-  std::snprintf(buf, sizeof(buf), "%.*f", digits, v);
   return buf;
 }
 
@@ -261,8 +256,8 @@ Status SessionRecorder::CommitRow(const StereoFrame& pair,
   Status s = CheckWrite(frames_, joints);
   if (!s.ok()) return s;
   std::string row = std::to_string(frames_) + "," +
-                    Fixed(pair.left.timestamp_s, 6) + "," +
-                    Fixed(pair.right.timestamp_s, 6) + "," +
+                    FormatFixed(pair.left.timestamp_s, 6) + "," +
+                    FormatFixed(pair.right.timestamp_s, 6) + "," +
                     std::to_string(pair.left.sequence) + "," +
                     std::to_string(pair.right.sequence);
   for (double v : joints) {

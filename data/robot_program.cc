@@ -1,19 +1,13 @@
 #include "data/robot_program.h"
 
 #include <cmath>
-#include <cstdio>
 #include <sstream>
 
 #include "data/error.h"
+#include "data/yaml_util.h"
 
 namespace kincal {
 namespace {
-
-std::string Num(double v, int digits) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, "%.*f", digits, v);
-  return buf;
-}
 
 void CheckRobot(ProgramFormat format, const Robot& robot) {
   const int n = static_cast<int>(robot.joints.size());
@@ -58,7 +52,7 @@ std::string Urscript(const std::vector<std::string>& ids,
   for (size_t i = 0; i < rows.size(); ++i) {
     os << "  # " << ids[i] << "\n  movej([";
     for (size_t j = 0; j < rows[i].size(); ++j) {
-      os << (j ? ", " : "") << Num(rows[i][j] * M_PI / 180.0, 9);
+      os << (j ? ", " : "") << FormatFixed(rows[i][j] * M_PI / 180.0, 9);
     }
     os << "], a=0.5, v=0.2)\n";
   }
@@ -78,7 +72,7 @@ std::string Krl(const std::vector<std::string>& ids,
     for (size_t j = 0; j < rows[i].size(); ++j) {
       const std::string axis =
           j < 6 ? "A" + std::to_string(j + 1) : "E" + std::to_string(j - 5);
-      os << (j ? ", " : "") << axis << " " << Num(rows[i][j], 6);
+      os << (j ? ", " : "") << axis << " " << FormatFixed(rows[i][j], 6);
     }
     os << "}  ; " << ids[i] << "\n";
   }
@@ -97,12 +91,13 @@ std::string Rapid(const std::vector<std::string>& ids,
   for (size_t i = 0; i < rows.size(); ++i) {
     std::string rax, eax;
     for (size_t j = 0; j < 6; ++j) {
-      rax += (j ? "," : "") +
-             (j < rows[i].size() ? Num(rows[i][j], 6) : std::string("0"));
+      rax += (j ? "," : "") + (j < rows[i].size() ? FormatFixed(rows[i][j], 6)
+                                                  : std::string("0"));
     }
     for (size_t j = 6; j < 12; ++j) {
-      eax += (j > 6 ? "," : "") +
-             (j < rows[i].size() ? Num(rows[i][j], 6) : std::string("9E9"));
+      eax +=
+          (j > 6 ? "," : "") + (j < rows[i].size() ? FormatFixed(rows[i][j], 6)
+                                                   : std::string("9E9"));
     }
     os << "    [[" << rax << "],[" << eax << "]]"
        << (i + 1 < rows.size() ? "," : "") << "  ! " << ids[i] << "\n";
@@ -126,7 +121,7 @@ std::string Franka(const std::vector<std::string>& ids,
   for (size_t i = 0; i < rows.size(); ++i) {
     os << "    {{";
     for (size_t j = 0; j < rows[i].size(); ++j) {
-      os << (j ? ", " : "") << Num(rows[i][j] * M_PI / 180.0, 9);
+      os << (j ? ", " : "") << FormatFixed(rows[i][j] * M_PI / 180.0, 9);
     }
     os << "}},  // " << ids[i] << "\n";
   }

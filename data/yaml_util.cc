@@ -129,4 +129,10 @@ std::string FormatDouble(double value) {
   return buf;
 }
 
+std::string FormatFixed(double value, int digits) {
+  char buf[64];
+  std::snprintf(buf, sizeof(buf), "%.*f", digits, value);
+  return buf;
+}
+
 }  // namespace kincal

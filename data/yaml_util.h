@@ -45,6 +45,8 @@ class YamlReader {
 
 // Shortest text that reads back to the same double (for writers).
 std::string FormatDouble(double value);
+// `value` with `digits` decimals ("%.*f"), for messages and fixed-width text.
+std::string FormatFixed(double value, int digits);
 
 }  // namespace kincal
 

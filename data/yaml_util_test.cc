@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstdlib>
 
 #include "data/error.h"
@@ -92,6 +93,12 @@ TEST(YamlUtilTest, NumbersIntegersAndStrings) {
               r.Numbers(n["f"], "f", 3, 3);
             }).find("f: expected 3 numbers, got 2"),
             std::string::npos);
+}
+
+TEST(YamlUtilTest, FormatFixedHasTheGivenDecimals) {
+  EXPECT_EQ(FormatFixed(100.0, 3), "100.000");
+  EXPECT_EQ(FormatFixed(-0.3051, 2), "-0.31");
+  EXPECT_EQ(FormatFixed(M_PI / 18, 9), "0.174532925");
 }
 
 TEST(YamlUtilTest, FormatDoubleIsShortestThatReadsBack) {
