@@ -16,6 +16,7 @@
 #include "data/progress.h"
 #include "data/provenance.h"
 #include "data/session.h"
+#include "data/warnings.h"
 #include "vision/pivot.h"
 #include "vision/target.h"
 #include "vision/target_layout.h"
@@ -48,32 +49,43 @@ std::vector<LayoutFrame> Detect(const std::string& dir, const Rig& rig,
   });
 }
 
-struct PivotOutcome {
-  PivotResult result;
-  int views = 0;  // pivot frames with a tool pose
-};
+// The tip by pivot calibration with the measured layout; a refusal names
+// the pivot session.
+PivotTipResult MeasureTip(const std::vector<LayoutFrame>& frames,
+                          const Rig& rig, const TargetLayoutResult& layout,
+                          const TargetArgs& args) {
+  PivotTipOptions options;
+  options.min_views = args.min_views;
+  options.min_tilt_deg = args.min_tilt_deg;
+  try {
+    return MeasurePivotTip(rig, layout, frames, options);
+  } catch (const InputError& e) {
+    throw InputError(args.pivot + ": " + e.what());
+  }
+}
 
-// Tool poses of the pivot session with the measured layout, then the pivot
-// calibration (refused when the tilt is too small).
-PivotOutcome MeasureTip(const std::vector<LayoutFrame>& frames, const Rig& rig,
-                        const Target& target, const TargetArgs& args) {
-  std::vector<Rigid3> poses;
-  for (const LayoutFrame& f : frames) {
-    const ToolPoseResult r = EstimateToolPose(rig, target, f.detections);
-    if (r.found) poses.push_back(r.rig_from_tool);
+// Views with two or more tags that a layout should rest on; fewer (or
+// fewer than half the frames) are warned about: the bundle still runs, but
+// its sigmas rest on few views and one-tag frames carry no layout.
+constexpr int kWellDeterminedViews = 30;
+
+void WarnAboutLayoutViews(const TargetLayoutResult& layout,
+                          Warnings* warnings) {
+  if (layout.multi_tag_views >= kWellDeterminedViews &&
+      2 * layout.multi_tag_views >= layout.frames) {
+    return;
   }
-  if (static_cast<int>(poses.size()) < args.min_views) {
-    throw InputError(
-        args.pivot + ": the tool was found in " + std::to_string(poses.size()) +
-        " of " + std::to_string(frames.size()) + " frames (at least " +
-        std::to_string(args.min_views) +
-        " needed): record the tool pivoting about its tip with its tags in "
-        "view");
-  }
-  PivotOutcome out;
-  out.result = PivotCalibration(poses, 1e-3, args.min_tilt_deg);
-  out.views = static_cast<int>(poses.size());
-  return out;
+  warnings->Add(
+      "few_layout_views",
+      "only " + std::to_string(layout.multi_tag_views) + " of " +
+          std::to_string(layout.frames) +
+          " frames show two or more tags together; the layout rests on "
+          "those alone (frames with one tag say nothing about where the tags "
+          "sit on the tool), so it may be off by more than its sigma: record "
+          "a session of the tool turned so that pairs of neighbouring tags "
+          "are seen together, at least " +
+          std::to_string(kWellDeterminedViews) +
+          " such views (e.g. the tool alone, hand-held and tilted +-25 deg)");
 }
 
 nlohmann::json Vec3(const Eigen::Vector3d& v) {
@@ -81,11 +93,13 @@ nlohmann::json Vec3(const Eigen::Vector3d& v) {
 }
 
 void Print(const TargetArgs& args, const TargetLayoutResult& layout,
-           const Target& target, const PivotOutcome* pivot, double seconds) {
+           const Target& target, const PivotTipResult* pivot,
+           const Warnings& warnings, double seconds) {
   if (args.json) {
     nlohmann::json j;
     j["out"] = args.out;
     j["views_used"] = layout.views_used;
+    j["frames"] = layout.frames;
     j["reference_tag"] = layout.reference_tag_id;
     j["reproj_rms_px"] = Number(layout.rms_px);
     j["corners_used"] = layout.corners_used;
@@ -102,12 +116,14 @@ void Print(const TargetArgs& args, const TargetLayoutResult& layout,
     if (pivot) {
       j["tip_in_tool"] = Vec3(target.tip_in_tool);
       j["tip_sigma_mm"] = Vec3(target.tip_sigma_mm);
-      j["pivot_rms_mm"] = Number(pivot->result.rms_mm);
+      j["pivot_rms_mm"] = Number(pivot->pivot.rms_mm);
       j["pivot_views"] = pivot->views;
-      j["pivot_tilt_deg"] = Number(pivot->result.tilt_range_deg);
-      j["pivot_in_rig"] = Vec3(pivot->result.pivot_in_rig);
+      j["pivot_tilt_deg"] = Number(pivot->pivot.tilt_range_deg);
+      j["pivot_in_rig"] = Vec3(pivot->pivot.pivot_in_rig);
+      j["tip_layout_sigma_mm"] = Vec3(pivot->layout_sigma_mm);
     }
     j["seconds"] = seconds;
+    AddWarnings(warnings, &j);
     PrintJson(j);
     return;
   }
@@ -125,7 +141,7 @@ void Print(const TargetArgs& args, const TargetLayoutResult& layout,
         "  tip (%.3f, %.3f, %.3f) mm, sigma up to %.3f mm, pivot RMS %.3f mm "
         "over %d views\n",
         target.tip_in_tool.x(), target.tip_in_tool.y(), target.tip_in_tool.z(),
-        target.tip_sigma_mm.maxCoeff(), pivot->result.rms_mm, pivot->views);
+        target.tip_sigma_mm.maxCoeff(), pivot->pivot.rms_mm, pivot->views);
   }
   std::printf("  wrote %s\n", args.out.c_str());
 }
@@ -149,22 +165,24 @@ int RunTarget(const TargetArgs& args) {
   const TargetLayoutResult layout = MeasureTargetLayout(rig, frames, options);
   Target target = layout.target;
   target.made_by = CommandLine();
-  std::unique_ptr<PivotOutcome> pivot;
+  std::unique_ptr<PivotTipResult> pivot;
   if (!args.pivot.empty()) {
     progress.Stage("pivot calibration");
-    pivot = std::make_unique<PivotOutcome>(
-        MeasureTip(pivot_frames, rig, target, args));
+    pivot = std::make_unique<PivotTipResult>(
+        MeasureTip(pivot_frames, rig, layout, args));
     target.has_tip = true;
-    target.tip_in_tool = pivot->result.tip_in_tool;
+    target.tip_in_tool = pivot->pivot.tip_in_tool;
     target.has_tip_sigma = true;
-    target.tip_sigma_mm = pivot->result.tip_sigma_mm;
+    target.tip_sigma_mm = pivot->tip_sigma_mm;
   }
   progress.Done();
+  Warnings warnings = CommandWarnings();
+  WarnAboutLayoutViews(layout, &warnings);
   WriteTargetYaml(args.out, target);
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start)
           .count();
-  Print(args, layout, target, pivot.get(), seconds);
+  Print(args, layout, target, pivot.get(), warnings, seconds);
   return 0;
 }
 

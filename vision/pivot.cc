@@ -89,12 +89,36 @@ PivotResult PivotCalibration(const std::vector<Rigid3>& rig_from_tool,
     const Eigen::VectorXd inv_s2 = s.array().square().inverse();
     const Eigen::MatrixXd cov =
         sigma2 * V * inv_s2.asDiagonal() * V.transpose();
+    r.tip_covariance = cov.topLeftCorner<3, 3>();
     for (int k = 0; k < 3; ++k) {
       r.tip_sigma_mm(k) = std::sqrt(cov(k, k));
       r.pivot_sigma_mm(k) = std::sqrt(cov(3 + k, 3 + k));
     }
   }
   return r;
+}
+
+Eigen::MatrixXd PivotTipJacobian(const std::vector<Rigid3>& rig_from_tool,
+                                 const Eigen::Vector3d& tip_in_tool) {
+  const int n = static_cast<int>(rig_from_tool.size());
+  Eigen::MatrixXd A(3 * n, 6);
+  for (int i = 0; i < n; ++i) {
+    A.block<3, 3>(3 * i, 0) = rig_from_tool[i].R;
+    A.block<3, 3>(3 * i, 3) = -Eigen::Matrix3d::Identity();
+  }
+  // Rows of the tip in -(A^T A)^-1 A^T.
+  const Eigen::MatrixXd solve =
+      -(A.transpose() * A).ldlt().solve(A.transpose()).topRows(3);
+  Eigen::MatrixXd jacobian(3, 6 * n);
+  for (int i = 0; i < n; ++i) {
+    const Eigen::Vector3d arm = rig_from_tool[i].R * tip_in_tool;
+    Eigen::Matrix3d skew;
+    skew << 0, -arm.z(), arm.y(), arm.z(), 0, -arm.x(), -arm.y(), arm.x(), 0;
+    const Eigen::Matrix3d block = solve.middleCols<3>(3 * i);
+    jacobian.middleCols<3>(6 * i) = -block * skew;
+    jacobian.middleCols<3>(6 * i + 3) = block;
+  }
+  return jacobian;
 }
 
 }  // namespace kincal

@@ -29,6 +29,8 @@ struct PivotResult {
   // (the pose noise seen through the residuals).
   Eigen::Vector3d tip_sigma_mm = Eigen::Vector3d::Zero();
   Eigen::Vector3d pivot_sigma_mm = Eigen::Vector3d::Zero();
+  // The full 3x3 covariance of tip_in_tool behind tip_sigma_mm (mm^2).
+  Eigen::Matrix3d tip_covariance = Eigen::Matrix3d::Zero();
   // How far the tool was tilted: the extent (max - min, deg) of the poses'
   // rotations about the second principal axis of their spread (the smaller
   // of the two largest; a needle turned about one axis only has ~0).
@@ -45,6 +47,14 @@ double PivotTiltRangeDeg(const std::vector<Rigid3>& rig_from_tool);
 PivotResult PivotCalibration(const std::vector<Rigid3>& rig_from_tool,
                              double min_conditioning = 1e-3,
                              double min_tilt_range_deg = 0);
+
+// How the least-squares tip moves with the tool poses: d tip_in_tool /
+// d (a_i, dt_i), 3 x 6n, for pose i corrected as (exp([a_i]x) R_i, t_i +
+// dt_i) (rotation vector a_i on the left, rad; dt_i in mm). With the pivot's
+// residuals small, dx = -(A^T A)^-1 A^T de, where de_i = -[R_i tip]x a_i +
+// dt_i is the change of pose i's residual at the fitted (tip, pivot).
+Eigen::MatrixXd PivotTipJacobian(const std::vector<Rigid3>& rig_from_tool,
+                                 const Eigen::Vector3d& tip_in_tool);
 
 }  // namespace kincal
 

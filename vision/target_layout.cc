@@ -341,9 +341,20 @@ int RejectOutliers(Problem* p, const Rig& rig,
                    sorted.end());
   const double limit = std::max(
       options.outlier_px, options.outlier_ratio * sorted[sorted.size() / 2]);
-  int rejected = 0;
+  // A corner that fails takes its tag observation's other corners with it:
+  // a tag's corners err together (a quad fitted as a whole, a neighbouring
+  // tag in the refinement's band), so its "good" corners are suspect too.
+  std::set<std::array<int, 3>> failed;
   for (size_t i = 0; i < res.size(); ++i) {
     if (res[i] < 0 || res[i] > limit) {
+      const Corner& c = p->corners[i];
+      failed.insert({c.frame, c.tag, c.camera});
+    }
+  }
+  int rejected = 0;
+  for (size_t i = 0; i < res.size(); ++i) {
+    const Corner& c = p->corners[i];
+    if (p->corner_used[i] && failed.count({c.frame, c.tag, c.camera})) {
       p->corner_used[i] = false;
       ++rejected;
     }
@@ -351,29 +362,118 @@ int RejectOutliers(Problem* p, const Rig& rig,
   return rejected;
 }
 
-// Step 5: each tag's 1-sigma from the covariance of its block.
-void TagSigmas(const Problem& p, ceres::Problem* problem, double sigma0,
-               std::vector<LayoutTag>* tags) {
-  ceres::Covariance::Options co;
-  co.algorithm_type = ceres::SPARSE_QR;
-  ceres::Covariance covariance(co);
-  std::vector<std::pair<const double*, const double*>> blocks;
-  for (size_t i = 0; i < p.ids.size(); ++i) {
-    if (static_cast<int>(i) == p.reference) continue;
-    blocks.push_back({p.tag_blocks[i].data(), p.tag_blocks[i].data()});
+// Moves every block's rotation into its start rotation (rotation vector 0),
+// so that Jacobians at the blocks are those of left corrections of the
+// fitted poses.
+void Rebase(Problem* p) {
+  for (size_t i = 0; i < p->tag_blocks.size(); ++i) {
+    p->tag_R0[i] = BlockPose(p->tag_blocks[i], p->tag_R0[i]).R;
+    std::fill_n(p->tag_blocks[i].begin(), 3, 0.0);
   }
-  if (blocks.empty() || !covariance.Compute(blocks, problem)) return;
-  for (size_t i = 0; i < p.ids.size(); ++i) {
-    if (static_cast<int>(i) == p.reference) continue;
-    double cov[36];
-    covariance.GetCovarianceBlock(p.tag_blocks[i].data(),
-                                  p.tag_blocks[i].data(), cov);
-    for (int k = 0; k < 3; ++k) {
-      (*tags)[i].sigma_r_deg(k) =
-          sigma0 * std::sqrt(cov[k * 6 + k]) * 180 / M_PI;
-      (*tags)[i].sigma_t_mm(k) = sigma0 * std::sqrt(cov[(k + 3) * 6 + k + 3]);
+  for (size_t f = 0; f < p->frame_blocks.size(); ++f) {
+    p->frame_R0[f] = BlockPose(p->frame_blocks[f], p->frame_R0[f]).R;
+    std::fill_n(p->frame_blocks[f].begin(), 3, 0.0);
+  }
+}
+
+using Matrix26 = Eigen::Matrix<double, 2, 6, Eigen::RowMajor>;
+using Matrix6d = Eigen::Matrix<double, 6, 6>;
+using Vector6d = Eigen::Matrix<double, 6, 1>;
+
+// One corner's residual and its Jacobians on the frame's and the tag's
+// blocks; false for a point behind the camera.
+bool CornerJacobians(const Eigen::Vector2d& px, const Eigen::Vector3d& c_in_tag,
+                     const Camera& camera, const Eigen::Matrix3d& rig_R_tool0,
+                     const Eigen::Matrix3d& tool_R_tag0,
+                     const double* frame_block, const double* tag_block,
+                     Eigen::Vector2d* residual, Matrix26* d_frame,
+                     Matrix26* d_tag) {
+  const std::unique_ptr<ceres::CostFunction> cost(
+      LayoutCornerCost::Create(px, c_in_tag, camera, rig_R_tool0, tool_R_tag0));
+  const double* blocks[2] = {frame_block, tag_block};
+  double* jacobians[2] = {d_frame->data(), d_tag->data()};
+  return cost->Evaluate(blocks, residual->data(), jacobians);
+}
+
+// Step 5: the tags' joint covariance (LayoutCovariance), 6 per tag in the
+// problem's tag order, the reference's rows and columns 0. The frame poses
+// are eliminated per frame: S = H_tt - sum_f H_tf H_ff^-1 H_ft, and a tag
+// observation's score on the tags is u_c = g_t - H_tf H_ff^-1 g_f.
+Eigen::MatrixXd TagCovariance(const Problem& p, const Rig& rig,
+                              double tag_size_mm, double sigma0,
+                              LayoutCovariance model) {
+  const int tags = static_cast<int>(p.ids.size());
+  const int frames = static_cast<int>(p.frame_blocks.size());
+  const auto column = [&](int tag) {
+    return tag == p.reference ? -1 : 6 * (tag < p.reference ? tag : tag - 1);
+  };
+  const int dim = 6 * (tags - 1);
+  std::vector<Matrix6d> h_ff(frames, Matrix6d::Zero());
+  std::vector<Eigen::MatrixXd> h_ft(frames, Eigen::MatrixXd::Zero(6, dim));
+  Eigen::MatrixXd h_tt = Eigen::MatrixXd::Zero(dim, dim);
+  // Scores (g_f, g_t) of each tag observation, keyed (frame, tag, camera).
+  std::map<std::array<int, 3>, std::pair<Vector6d, Eigen::VectorXd>> scores;
+  int residuals = 0;
+  for (size_t i = 0; i < p.corners.size(); ++i) {
+    if (!p.corner_used[i]) continue;
+    const Corner& c = p.corners[i];
+    Eigen::Vector2d r;
+    Matrix26 jf, jt;
+    if (!CornerJacobians(c.px, TagCornerInTag(c.k, tag_size_mm),
+                         rig.cameras[c.camera], p.frame_R0[c.frame],
+                         p.tag_R0[c.tag], p.frame_blocks[c.frame].data(),
+                         p.tag_blocks[c.tag].data(), &r, &jf, &jt)) {
+      continue;
+    }
+    residuals += 2;
+    h_ff[c.frame] += jf.transpose() * jf;
+    auto& score = scores[{c.frame, c.tag, c.camera}];
+    if (score.second.size() == 0) {
+      score.first.setZero();
+      score.second = Eigen::VectorXd::Zero(dim);
+    }
+    score.first += jf.transpose() * r;
+    const int col = column(c.tag);
+    if (col < 0) continue;
+    h_ft[c.frame].middleCols<6>(col) += jf.transpose() * jt;
+    h_tt.block<6, 6>(col, col) += jt.transpose() * jt;
+    score.second.segment<6>(col) += jt.transpose() * r;
+  }
+  std::vector<Matrix6d> h_ff_inv(frames);
+  Eigen::MatrixXd schur = h_tt;
+  for (int f = 0; f < frames; ++f) {
+    h_ff_inv[f] = h_ff[f].inverse();
+    schur -= h_ft[f].transpose() * h_ff_inv[f] * h_ft[f];
+  }
+  const Eigen::MatrixXd schur_inv =
+      schur.ldlt().solve(Eigen::MatrixXd::Identity(dim, dim));
+  Eigen::MatrixXd free_cov;
+  if (model == LayoutCovariance::kCornerNoise) {
+    free_cov = sigma0 * sigma0 * schur_inv;
+  } else {
+    Eigen::MatrixXd meat = Eigen::MatrixXd::Zero(dim, dim);
+    for (const auto& [key, score] : scores) {
+      const Eigen::VectorXd u =
+          score.second -
+          h_ft[key[0]].transpose() * (h_ff_inv[key[0]] * score.first);
+      meat += u * u.transpose();
+    }
+    const int parameters = 6 * frames + dim;
+    const double dof_scale =
+        residuals > parameters
+            ? static_cast<double>(residuals) / (residuals - parameters)
+            : 1.0;
+    free_cov = dof_scale * schur_inv * meat * schur_inv;
+  }
+  Eigen::MatrixXd cov = Eigen::MatrixXd::Zero(6 * tags, 6 * tags);
+  for (int a = 0; a < tags; ++a) {
+    for (int b = 0; b < tags; ++b) {
+      if (column(a) < 0 || column(b) < 0) continue;
+      cov.block<6, 6>(6 * a, 6 * b) =
+          free_cov.block<6, 6>(column(a), column(b));
     }
   }
+  return cov;
 }
 
 }  // namespace
@@ -393,6 +493,9 @@ TargetLayoutResult MeasureTargetLayout(const Rig& rig,
   const std::vector<TagPoses> poses = SingleTagPoses(rig, frames, options);
   int multi = 0;
   for (const TagPoses& p : poses) multi += p.size() >= 2 ? 1 : 0;
+  TargetLayoutResult result;
+  result.multi_tag_views = multi;
+  result.frames = static_cast<int>(frames.size());
   if (multi < options.min_views) {
     throw InputError(
         "only " + std::to_string(multi) + " of " +
@@ -402,7 +505,6 @@ TargetLayoutResult MeasureTargetLayout(const Rig& rig,
         " needed): record the tool from more directions, each view showing "
         "neighbouring tags together");
   }
-  TargetLayoutResult result;
   const std::map<int, Rigid3> layout =
       StartLayout(poses, &result.reference_tag_id);
   Problem p =
@@ -458,7 +560,18 @@ TargetLayoutResult MeasureTargetLayout(const Rig& rig,
     tag.views = static_cast<int>(frames_seen.size());
     result.tags.push_back(tag);
   }
-  TagSigmas(p, problem.get(), result.sigma0_px, &result.tags);
+  Rebase(&p);
+  result.covariance = TagCovariance(p, rig, options.tag_size_mm,
+                                    result.sigma0_px, options.covariance);
+  for (size_t i = 0; i < result.tags.size(); ++i) {
+    for (int k = 0; k < 3; ++k) {
+      const int row = 6 * static_cast<int>(i) + k;
+      result.tags[i].sigma_r_deg(k) =
+          std::sqrt(result.covariance(row, row)) * 180 / M_PI;
+      result.tags[i].sigma_t_mm(k) =
+          std::sqrt(result.covariance(row + 3, row + 3));
+    }
+  }
   for (const LayoutTag& t : result.tags) {
     TargetTag tag;
     tag.id = t.id;
@@ -473,6 +586,88 @@ TargetLayoutResult MeasureTargetLayout(const Rig& rig,
     result.rig_from_tool.push_back(BlockPose(p.frame_blocks[f], p.frame_R0[f]));
   }
   return result;
+}
+
+Eigen::MatrixXd ToolPoseLayoutJacobian(const Rig& rig,
+                                       const TargetLayoutResult& layout,
+                                       const ToolPoseResult& pose) {
+  const int tags = static_cast<int>(layout.tags.size());
+  Matrix6d h = Matrix6d::Zero();
+  Eigen::MatrixXd cross = Eigen::MatrixXd::Zero(6, 6 * tags);
+  const std::array<double, 6> frame_block = {0,
+                                             0,
+                                             0,
+                                             pose.rig_from_tool.t.x(),
+                                             pose.rig_from_tool.t.y(),
+                                             pose.rig_from_tool.t.z()};
+  for (const TagObservationResult& obs : pose.tags) {
+    if (!obs.used) continue;
+    int index = -1;
+    for (int i = 0; i < tags; ++i) {
+      if (layout.tags[i].id == obs.tag_id) index = i;
+    }
+    if (index < 0) continue;
+    const Rigid3& tool_from_tag = layout.tags[index].tool_from_tag;
+    const std::array<double, 6> tag_block = {
+        0, 0, 0, tool_from_tag.t.x(), tool_from_tag.t.y(), tool_from_tag.t.z()};
+    for (int k = 0; k < 4; ++k) {
+      if (!obs.corner_used[k]) continue;
+      Eigen::Vector2d r;
+      Matrix26 jf, jt;
+      if (!CornerJacobians(obs.corners_px[k],
+                           TagCornerInTag(k, layout.target.tags[index].size_mm),
+                           rig.cameras[obs.camera], pose.rig_from_tool.R,
+                           tool_from_tag.R, frame_block.data(),
+                           tag_block.data(), &r, &jf, &jt)) {
+        continue;
+      }
+      h += jf.transpose() * jf;
+      cross.middleCols<6>(6 * index) += jf.transpose() * jt;
+    }
+  }
+  return -h.ldlt().solve(cross);
+}
+
+PivotTipResult MeasurePivotTip(const Rig& rig, const TargetLayoutResult& layout,
+                               const std::vector<LayoutFrame>& frames,
+                               const PivotTipOptions& options) {
+  std::vector<Rigid3> poses;
+  std::vector<Eigen::MatrixXd> pose_jacobians;
+  for (const LayoutFrame& f : frames) {
+    const ToolPoseResult r =
+        EstimateToolPose(rig, layout.target, f.detections, options.pose);
+    if (!r.found) continue;
+    poses.push_back(r.rig_from_tool);
+    pose_jacobians.push_back(ToolPoseLayoutJacobian(rig, layout, r));
+  }
+  if (static_cast<int>(poses.size()) < options.min_views) {
+    throw InputError("the tool was found in " + std::to_string(poses.size()) +
+                     " of " + std::to_string(frames.size()) +
+                     " frames (at least " + std::to_string(options.min_views) +
+                     " needed): record the tool pivoting about its tip with "
+                     "its tags in view");
+  }
+  PivotTipResult out;
+  out.pivot =
+      PivotCalibration(poses, options.min_conditioning, options.min_tilt_deg);
+  out.views = static_cast<int>(poses.size());
+  // d tip / d layout = sum over frames of d tip / d pose_i * d pose_i / d
+  // layout; the layout's covariance through it adds to the pivot's.
+  const Eigen::MatrixXd tip_from_poses =
+      PivotTipJacobian(poses, out.pivot.tip_in_tool);
+  Eigen::MatrixXd tip_from_layout =
+      Eigen::MatrixXd::Zero(3, layout.covariance.cols());
+  for (size_t i = 0; i < poses.size(); ++i) {
+    tip_from_layout += tip_from_poses.middleCols<6>(6 * i) * pose_jacobians[i];
+  }
+  const Eigen::Matrix3d layout_cov =
+      tip_from_layout * layout.covariance * tip_from_layout.transpose();
+  const Eigen::Matrix3d total = out.pivot.tip_covariance + layout_cov;
+  for (int k = 0; k < 3; ++k) {
+    out.layout_sigma_mm(k) = std::sqrt(std::max(0.0, layout_cov(k, k)));
+    out.tip_sigma_mm(k) = std::sqrt(std::max(0.0, total(k, k)));
+  }
+  return out;
 }
 
 std::vector<LayoutFrame> DetectSessionTags(

@@ -18,9 +18,12 @@
 //     every frame showing two or more placed tags: per frame rig_from_tool,
 //     per tag tool_from_tag (reference fixed), rig fixed; a Huber fit, then
 //     corners with large residuals out and a plain least-squares fit;
-//  5. each tag's covariance (ceres::Covariance) scaled by the residuals'
-//     sigma^2, reported as 1-sigma of the translation (tool axes, mm) and of
-//     the rotation error vector in the tool frame (deg).
+//  5. the tags' joint covariance, reported per tag as 1-sigma of the
+//     translation (tool axes, mm) and of the rotation error vector in the
+//     tool frame (deg); see LayoutCovariance for the noise model.
+//
+// A needle tip by pivot calibration with the measured layout
+// (MeasurePivotTip) carries the layout's covariance into the tip's sigma.
 
 #include <Eigen/Core>
 #include <functional>
@@ -30,6 +33,7 @@
 #include "camcal/rig.h"
 #include "data/session.h"
 #include "vision/apriltag_detector.h"
+#include "vision/pivot.h"
 #include "vision/target.h"
 #include "vision/tool_pose.h"
 
@@ -41,6 +45,17 @@ struct LayoutFrame {
   std::vector<std::vector<TagDetection>> detections;
 };
 
+// How the tags' covariance is estimated (H = J^T J of the bundle, the frame
+// poses eliminated by their Schur complement):
+//  - kCornerNoise: sigma0^2 H^-1, independent corner noise of the residuals'
+//    sigma0; too small when a tag's four corners err together (blur, a
+//    tag's quad fitted as a whole);
+//  - kTagObservations: cluster-robust (sandwich) H^-1 (sum_c g_c g_c^T) H^-1
+//    with g_c = J_c^T r_c over each tag observation c (one tag in one
+//    camera at one frame), scaled by N / (N - P) (N residuals, P
+//    parameters): any error shared by a tag's corners counts fully.
+enum class LayoutCovariance { kCornerNoise, kTagObservations };
+
 struct TargetLayoutOptions {
   std::string family = "tag36h11";
   double tag_size_mm = 0;  // edge of the black square; required (> 0)
@@ -48,15 +63,17 @@ struct TargetLayoutOptions {
   int min_views = 10;
   // Huber scale of the first fit (px).
   double huber_px = 1.0;
-  // After the first fit a corner is left out when its residual exceeds
+  // After the first fit a tag observation (one tag in one camera at one
+  // frame) is left out when one of its corners' residual exceeds
   // max(outlier_px, outlier_ratio * median corner residual).
-  double outlier_px = 1.0;
-  double outlier_ratio = 5.0;
+  double outlier_px = 0.3;
+  double outlier_ratio = 4.0;
   int max_iterations = 100;
   // A final corner RMS above this is refused: the tag size (or the rig, or
   // the family) does not fit the images.
   double max_rms_px = 2.0;
   ToolPoseOptions pose;  // the one-tag pose fits of step 1
+  LayoutCovariance covariance = LayoutCovariance::kTagObservations;
 
   void Check() const;  // InputError naming the bad option
 };
@@ -82,6 +99,14 @@ struct TargetLayoutResult {
   int corners_rejected = 0;
   double rms_px = 0;     // RMS corner residual (per coordinate) of the fit
   double sigma0_px = 0;  // residual sigma with degrees of freedom
+  // Joint covariance of the tags' pose corrections, 6 per tag in the order
+  // of `tags` (rotation error vector in the tool frame, rad; translation,
+  // mm); the reference tag's rows and columns are 0.
+  Eigen::MatrixXd covariance;
+  // Frames of the session that show two or more tags (those carry the
+  // layout) and all frames.
+  int multi_tag_views = 0;
+  int frames = 0;
 };
 
 // Throws InputError (the reason and what to record instead) when the views
@@ -91,6 +116,43 @@ struct TargetLayoutResult {
 TargetLayoutResult MeasureTargetLayout(const Rig& rig,
                                        const std::vector<LayoutFrame>& frames,
                                        const TargetLayoutOptions& options);
+
+// How rig_from_tool, fitted (plain least squares, as EstimateToolPose's
+// final fit) to the corners that `pose` used with the layout's target,
+// moves with the layout: 6 x 6 * layout.tags.size(), rows (a, dt) of the
+// pose's correction (exp([a]x) R, t + dt), columns the tags' corrections as
+// in TargetLayoutResult::covariance. Implicit function theorem:
+// -(Jp^T Jp)^-1 Jp^T Jl at the fitted pose.
+Eigen::MatrixXd ToolPoseLayoutJacobian(const Rig& rig,
+                                       const TargetLayoutResult& layout,
+                                       const ToolPoseResult& pose);
+
+struct PivotTipOptions {
+  // Pivot frames with a tool pose needed at least.
+  int min_views = 10;
+  // Tilt range needed in the second direction (PivotResult::tilt_range_deg).
+  double min_tilt_deg = 15.0;
+  double min_conditioning = 1e-3;
+  ToolPoseOptions pose;
+};
+
+struct PivotTipResult {
+  PivotResult pivot;  // tip_sigma_mm there: the pivot residuals' part only
+  int views = 0;      // pivot frames with a tool pose
+  // 1-sigma of tip_in_tool per tool axis (mm): the pivot residuals' part and
+  // the layout's covariance carried through the tool poses of every pivot
+  // frame (ToolPoseLayoutJacobian, PivotTipJacobian).
+  Eigen::Vector3d tip_sigma_mm = Eigen::Vector3d::Zero();
+  Eigen::Vector3d layout_sigma_mm = Eigen::Vector3d::Zero();  // its part
+};
+
+// The tip by pivot calibration of the tool tracked with the measured layout
+// in `frames` (the tip resting in a divot while the tool tilts). InputError
+// with what to record instead: too few frames with the tool, too little
+// tilt, rotations that leave the tip undetermined.
+PivotTipResult MeasurePivotTip(const Rig& rig, const TargetLayoutResult& layout,
+                               const std::vector<LayoutFrame>& frames,
+                               const PivotTipOptions& options);
 
 // Every complete frame of a two-camera session, tags detected at full
 // frame in both cameras. progress (optional) gets (done, total) per frame.
