@@ -411,9 +411,13 @@ Eigen::MatrixXd TagCovariance(const Problem& p, const Rig& rig,
   std::vector<Matrix6d> h_ff(frames, Matrix6d::Zero());
   std::vector<Eigen::MatrixXd> h_ft(frames, Eigen::MatrixXd::Zero(6, dim));
   Eigen::MatrixXd h_tt = Eigen::MatrixXd::Zero(dim, dim);
-  // Scores (g_f, g_t) of each tag observation, keyed (frame, tag, camera).
-  std::map<std::array<int, 3>, std::pair<Vector6d, Eigen::VectorXd>> scores;
-  int residuals = 0;
+  // Each tag observation's Jacobian rows on (its frame's 6, the tags') and
+  // residuals, keyed (frame, tag, camera).
+  struct Observation {
+    std::vector<Eigen::RowVectorXd> rows;
+    std::vector<double> residuals;
+  };
+  std::map<std::array<int, 3>, Observation> observations;
   for (size_t i = 0; i < p.corners.size(); ++i) {
     if (!p.corner_used[i]) continue;
     const Corner& c = p.corners[i];
@@ -425,19 +429,19 @@ Eigen::MatrixXd TagCovariance(const Problem& p, const Rig& rig,
                          p.tag_blocks[c.tag].data(), &r, &jf, &jt)) {
       continue;
     }
-    residuals += 2;
     h_ff[c.frame] += jf.transpose() * jf;
-    auto& score = scores[{c.frame, c.tag, c.camera}];
-    if (score.second.size() == 0) {
-      score.first.setZero();
-      score.second = Eigen::VectorXd::Zero(dim);
-    }
-    score.first += jf.transpose() * r;
     const int col = column(c.tag);
+    Observation& obs = observations[{c.frame, c.tag, c.camera}];
+    for (int k = 0; k < 2; ++k) {
+      Eigen::RowVectorXd row = Eigen::RowVectorXd::Zero(6 + dim);
+      row.head<6>() = jf.row(k);
+      if (col >= 0) row.segment<6>(6 + col) = jt.row(k);
+      obs.rows.push_back(row);
+      obs.residuals.push_back(r(k));
+    }
     if (col < 0) continue;
     h_ft[c.frame].middleCols<6>(col) += jf.transpose() * jt;
     h_tt.block<6, 6>(col, col) += jt.transpose() * jt;
-    score.second.segment<6>(col) += jt.transpose() * r;
   }
   std::vector<Matrix6d> h_ff_inv(frames);
   Eigen::MatrixXd schur = h_tt;
@@ -451,19 +455,42 @@ Eigen::MatrixXd TagCovariance(const Problem& p, const Rig& rig,
   if (model == LayoutCovariance::kCornerNoise) {
     free_cov = sigma0 * sigma0 * schur_inv;
   } else {
+    // The inverse of H on (frame f, tags): [[A, B], [B^T, S^-1]] with
+    // B = -H_ff^-1 H_ft S^-1, A = H_ff^-1 - B H_tf H_ff^-1.
     Eigen::MatrixXd meat = Eigen::MatrixXd::Zero(dim, dim);
-    for (const auto& [key, score] : scores) {
+    Eigen::MatrixXd local(6 + dim, 6 + dim);
+    for (const auto& [key, obs] : observations) {
+      const int f = key[0];
+      const Eigen::MatrixXd b = -h_ff_inv[f] * h_ft[f] * schur_inv;
+      local.topLeftCorner(6, 6) =
+          h_ff_inv[f] - b * h_ft[f].transpose() * h_ff_inv[f];
+      local.topRightCorner(6, dim) = b;
+      local.bottomLeftCorner(dim, 6) = b.transpose();
+      local.bottomRightCorner(dim, dim) = schur_inv;
+      const int n = static_cast<int>(obs.rows.size());
+      Eigen::MatrixXd jacobian(n, 6 + dim);
+      Eigen::VectorXd residual(n);
+      for (int k = 0; k < n; ++k) {
+        jacobian.row(k) = obs.rows[k];
+        residual(k) = obs.residuals[k];
+      }
+      // The residuals the observation would have had, were it left out of
+      // the fit: (I - J_c H^-1 J_c^T)^-1 r_c (jackknife-like CR3 scores).
+      const Eigen::MatrixXd leverage = jacobian * local * jacobian.transpose();
+      Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(
+          Eigen::MatrixXd::Identity(n, n) - leverage);
+      const Eigen::VectorXd kept =
+          eig.eigenvalues().cwiseMax(0.05).cwiseInverse();
+      const Eigen::VectorXd left_out = eig.eigenvectors() * kept.asDiagonal() *
+                                       eig.eigenvectors().transpose() *
+                                       residual;
+      const Eigen::VectorXd score = jacobian.transpose() * left_out;
       const Eigen::VectorXd u =
-          score.second -
-          h_ft[key[0]].transpose() * (h_ff_inv[key[0]] * score.first);
+          score.tail(dim) -
+          h_ft[f].transpose() * (h_ff_inv[f] * score.head<6>());
       meat += u * u.transpose();
     }
-    const int parameters = 6 * frames + dim;
-    const double dof_scale =
-        residuals > parameters
-            ? static_cast<double>(residuals) / (residuals - parameters)
-            : 1.0;
-    free_cov = dof_scale * schur_inv * meat * schur_inv;
+    free_cov = schur_inv * meat * schur_inv;
   }
   Eigen::MatrixXd cov = Eigen::MatrixXd::Zero(6 * tags, 6 * tags);
   for (int a = 0; a < tags; ++a) {

@@ -50,10 +50,13 @@ struct LayoutFrame {
 //  - kCornerNoise: sigma0^2 H^-1, independent corner noise of the residuals'
 //    sigma0; too small when a tag's four corners err together (blur, a
 //    tag's quad fitted as a whole);
-//  - kTagObservations: cluster-robust (sandwich) H^-1 (sum_c g_c g_c^T) H^-1
-//    with g_c = J_c^T r_c over each tag observation c (one tag in one
-//    camera at one frame), scaled by N / (N - P) (N residuals, P
-//    parameters): any error shared by a tag's corners counts fully.
+//  - kTagObservations (default): cluster-robust (sandwich)
+//    H^-1 (sum_c g_c g_c^T) H^-1 over each tag observation c (one tag in one
+//    camera at one frame), g_c = J_c^T (I - J_c H^-1 J_c^T)^-1 r_c (the
+//    residuals c would have had left out of the fit, as a jackknife): any
+//    error shared by a tag's corners counts fully, whatever its size per
+//    observation. Errors shared across frames (a bias of the corner detector
+//    that repeats at every view of a tag) are not seen by either.
 enum class LayoutCovariance { kCornerNoise, kTagObservations };
 
 struct TargetLayoutOptions {
