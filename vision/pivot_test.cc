@@ -153,5 +153,33 @@ TEST(Pivot, RenderedPivotRecoversTipOffset) {
   EXPECT_LT(r.rms_mm, 0.2);
 }
 
+// PivotTipJacobian against finite differences of the pivot fit: each pose
+// corrected on the left by a small rotation, then by a small translation.
+TEST(Pivot, TipJacobianMatchesFiniteDifferences) {
+  const Eigen::Vector3d tip(3, 100, 12), pivot(40, 60, 480);
+  const auto poses = PivotPoses(tip, pivot, Eigen::Matrix3d::Identity(), 8);
+  const Eigen::MatrixXd jacobian = PivotTipJacobian(poses, tip);
+  ASSERT_EQ(jacobian.rows(), 3);
+  ASSERT_EQ(jacobian.cols(), 48);
+  const double h = 1e-6;
+  for (int i = 0; i < 8; ++i) {
+    for (int k = 0; k < 6; ++k) {
+      std::vector<Rigid3> moved = poses;
+      Eigen::Vector3d delta = Eigen::Vector3d::Zero();
+      delta(k % 3) = h;
+      if (k < 3) {
+        moved[i].R = RotationMatrixFromVector(delta) * moved[i].R;
+      } else {
+        moved[i].t += delta;
+      }
+      const Eigen::Vector3d numeric =
+          (PivotCalibration(moved).tip_in_tool - tip) / h;
+      EXPECT_LT((numeric - jacobian.col(6 * i + k)).norm(),
+                1e-4 * std::max(1.0, numeric.norm()))
+          << i << " " << k;
+    }
+  }
+}
+
 }  // namespace
 }  // namespace kincal

@@ -224,5 +224,47 @@ TEST(TargetLayout, RejectsBadOptions) {
   EXPECT_THROW(MeasureTargetLayout(rig, {}, o), InputError);
 }
 
+// ToolPoseLayoutJacobian against refitting the tool pose with one tag's
+// pose corrected by a small rotation (left) or translation.
+TEST(TargetLayout, ToolPoseLayoutJacobianMatchesRefits) {
+  const Rig rig = ExampleStereoRig(1280, 1024);
+  const auto truth = TrueLayout();
+  const TargetLayoutResult layout =
+      MeasureTargetLayout(rig, Frames(rig, truth, 30, 0.1, 5), Options());
+  const auto frames = Frames(rig, truth, 4, 0.1, 9);
+  const ToolPoseResult pose =
+      EstimateToolPose(rig, layout.target, frames[1].detections);
+  ASSERT_TRUE(pose.found);
+  ASSERT_GE(pose.tags_used, 3);
+  const Eigen::MatrixXd jacobian = ToolPoseLayoutJacobian(rig, layout, pose);
+  ASSERT_EQ(jacobian.rows(), 6);
+  ASSERT_EQ(jacobian.cols(), 6 * static_cast<int>(layout.tags.size()));
+  const double h = 1e-4;
+  for (size_t tag = 0; tag < layout.tags.size(); ++tag) {
+    for (int k = 0; k < 6; ++k) {
+      Target moved = layout.target;
+      Eigen::Vector3d delta = Eigen::Vector3d::Zero();
+      delta(k % 3) = k < 3 ? h : 100 * h;
+      Rigid3& tool_from_tag = moved.tags[tag].tool_from_tag;
+      if (k < 3) {
+        tool_from_tag.R = RotationMatrixFromVector(delta) * tool_from_tag.R;
+      } else {
+        tool_from_tag.t += delta;
+      }
+      const ToolPoseResult refit =
+          EstimateToolPose(rig, moved, frames[1].detections);
+      ASSERT_TRUE(refit.found);
+      Eigen::Matrix<double, 6, 1> numeric;
+      numeric.head<3>() = RotationVectorFromMatrix(
+          refit.rig_from_tool.R * pose.rig_from_tool.R.transpose());
+      numeric.tail<3>() = refit.rig_from_tool.t - pose.rig_from_tool.t;
+      const Eigen::Matrix<double, 6, 1> predicted =
+          jacobian.col(6 * tag + k) * delta(k % 3);
+      EXPECT_LT((numeric - predicted).norm(), 0.02 * predicted.norm() + 1e-7)
+          << "tag " << tag << " component " << k;
+    }
+  }
+}
+
 }  // namespace
 }  // namespace kincal
