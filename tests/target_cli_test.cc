@@ -218,9 +218,10 @@ TEST(TargetCli, RandomHoldersMonteCarlo) {
   }
   std::printf("RMS error/sigma: t %.2f, r %.2f, tip %.2f\n", RmsOf(z_t),
               RmsOf(z_r), RmsOf(z_tip));
+  // Measured 1.55, 1.16, 0.90 here; 1.23, 1.23, 1.03 over 8 seeds.
   for (double z : {RmsOf(z_t), RmsOf(z_r), RmsOf(z_tip)}) {
-    EXPECT_GT(z, 0.5);
-    EXPECT_LT(z, 2.5);
+    EXPECT_GT(z, 0.6);
+    EXPECT_LT(z, 2.0);
   }
 }
 

@@ -7,6 +7,29 @@
 #include "data/error.h"
 
 namespace kincal {
+namespace {
+
+// Covariance of the pivot solution, robust to pose errors that differ from
+// pose to pose in size and direction: (A^T A)^-1 (sum_i A_i^T e_i e_i^T A_i)
+// (A^T A)^-1 over the poses i (3 rows each), e_i = (I - A_i (A^T A)^-1
+// A_i^T)^-1 r_i, the residual pose i would have had left out of the fit.
+Eigen::MatrixXd PoseClusteredCovariance(const Eigen::MatrixXd& A,
+                                        const Eigen::VectorXd& residual,
+                                        const Eigen::MatrixXd& ata_inv) {
+  Eigen::MatrixXd meat = Eigen::MatrixXd::Zero(6, 6);
+  for (int i = 0; i < A.rows() / 3; ++i) {
+    const Eigen::Matrix<double, 3, 6> rows = A.middleRows<3>(3 * i);
+    const Eigen::Matrix3d keep =
+        Eigen::Matrix3d::Identity() - rows * ata_inv * rows.transpose();
+    const Eigen::Vector3d left_out =
+        keep.ldlt().solve(Eigen::Vector3d(residual.segment<3>(3 * i)));
+    const Eigen::Matrix<double, 6, 1> score = rows.transpose() * left_out;
+    meat += score * score.transpose();
+  }
+  return ata_inv * meat * ata_inv;
+}
+
+}  // namespace
 
 double PivotTiltRangeDeg(const std::vector<Rigid3>& rig_from_tool) {
   const int n = static_cast<int>(rig_from_tool.size());
@@ -83,12 +106,11 @@ PivotResult PivotCalibration(const std::vector<Rigid3>& rig_from_tool,
   r.rms_mm = std::sqrt(sum / n);
   r.tilt_range_deg = tilt;
   if (3 * n > 6) {
-    const double sigma2 = sum / (3 * n - 6);
     // (A^T A)^-1 = V S^-2 V^T.
     const Eigen::MatrixXd V = svd.matrixV();
     const Eigen::VectorXd inv_s2 = s.array().square().inverse();
-    const Eigen::MatrixXd cov =
-        sigma2 * V * inv_s2.asDiagonal() * V.transpose();
+    const Eigen::MatrixXd ata_inv = V * inv_s2.asDiagonal() * V.transpose();
+    const Eigen::MatrixXd cov = PoseClusteredCovariance(A, b - A * x, ata_inv);
     r.tip_covariance = cov.topLeftCorner<3, 3>();
     for (int k = 0; k < 3; ++k) {
       r.tip_sigma_mm(k) = std::sqrt(cov(k, k));

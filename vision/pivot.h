@@ -25,8 +25,11 @@ struct PivotResult {
   // rotations do not span two axes (the offset along the axis is unknown).
   double conditioning = 0;
   // 1-sigma of tip_in_tool and pivot_in_rig per axis (mm), from the linear
-  // least squares: sigma^2 (A^T A)^-1 with sigma^2 = |residual|^2 / (3n - 6)
-  // (the pose noise seen through the residuals).
+  // least squares, robust to pose errors that differ from pose to pose in
+  // size and direction (the depth of a stereo pose errs most):
+  // (A^T A)^-1 (sum_i A_i^T e_i e_i^T A_i) (A^T A)^-1 over the poses, e_i =
+  // (I - A_i (A^T A)^-1 A_i^T)^-1 r_i the residual of pose i had it been
+  // left out of the fit. Isotropic noise: as sigma^2 (A^T A)^-1.
   Eigen::Vector3d tip_sigma_mm = Eigen::Vector3d::Zero();
   Eigen::Vector3d pivot_sigma_mm = Eigen::Vector3d::Zero();
   // The full 3x3 covariance of tip_in_tool behind tip_sigma_mm (mm^2).
