@@ -395,6 +395,20 @@ bool CornerJacobians(const Eigen::Vector2d& px, const Eigen::Vector3d& c_in_tag,
   return cost->Evaluate(blocks, residual->data(), jacobians);
 }
 
+// Inverse on the range of a symmetric positive semi-definite matrix: a frame
+// whose every tag observation was left out has H_ff = 0 and no say.
+Matrix6d PseudoInverse(const Matrix6d& h) {
+  const Eigen::SelfAdjointEigenSolver<Matrix6d> eig(h);
+  const Eigen::Matrix<double, 6, 1> values = eig.eigenvalues();
+  const double floor = 1e-12 * std::max(values.maxCoeff(), 0.0);
+  Eigen::Matrix<double, 6, 1> inverse;
+  for (int k = 0; k < 6; ++k) {
+    inverse(k) = values(k) > floor && values(k) > 0 ? 1 / values(k) : 0;
+  }
+  return eig.eigenvectors() * inverse.asDiagonal() *
+         eig.eigenvectors().transpose();
+}
+
 // Step 5: the tags' joint covariance (LayoutCovariance), 6 per tag in the
 // problem's tag order, the reference's rows and columns 0. The frame poses
 // are eliminated per frame: S = H_tt - sum_f H_tf H_ff^-1 H_ft, and a tag
@@ -446,7 +460,7 @@ Eigen::MatrixXd TagCovariance(const Problem& p, const Rig& rig,
   std::vector<Matrix6d> h_ff_inv(frames);
   Eigen::MatrixXd schur = h_tt;
   for (int f = 0; f < frames; ++f) {
-    h_ff_inv[f] = h_ff[f].inverse();
+    h_ff_inv[f] = PseudoInverse(h_ff[f]);
     schur -= h_ft[f].transpose() * h_ff_inv[f] * h_ft[f];
   }
   const Eigen::MatrixXd schur_inv =

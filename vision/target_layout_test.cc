@@ -161,8 +161,20 @@ TEST(TargetLayout, TwoTagsAndOutliers) {
     frames[i].detections[0][0].corners[1] += Eigen::Vector2d(6, -4);
     ++spoiled;
   }
+  // Every tag observation of frame 2 spoiled: the frame drops out whole,
+  // and the covariance stays finite.
+  for (auto& camera : frames[2].detections) {
+    for (TagDetection& d : camera) d.corners[2] += Eigen::Vector2d(-3, 5);
+  }
   const TargetLayoutResult r = MeasureTargetLayout(rig, frames, Options());
   EXPECT_GE(r.corners_rejected, spoiled);
+  EXPECT_TRUE(r.covariance.allFinite());
+  for (const LayoutTag& tag : r.tags) {
+    EXPECT_TRUE(tag.sigma_t_mm.allFinite() && tag.sigma_r_deg.allFinite());
+    if (tag.id != r.reference_tag_id) {
+      EXPECT_GT(tag.sigma_t_mm.minCoeff(), 0);
+    }
+  }
   for (const LayoutTag& tag : r.tags) {
     const Rigid3 want = TrueRefFromTag(truth, r.reference_tag_id, tag.id);
     EXPECT_LT((tag.tool_from_tag.t - want.t).norm(), 0.05);
