@@ -13,12 +13,12 @@
 //  - 40 views tilted up to +-25 / +-30 deg, and a pivot session of 32
 //    frames on two circles tilted +-25 and +-12 deg about the tip;
 //  - the layout against the truth in the reference tag's frame, and the
-//    pivot tip with its sigma (pivot and layout parts).
+//    pivot tip with its sigma (pivot and layout parts);
+//  - `plain`: blur 0.5 px and noise 1.5 gray levels only, instead of the
+//    widened effects.
 
 #include <chrono>
 #include <cmath>
-#include <cstdio>
-#include <cstdlib>
 #include <random>
 #include <vector>
 
@@ -142,26 +142,6 @@ inline std::vector<LayoutFrame> RenderAndDetect(
             mean += (d.corners[k] - t.corners[k]) / 4;
           }
           errors->n += 4;
-          if (std::getenv("KINCAL_MC_DEBUG")) {
-            const Camera& cam = rig.cameras[f.detections.size() - 1];
-            const Rigid3 cam_from_tag = cam.cam_from_rig * poses[i] *
-                                        target.FindTag(d.id)->tool_from_tag;
-            const double angle =
-                std::acos(std::abs(
-                    cam_from_tag.t.normalized().dot(cam_from_tag.R.col(2)))) *
-                180 / M_PI;
-            double side = 0;
-            for (int k = 0; k < 4; ++k) {
-              side = std::max(side,
-                              (t.corners[k] - t.corners[(k + 1) % 4]).norm());
-            }
-            double rms = 0;
-            for (int k = 0; k < 4; ++k)
-              rms += (d.corners[k] - t.corners[k]).squaredNorm() / 4;
-            std::fprintf(stderr, "OBS %d %.1f %.1f %.3f %.3f %d%d%d%d\n", d.id,
-                         angle, side, std::sqrt(rms), mean.norm(), d.refined[0],
-                         d.refined[1], d.refined[2], d.refined[3]);
-          }
           errors->max_offset = std::max(errors->max_offset, mean.norm());
         }
       }
