@@ -701,13 +701,26 @@ TEST(LabProcedureTest, EveryBlockRunsOnItsStandIns) {
     EXPECT_TRUE(RunDocBlock(b, s))
         << "docs/LAB.md:" << b.line << ": marker word without a stand-in";
   }
-  for (const char* file :
-       {"grid.pdf", "rig.yaml", "target.yaml", "poses.csv", "cell.yaml",
-        "run1/observations.csv", "run3/frames.csv", "joint_log/run2/frames.csv",
-        "run1/points.csv", "run1/obs.csv", "cal.yaml", "diag.json",
-        "report.html", "ur10/extended.yaml", "ur10/program_compensated.csv",
-        "ur10/iso.csv", "rehearsal/cal.yaml",
-        "rehearsal/handshake/frames.csv"}) {
+  for (const char* file : {"grid.pdf",
+                           "rig.yaml",
+                           "target.yaml",
+                           "poses.csv",
+                           "cell.yaml",
+                           "run1/observations.csv",
+                           "run3/frames.csv",
+                           "joint_log/run2/frames.csv",
+                           "run1/points.csv",
+                           "run1/obs.csv",
+                           "cal.yaml",
+                           "diag.json",
+                           "report.html",
+                           "bundle.json",
+                           "ur10/extended.yaml",
+                           "ur10/ur_kinematics.yaml",
+                           "ur10/program_compensated.csv",
+                           "ur10/iso.csv",
+                           "rehearsal/cal.yaml",
+                           "rehearsal/handshake/frames.csv"}) {
     EXPECT_TRUE(testing::Exists(s.lab + "/" + file)) << file;
   }
   // The rig camcal measured from the grid (board in mm) is the simulated one.
