@@ -5,9 +5,11 @@
 
 #include <Eigen/Geometry>
 #include <algorithm>
+#include <cctype>
 #include <cstdint>
 #include <cstring>
 #include <fstream>
+#include <iterator>
 #include <limits>
 #include <map>
 #include <mutex>
@@ -55,6 +57,8 @@ std::vector<Eigen::Vector3d> ReadMeshVertices(const std::string& path) {
     const size_t n = std::strlen(ext);
     return lower.size() >= n && lower.compare(lower.size() - n, n, ext) == 0;
   };
+  // Binary STL: 80-byte header, little-endian triangle count, 50 bytes per
+  // triangle (normal, three vertices as float32, attribute count).
   if (ends_with(".stl") && data.size() >= 84) {
     uint32_t triangles = 0;
     std::memcpy(&triangles, data.data() + 80, 4);

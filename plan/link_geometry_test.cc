@@ -5,6 +5,7 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 
 #include "calib/chain.h"
 #include "data/atomic_file.h"
@@ -101,6 +102,35 @@ TEST(LinkGeometry, EveryElementKindBecomesItsEnclosingCapsule) {
   ExpectCapsule(g.capsules[3], "l3", 2, V(0, 0, 0), V(300, 0, 0),
                 30 * std::sqrt(2.0));
   ExpectCapsule(g.capsules[4], "tool", 2, V(300, 0, 0), V(300, 0, 0), 30);
+}
+
+// The same bar as a binary STL and as an OBJ gives the same capsule.
+TEST(LinkGeometry, BinaryStlAndObjMeshesAreRead) {
+  const Tiny t = MakeTiny();
+  const float corners[2][3][3] = {
+      {{-0.15f, -0.03f, -0.03f},
+       {0.15f, -0.03f, -0.03f},
+       {0.15f, 0.03f, -0.03f}},
+      {{-0.15f, 0.03f, 0.03f}, {0.15f, 0.03f, 0.03f}, {0.15f, -0.03f, 0.03f}}};
+  std::string stl(80, ' ');
+  const uint32_t triangles = 2;
+  stl.append(reinterpret_cast<const char*>(&triangles), 4);
+  for (const auto& triangle : corners) {
+    const float normal[3] = {0, 0, 1};
+    stl.append(reinterpret_cast<const char*>(normal), 12);
+    stl.append(reinterpret_cast<const char*>(triangle), 36);
+    stl.append(2, '\0');
+  }
+  WriteFileAtomic(t.dir + "/bar_binary.stl", stl);
+  WriteFileAtomic(t.dir + "/bar.obj",
+                  "v -0.15 -0.03 -0.03\nv 0.15 0.03 0.03\nf 1 2 1\n");
+  for (const char* mesh : {"bar_binary.stl", "bar.obj"}) {
+    const LinkGeometry g =
+        ParseUrdfLinkGeometry(TinyUrdf(mesh), t.dir, t.robot);
+    ASSERT_EQ(g.capsules.size(), 5u) << mesh;
+    ExpectCapsule(g.capsules[3], "l3", 2, Eigen::Vector3d(0, 0, 0),
+                  Eigen::Vector3d(300, 0, 0), 30 * std::sqrt(2.0));
+  }
 }
 
 // The chain's frames carry the URDF's links: the frames against the
