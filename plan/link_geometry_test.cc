@@ -79,14 +79,16 @@ Tiny MakeTiny() {
 
 void ExpectCapsule(const LinkCapsule& c, const std::string& link, int frame,
                    const Eigen::Vector3d& a, const Eigen::Vector3d& b,
-                   double radius) {
+                   double radius, double tolerance = 1e-6) {
   EXPECT_EQ(c.link, link);
   EXPECT_EQ(c.frame, frame) << link;
-  const bool same = (c.a - a).norm() < 1e-6 && (c.b - b).norm() < 1e-6;
-  const bool swapped = (c.a - b).norm() < 1e-6 && (c.b - a).norm() < 1e-6;
+  const bool same =
+      (c.a - a).norm() < tolerance && (c.b - b).norm() < tolerance;
+  const bool swapped =
+      (c.a - b).norm() < tolerance && (c.b - a).norm() < tolerance;
   EXPECT_TRUE(same || swapped)
       << link << ": " << c.a.transpose() << " / " << c.b.transpose();
-  EXPECT_NEAR(c.radius_mm, radius, 1e-6) << link;
+  EXPECT_NEAR(c.radius_mm, radius, tolerance) << link;
 }
 
 TEST(LinkGeometry, EveryElementKindBecomesItsEnclosingCapsule) {
@@ -128,8 +130,9 @@ TEST(LinkGeometry, BinaryStlAndObjMeshesAreRead) {
     const LinkGeometry g =
         ParseUrdfLinkGeometry(TinyUrdf(mesh), t.dir, t.robot);
     ASSERT_EQ(g.capsules.size(), 5u) << mesh;
+    // float32 vertices: 1e-5 mm.
     ExpectCapsule(g.capsules[3], "l3", 2, Eigen::Vector3d(0, 0, 0),
-                  Eigen::Vector3d(300, 0, 0), 30 * std::sqrt(2.0));
+                  Eigen::Vector3d(300, 0, 0), 30 * std::sqrt(2.0), 1e-4);
   }
 }
 
