@@ -54,6 +54,9 @@ int main(int argc, char** argv) {
       "kincal: robot accuracy measurement, calibration and diagnosis.\n"
       "Units at every interface: mm, degrees, seconds."};
   app.require_subcommand(1);
+  app.footer(
+      "Solver messages (Ceres, through glog) are hidden; set "
+      "KINCAL_SOLVER_LOG=1 to see them on stderr.");
   app.option_defaults()->always_capture_default();  // --help shows defaults
   app.set_version_flag("--version",
                        kincal::ToolVersion() + " (commit " KINCAL_COMMIT ")");
