@@ -4,7 +4,6 @@
 
 #include <cmath>
 #include <cstdio>
-#include <iostream>
 #include <memory>
 #include <optional>
 
@@ -16,6 +15,7 @@
 #include "data/progress.h"
 #include "data/rigid3.h"
 #include "data/urdf.h"
+#include "data/warnings.h"
 #include "plan/confirm.h"
 #include "plan/iso9283_cube.h"
 #include "plan/link_geometry.h"
@@ -43,9 +43,10 @@ struct PlanArgs {
   bool n_given = false;
   bool cube_option_given = false;  // --cube, --cycles, ...
   // Where the link capsules come from ("urdf collision" or "capsules") and
-  // why a URDF's collision geometry was not used.
+  // why a URDF's collision geometry was not used (code
+  // urdf_collision_unused).
   std::string link_geometry = "capsules";
-  std::vector<std::string> warnings;
+  std::vector<Warning> warnings;
 };
 
 // A URDF robot's links from its <collision> geometry (plan/link_geometry.h);
@@ -57,10 +58,11 @@ void UseUrdfCollisionGeometry(const Robot& robot, PlanArgs* args) {
     return;
   }
   LinkGeometry links = ReadUrdfLinkGeometry(path, robot, args->root);
+  Warnings warnings = CommandWarnings();
   for (const std::string& w : links.warnings) {
-    std::cerr << "kincal plan: warning: " << w << "\n";
-    args->warnings.push_back(w);
+    warnings.Add("urdf_collision_unused", w);
   }
+  args->warnings = warnings.list();
   if (links.empty()) return;
   MarkAlwaysTouching(Chain::FromRobot(robot), robot, &links);
   args->link_geometry = "urdf collision";
@@ -70,7 +72,7 @@ void UseUrdfCollisionGeometry(const Robot& robot, PlanArgs* args) {
 // The safety fields both JSON objects share.
 void SafetyJson(const PlanArgs& args, nlohmann::json* j) {
   (*j)["link_geometry"] = args.link_geometry;
-  if (!args.warnings.empty()) (*j)["warnings"] = args.warnings;
+  AddWarnings(args.warnings, j);
 }
 
 // The JSON object of a plan (with --confirm: also simulated calibrations at
