@@ -16,6 +16,7 @@
 #include "app/front_end.h"
 #include "camcal/calibrate_cameras.h"
 #include "camcal/cameramodel.h"
+#include "camcal/plausibility.h"
 #include "camcal/rig.h"
 #include "data/error.h"
 #include "data/glob.h"
@@ -37,6 +38,7 @@ struct CamcalArgs {
   double uncertainty_distance = 0;
   double valid_threshold_px = 1.0;
   std::string out_cameramodel;  // PREFIX: PREFIX-<camera>.cameramodel
+  bool tiny_board = false;      // skip the board-in-metres checks
   bool json = false;
 };
 
@@ -384,6 +386,10 @@ void PrintSummary(const CamcalArgs& args, const CalibTargetSpec& spec,
 int RunCamcal(const CamcalArgs& args) {
   // Everything that can be checked before reading images comes first.
   const CalibTargetSpec spec = ParseCalibTargetSpec(args.target);
+  if (!args.tiny_board) {
+    const std::string why = BoardSizeImplausible(spec.size, spec.text);
+    if (!why.empty()) throw InputError(why);
+  }
   const CalibrationOptions options = ResolveOptions(args);
   const std::vector<std::vector<std::string>> files = ImageFiles(args);
   Progress progress("kincal camcal", args.json);
@@ -396,6 +402,10 @@ int RunCamcal(const CamcalArgs& args) {
   if (!failure.empty()) {
     std::cerr << "kincal: failure: " << failure << "; nothing written\n";
     return 1;
+  }
+  if (!args.tiny_board) {
+    const std::string why = SolvedRigImplausible(sum, spec.size, spec.text);
+    if (!why.empty()) throw InputError(why + "; nothing written");
   }
   WriteRigYaml(args.out, sum.rig);
   if (!args.out_cameramodel.empty()) WriteCameraModels(args, sum);
@@ -441,6 +451,10 @@ void AddCamcalCommand(CLI::App& app, Runner* run) {
   sub->add_option("--out-cameramodel", args->out_cameramodel,
                   "also write mrcal models PREFIX-<camera>.cameramodel "
                   "(translations in target units)");
+  sub->add_flag("--tiny-board", args->tiny_board,
+                "the board really is this small (sizes in mm): skip the "
+                "board-in-metres checks (a square or tag under 1 mm, the "
+                "board seen within 20 mm, a baseline under 1 mm)");
   sub->add_flag("--json", args->json, "print one JSON object");
   sub->footer(HelpFooter(
       "Example: stereo rig from a 9x6 chessboard with 25 mm squares:\n  kincal "

@@ -15,8 +15,10 @@
 #include "data/progress.h"
 #include "data/rigid3.h"
 #include "data/urdf.h"
+#include "data/warnings.h"
 #include "plan/confirm.h"
 #include "plan/iso9283_cube.h"
+#include "plan/link_geometry.h"
 #include "plan/obstacles.h"
 #include "plan/plan.h"
 #include "vision/target.h"
@@ -40,7 +42,38 @@ struct PlanArgs {
   std::vector<std::string> design_only;
   bool n_given = false;
   bool cube_option_given = false;  // --cube, --cycles, ...
+  // Where the link capsules come from ("urdf collision" or "capsules") and
+  // why a URDF's collision geometry was not used (code
+  // urdf_collision_unused).
+  std::string link_geometry = "capsules";
+  std::vector<Warning> warnings;
 };
+
+// A URDF robot's links from its <collision> geometry (plan/link_geometry.h);
+// the generic capsules otherwise, with a warning on stderr when the URDF's
+// geometry cannot be used.
+void UseUrdfCollisionGeometry(const Robot& robot, PlanArgs* args) {
+  const std::string& path = args->robot;
+  if (path.size() < 5 || path.compare(path.size() - 5, 5, ".urdf") != 0) {
+    return;
+  }
+  LinkGeometry links = ReadUrdfLinkGeometry(path, robot, args->root);
+  Warnings warnings = CommandWarnings();
+  for (const std::string& w : links.warnings) {
+    warnings.Add("urdf_collision_unused", w);
+  }
+  args->warnings = warnings.list();
+  if (links.empty()) return;
+  MarkAlwaysTouching(Chain::FromRobot(robot), robot, &links);
+  args->link_geometry = "urdf collision";
+  args->options.safety.links = std::move(links);
+}
+
+// The safety fields both JSON objects share.
+void SafetyJson(const PlanArgs& args, nlohmann::json* j) {
+  (*j)["link_geometry"] = args.link_geometry;
+  AddWarnings(args.warnings, j);
+}
 
 // The JSON object of a plan (with --confirm: also simulated calibrations at
 // the planned and the random poses).
@@ -81,6 +114,7 @@ nlohmann::json PlanJson(const PlanArgs& args, const Robot& robot,
   j["swaps"] = plan.swaps;
   j["limit_margin"] = args.options.limit_margin;
   j["link_radius_mm"] = args.options.safety.link_radius_mm;
+  SafetyJson(args, &j);
   j["obstacles"] = args.obstacles;
   j["rejected_limits"] = plan.rejected_limits;
   j["rejected_collision"] = plan.rejected_collision;
@@ -169,6 +203,7 @@ nlohmann::json IsoCubeJson(const PlanArgs& args, const Robot& robot,
   j["poses"] = poses;
   j["limit_margin"] = args.cube.limit_margin;
   j["link_radius_mm"] = args.cube.safety.link_radius_mm;
+  SafetyJson(args, &j);
   j["obstacles"] = args.obstacles;
   j["seeds_tried"] = plan.seeds_tried;
   j["draws"] = plan.draws;
@@ -223,6 +258,7 @@ int RunPlan(PlanArgs args) {
     args.options.safety.obstacles = ReadObstaclesYaml(args.obstacles);
   }
   args.options.safety.self_collision = !args.no_self_collision;
+  UseUrdfCollisionGeometry(robot, &args);
   if (args.iso9283) return RunIsoCube(args, robot);
   if (!args.n_given) {
     throw InputError(

@@ -1,8 +1,11 @@
 // kincal: measure how accurately a robot moves, find out why it is wrong, and
 // fix its model. One binary, each subcommand a thin layer over the libraries.
 
+#include <glog/logging.h>
 #include <malloc.h>
 
+#include <cstdlib>
+#include <cstring>
 #include <exception>
 #include <iostream>
 
@@ -19,6 +22,19 @@ void PrintJson(nlohmann::json result) {
   std::cout << result.dump() << std::endl;
 }
 
+// Ceres logs through glog (e.g. one "Residual and Jacobian evaluation
+// failed" warning per frame when no tool pose fits): kincal's own message
+// says what went wrong and what to do, so glog prints only fatal errors,
+// unless KINCAL_SOLVER_LOG is set to a non-empty value other than 0 (then
+// every glog line, INFO included, goes to stderr).
+void RouteSolverLogs(const char* argv0) {
+  const char* env = std::getenv("KINCAL_SOLVER_LOG");
+  const bool show = env && *env && std::strcmp(env, "0") != 0;
+  FLAGS_logtostderr = true;
+  FLAGS_minloglevel = show ? google::GLOG_INFO : google::GLOG_FATAL;
+  google::InitGoogleLogging(argv0);
+}
+
 }  // namespace kincal::app
 
 int main(int argc, char** argv) {
@@ -33,10 +49,14 @@ int main(int argc, char** argv) {
   mallopt(M_MMAP_THRESHOLD, 32 << 20);
   mallopt(M_TRIM_THRESHOLD, 1 << 30);
   kincal::SetCommandLine(argc, argv);
+  kincal::app::RouteSolverLogs(argv[0]);
   CLI::App app{
       "kincal: robot accuracy measurement, calibration and diagnosis.\n"
       "Units at every interface: mm, degrees, seconds."};
   app.require_subcommand(1);
+  app.footer(
+      "Solver messages (Ceres, through glog) are hidden; set "
+      "KINCAL_SOLVER_LOG=1 to see them on stderr.");
   app.option_defaults()->always_capture_default();  // --help shows defaults
   app.set_version_flag("--version",
                        kincal::ToolVersion() + " (commit " KINCAL_COMMIT ")");

@@ -2,6 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
+#include <random>
+#include <utility>
 
 namespace kincal {
 namespace {
@@ -101,19 +104,101 @@ LinkCapsules LinkSegments(const Chain& chain, const std::vector<double>& q) {
   return out;
 }
 
+std::vector<Eigen::Matrix4d> BaseFromLinkFrames(const Chain& chain,
+                                                const std::vector<double>& q) {
+  std::vector<Eigen::Matrix4d> frames{Eigen::Matrix4d::Identity()};
+  for (int j = 0; j < chain.num_joints(); ++j) {
+    const ChainRow& row = chain.rows[j];
+    frames.push_back(frames.back() * RowTransform<double>(chain.convention, row,
+                                                          row.p.data(), q[j]));
+  }
+  return frames;
+}
+
+std::vector<PlacedCapsule> PlaceCapsules(const Chain& chain,
+                                         const std::vector<double>& q,
+                                         const SafetyOptions& options) {
+  std::vector<PlacedCapsule> placed;
+  if (options.links.empty()) {
+    const LinkCapsules links = LinkSegments(chain, q);
+    for (size_t k = 0; k < links.segments.size(); ++k) {
+      placed.push_back({links.segments[k], options.link_radius_mm,
+                        static_cast<int>(k),
+                        static_cast<int>(k) < links.base_count});
+    }
+    return placed;
+  }
+  const std::vector<Eigen::Matrix4d> frames = BaseFromLinkFrames(chain, q);
+  for (const LinkCapsule& c : options.links.capsules) {
+    const Eigen::Matrix4d& m = frames[c.frame + 1];
+    const Eigen::Matrix3d r = m.block<3, 3>(0, 0);
+    const Eigen::Vector3d t = m.block<3, 1>(0, 3);
+    placed.push_back(
+        {{r * c.a + t, r * c.b + t}, c.radius_mm, c.frame, c.frame <= 0});
+  }
+  return placed;
+}
+
+namespace {
+
+bool AlwaysTouching(const SafetyOptions& options, int i, int k) {
+  const auto& pairs = options.links.always_touching;
+  return std::find(pairs.begin(), pairs.end(), std::make_pair(i, k)) !=
+         pairs.end();
+}
+
+}  // namespace
+
+void MarkAlwaysTouching(const Chain& chain, const Robot& robot,
+                        LinkGeometry* links, int samples) {
+  links->always_touching.clear();
+  const int n = static_cast<int>(links->capsules.size());
+  if (n == 0) return;
+  SafetyOptions options;
+  options.links = *links;
+  std::mt19937 rng(1);
+  std::vector<std::vector<int>> touching(n, std::vector<int>(n, 0));
+  for (int s = 0; s < samples; ++s) {
+    std::vector<double> q;
+    for (int j = 0; j < chain.num_joints(); ++j) {
+      const RobotRow& row = robot.joints[j];
+      const bool revolute = row.type == JointType::kRevolute;
+      const double lo = row.HasLimits() ? row.lower : (revolute ? -180 : -1000);
+      const double hi = row.HasLimits() ? row.upper : (revolute ? 180 : 1000);
+      q.push_back(chain.ReadingToInternal(
+          j, std::uniform_real_distribution<double>(lo, hi)(rng)));
+    }
+    const std::vector<PlacedCapsule> placed = PlaceCapsules(chain, q, options);
+    for (int i = 0; i < n; ++i) {
+      for (int k = i + 1; k < n; ++k) {
+        if (std::abs(placed[i].frame - placed[k].frame) < 2) continue;
+        touching[i][k] +=
+            SegmentSegmentDistance(placed[i].segment, placed[k].segment) <
+            placed[i].radius_mm + placed[k].radius_mm;
+      }
+    }
+  }
+  for (int i = 0; i < n; ++i) {
+    for (int k = i + 1; k < n; ++k) {
+      if (touching[i][k] == samples) links->always_touching.push_back({i, k});
+    }
+  }
+}
+
 Contact FindContact(const Chain& chain, const std::vector<double>& q,
                     const SafetyOptions& options) {
-  const LinkCapsules links = LinkSegments(chain, q);
-  const double radius = options.link_radius_mm;
-  const int n = static_cast<int>(links.segments.size());
+  const std::vector<PlacedCapsule> links = PlaceCapsules(chain, q, options);
+  const int n = static_cast<int>(links.size());
   Contact contact;
   const std::vector<ObstaclePlane>& planes = options.obstacles.planes;
   for (size_t p = 0; p < planes.size(); ++p) {
-    const double needed = radius + planes[p].clearance_mm;
-    const bool stands_on =
-        planes[p].normal.dot(-planes[p].point) < needed;  // base origin
-    for (int k = stands_on ? links.base_count : 0; k < n; ++k) {
-      if (SegmentPlaneDistance(links.segments[k], planes[p]) < needed) {
+    const double clearance = planes[p].clearance_mm;
+    const bool stands_on = planes[p].normal.dot(-planes[p].point) <
+                           options.link_radius_mm + clearance;  // base origin
+    for (int k = 0; k < n; ++k) {
+      if (stands_on && links[k].base) continue;
+      if (SegmentPlaneDistance(links[k].segment, planes[p]) <
+          links[k].radius_mm + clearance) {
         contact.kind = Contact::kPlane;
         contact.obstacle = static_cast<int>(p);
         contact.link = k;
@@ -124,8 +209,8 @@ Contact FindContact(const Chain& chain, const std::vector<double>& q,
   const std::vector<ObstacleBox>& boxes = options.obstacles.boxes;
   for (size_t b = 0; b < boxes.size(); ++b) {
     for (int k = 0; k < n; ++k) {
-      if (SegmentBoxDistance(links.segments[k], boxes[b]) <
-          radius + boxes[b].clearance_mm) {
+      if (SegmentBoxDistance(links[k].segment, boxes[b]) <
+          links[k].radius_mm + boxes[b].clearance_mm) {
         contact.kind = Contact::kBox;
         contact.obstacle = static_cast<int>(b);
         contact.link = k;
@@ -135,9 +220,13 @@ Contact FindContact(const Chain& chain, const std::vector<double>& q,
   }
   if (!options.self_collision) return contact;
   for (int i = 0; i < n; ++i) {
-    for (int k = i + 2; k < n; ++k) {
-      if (SegmentSegmentDistance(links.segments[i], links.segments[k]) <
-          2 * radius) {
+    for (int k = i + 1; k < n; ++k) {
+      if (std::abs(links[i].frame - links[k].frame) < 2 ||
+          AlwaysTouching(options, i, k)) {
+        continue;
+      }
+      if (SegmentSegmentDistance(links[i].segment, links[k].segment) <
+          links[i].radius_mm + links[k].radius_mm) {
         contact.kind = Contact::kSelf;
         contact.link = i;
         contact.other_link = k;

@@ -10,6 +10,13 @@
 // DH origins). All capsules share one radius (--link-radius, default 40 mm,
 // a UR10's or Panda's forearm); the last one (the tool up to the tip) too.
 //
+// For a robot given by URDF, plan/link_geometry.h's capsules from the
+// URDF's <collision> geometry replace these (SafetyOptions::links): each with
+// its own radius, carried by its chain frame; the base ones are those
+// carried by the base and joint 1's frame, and two capsules are checked
+// against each other when their frames are at least two apart and they do
+// not touch in every pose (LinkGeometry::always_touching).
+//
 // Rules:
 // - plane: the signed distance of a segment to the plane (its endpoint
 //   nearest the wrong side) must be at least radius + clearance;
@@ -28,6 +35,8 @@
 #include <vector>
 
 #include "calib/chain.h"
+#include "data/robot.h"
+#include "plan/link_geometry.h"
 #include "plan/obstacles.h"
 
 namespace kincal {
@@ -55,7 +64,32 @@ struct SafetyOptions {
   Obstacles obstacles;
   double link_radius_mm = 40;
   bool self_collision = true;
+  // The URDF's collision capsules; empty: the generic capsules above.
+  LinkGeometry links;
 };
+
+// The frames the chain carries links with, in the base frame, for joint
+// values q (internal units): [0] the base (identity), [j + 1] the frame
+// after joint j's motion.
+std::vector<Eigen::Matrix4d> BaseFromLinkFrames(const Chain& chain,
+                                                const std::vector<double>& q);
+
+// One pose's capsules in the base frame.
+struct PlacedCapsule {
+  Segment segment;
+  double radius_mm = 0;
+  int frame = 0;      // capsules of frames at least two apart are checked
+  bool base = false;  // turns about the first axis only
+};
+std::vector<PlacedCapsule> PlaceCapsules(const Chain& chain,
+                                         const std::vector<double>& q,
+                                         const SafetyOptions& options);
+
+// Fills links->always_touching: the pairs of capsules (frames at least two
+// apart) that meet in every one of `samples` random poses inside the
+// robot's limits (a joint without limits: a full turn / +-1 m), seeded.
+void MarkAlwaysTouching(const Chain& chain, const Robot& robot,
+                        LinkGeometry* links, int samples = 100);
 
 // What a pose meets first (kind kNone: nothing).
 struct Contact {
