@@ -7,6 +7,7 @@
 
 #include "calib/evaluate.h"
 #include "data/error.h"
+#include "data/import_ipa.h"
 #include "data/rigid3.h"
 #include "data/robot.h"
 #include "data/urdf.h"
@@ -369,6 +370,49 @@ TEST(CalibrateTest, UnlabelledConcatenationStillRefused) {
   // Labelled, each series is searched on its own: no jump.
   EXPECT_NO_THROW(
       RequireNoFrameJump(t.a.nominal, TwoSeriesCampaign().both, "calibrate"));
+}
+
+// Real data (../shared/data, skipped when absent): the UR10 series A (every
+// 8th grid row) and C (every 2nd random pose), measured with the tracker
+// moved in between. Labelled, each gets its own frame and both are fitted
+// near C's single-series figure (0.50 mm held out); unlabelled, one frame
+// cannot hold both and the rows are refused.
+TEST(CalibrateTest, RealUr10SeriesAAndCWithAFramePerSeries) {
+  KINCAL_REQUIRE_SHARED_DATA("ipa-robot-accuracy");
+  const std::string dir = testing::SharedDataDir() + "/ipa-robot-accuracy/";
+  auto every = [](const Observations& obs, int n, const std::string& name) {
+    std::vector<int> keep;
+    for (int i = 0; i < static_cast<int>(obs.rows.size()); i += n)
+      keep.push_back(i);
+    Observations out = Subset(obs, keep);
+    for (Observation& o : out.rows) {
+      o.series = name;
+      o.pose = name + "-" + o.pose;
+    }
+    return out;
+  };
+  Observations both =
+      every(ReadIpaSeries(dir + "Series_A/measurements_grid.csv").observations,
+            8, "A");
+  const Observations c =
+      every(ReadIpaSeries(dir + "Series_C/measurements_random_poses.csv")
+                .observations,
+            2, "C");
+  for (const Observation& o : c.rows) both.rows.push_back(o);
+  const Robot ur10 =
+      ReadRobotYaml(testing::SourceDir() + "/data/robots/ur10.yaml");
+  const CalibrateResult r = Calibrate(ur10, both, {});
+  ASSERT_EQ(r.state.NumFrames(), 2);
+  EXPECT_LT(r.heldout.rms_mm, 0.6);
+  EXPECT_LT(r.train.rms_mm, 0.6);
+  // The instrument moved: the two frames differ by more than a metre or a
+  // large turn, which is why one frame cannot hold both.
+  const Rigid3 c_from_a = BFromA(r.state.FrameBlock(0), r.state.FrameBlock(1));
+  EXPECT_GT(c_from_a.t.norm() +
+                1000 * (c_from_a.R - Eigen::Matrix3d::Identity()).norm(),
+            100.0);
+  for (Observation& o : both.rows) o.series.clear();
+  EXPECT_THROW(RequireNoFrameJump(ur10, both, "calibrate"), InputError);
 }
 
 }  // namespace
