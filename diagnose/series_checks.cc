@@ -1,6 +1,7 @@
 #include "diagnose/series_checks.h"
 
 #include <Eigen/QR>
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -77,27 +78,31 @@ void TestScales(const std::vector<Measurement>& train, const ModelState& state,
     shared.segment<3>(3 * i) = c;
     if (m.frame > 0) scales.block<3, 1>(3 * i, m.frame - 1) = c;
   }
-  // Column-scaled least squares on [J, scales] and on J alone.
-  Eigen::MatrixXd a(n, p + q);
-  a << jac, scales;
+  // Column-scaled least squares on [J, scales] and on J alone, through the
+  // normal equations (the columns are few against the rows).
+  Eigen::MatrixXd a(n, p + q + 1);
+  a << jac, scales, shared;
   Eigen::VectorXd norms = a.colwise().norm();
   for (int c = 0; c < a.cols(); ++c)
     if (norms(c) > 0) a.col(c) /= norms(c);
-  const Eigen::ColPivHouseholderQR<Eigen::MatrixXd> full(a);
-  const Eigen::VectorXd step = full.solve(-r);
-  const double rss1 = (r + a * step).squaredNorm();
-  const Eigen::ColPivHouseholderQR<Eigen::MatrixXd> base(a.leftCols(p));
-  const double rss0 = (r + a.leftCols(p) * base.solve(-r)).squaredNorm();
-  const int dof = n - full.rank();
+  const Eigen::MatrixXd normal = a.transpose() * a;
+  const Eigen::VectorXd gradient = a.transpose() * r;
+  const Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd> full(
+      normal.topLeftCorner(p + q, p + q));
+  const Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd> base(
+      normal.topLeftCorner(p, p));
+  const Eigen::VectorXd step = full.solve(-gradient.head(p + q));
+  const double rss1 = r.squaredNorm() + gradient.head(p + q).dot(step);
+  const double rss0 =
+      r.squaredNorm() - gradient.head(p).dot(base.solve(gradient.head(p)));
+  const int dof = n - static_cast<int>(full.rank());
   const double s2 = dof > 0 ? rss1 / dof : kNaN;
   out->scale_f = q > 0 && s2 > 0 ? (rss0 - rss1) / q / s2 : 0.0;
   out->scale_p_value =
       q > 0 && dof > 0 ? FDistributionUpperTail(out->scale_f, q, dof) : 1.0;
   out->scale_significant = out->scale_p_value < false_alarm;
-  // Covariance of the scaled solution: s2 (A^T A)^-1 (pseudo-inverse).
-  const Eigen::MatrixXd normal = a.transpose() * a;
-  const Eigen::MatrixXd cov =
-      s2 * normal.completeOrthogonalDecomposition().pseudoInverse();
+  // Covariance of the scaled solution: s2 (A^T A)^+.
+  const Eigen::MatrixXd cov = s2 * full.pseudoInverse();
   for (int k = 0; k < q; ++k) {
     const int c = p + k;
     SeriesCheck& check = out->series[k + 1];
@@ -106,9 +111,11 @@ void TestScales(const std::vector<Measurement>& train, const ModelState& state,
         norms(c) > 0 ? 1e6 * std::sqrt(std::max(0.0, cov(c, c))) / norms(c)
                      : kNaN;
   }
-  const Eigen::VectorXd projected = a.leftCols(p) * base.solve(shared) - shared;
+  // The shared column (unit length after scaling) off the span of J.
+  const Eigen::VectorXd toward = normal.col(p + q).head(p);
+  const double off = 1.0 - toward.dot(base.solve(toward));
   out->shared_scale_sine =
-      shared.norm() > 0 ? projected.norm() / shared.norm() : 0.0;
+      norms(p + q) > 0 ? std::sqrt(std::max(0.0, off)) : 0.0;
 }
 
 }  // namespace
