@@ -11,11 +11,12 @@
 //   - instrument scale: a length scale factor per series relative to the
 //     first (p_in_meas = s_k R_k tip + t_k), tested by one Gauss-Newton
 //     step from the final model with every free parameter refitted and an
-//     F-test. One scale shared by every series is not identifiable when the
-//     robot's lengths are free (scaling every length and the frames'
-//     translations moves no residual): the check measures that as the sine
-//     of the angle between the shared scale's column and the span of the
-//     free parameters' columns.
+//     F-test. One scale shared by every series is not identifiable when
+//     every length of the robot is free and no joint reading is a length
+//     (scaling every length and the frames' translations moves no
+//     residual; a prismatic joint's readings carry the unit): the check
+//     measures it as the sine of the angle between the shared scale's
+//     column and the span of the free parameters' columns.
 
 #include <Eigen/Core>
 #include <string>
