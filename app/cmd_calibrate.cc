@@ -231,7 +231,7 @@ int RunCalibrate(CalibrateArgs args) {
   Warnings warnings = CommandWarnings();
   const Observations obs =
       ReadCheckedObservations(args.obs, nominal, args.robot, &warnings);
-  RequireOneSeries(obs, "calibrate");
+  // Several series: one measuring frame each, the robot shared.
   RequireNoFrameJump(nominal, obs, "calibrate");
   args.options = FitOptions(args);
   Progress progress("kincal calibrate", args.json || obs.rows.size() < 500);

@@ -3,6 +3,7 @@
 //   diagnose clearance  the seed's Section 4 joint motion error test
 //   diagnose compare    per-joint clearance before / after maintenance
 
+#include <cmath>
 #include <cstdio>
 #include <memory>
 #include <sstream>
@@ -32,18 +33,74 @@ std::string FormatJoint(const std::string& joint) {
   return joint.empty() ? "-" : joint;
 }
 
+nlohmann::json Number(double v) {
+  return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json();
+}
+
+// diagnose/series_checks.h as JSON: per series, then the scale test.
+nlohmann::json SeriesJson(const SeriesChecks& c) {
+  nlohmann::json per = nlohmann::json::array();
+  for (const SeriesCheck& s : c.series) {
+    per.push_back({{"name", s.name},
+                   {"train_poses", s.train_poses},
+                   {"heldout_poses", s.heldout_poses},
+                   {"train_rms_mm", Number(s.train_rms_mm)},
+                   {"heldout_rms_mm", Number(s.heldout_rms_mm)},
+                   {"joints_cv_explained", Number(s.joints_cv_explained)},
+                   {"point_cv_explained", Number(s.point_cv_explained)},
+                   {"follows", s.follows},
+                   {"scale_ppm", Number(s.scale_ppm)},
+                   {"scale_sigma_ppm", Number(s.scale_sigma_ppm)}});
+  }
+  return {{"per_series", per},
+          {"scale_f", Number(c.scale_f)},
+          {"scale_p_value", Number(c.scale_p_value)},
+          {"scale_significant", c.scale_significant},
+          {"shared_scale_sine", Number(c.shared_scale_sine)}};
+}
+
+// The per-series lines of the text output (several series only).
+void PrintSeries(const SeriesChecks& c) {
+  if (c.series.empty()) return;
+  std::printf(
+      "  per series (own measuring frame): %-10s %6s %6s %10s %10s %7s %7s "
+      "%-10s %s\n",
+      "series", "train", "held", "train_mm", "held_mm", "joints", "point",
+      "follows", "scale ppm vs first");
+  for (const SeriesCheck& s : c.series) {
+    std::printf("  %35s %-10s %6d %6d %10.4f %10.4f %7.2f %7.2f %-10s", "",
+                s.name.empty() ? "-" : s.name.c_str(), s.train_poses,
+                s.heldout_poses, s.train_rms_mm, s.heldout_rms_mm,
+                s.joints_cv_explained, s.point_cv_explained, s.follows.c_str());
+    if (std::isfinite(s.scale_sigma_ppm)) {
+      std::printf(" %.1f +- %.1f\n", s.scale_ppm, s.scale_sigma_ppm);
+    } else {
+      std::printf(" (reference)\n");
+    }
+  }
+  std::printf(
+      "  instrument scale per series: F %.3g, p %.3g (%s); one scale shared "
+      "by all series: %s (sine %.2g)\n",
+      c.scale_f, c.scale_p_value,
+      c.scale_significant ? "significant" : "not significant",
+      c.shared_scale_sine < 1e-3 ? "not identifiable with the robot's lengths"
+                                 : "identifiable",
+      c.shared_scale_sine);
+}
+
 int RunModel(const ModelArgs& args) {
   const Robot robot = ReadRobot(args.robot, args.root, args.tip);
   Warnings warnings = CommandWarnings();
   const Observations obs =
       ReadCheckedObservations(args.obs, robot, args.robot, &warnings);
-  RequireOneSeries(obs, "diagnose model");
+  // Several series: one measuring frame each, the robot shared.
   RequireNoFrameJump(robot, obs, "diagnose model");
   DiagnoseOptions options = args.options;
   for (const std::string& v : args.validate) {
     options.validation.push_back(
         ReadCheckedObservations(v, robot, args.robot, &warnings));
-    RequireOneSeries(options.validation.back(), "diagnose model --validate");
+    RequireNoFrameJump(robot, options.validation.back(),
+                       "diagnose model --validate");
   }
   Progress progress("kincal diagnose model", args.json);
   progress.Stage("fitting candidate extensions with the geometry, " +
@@ -71,6 +128,7 @@ int RunModel(const ModelArgs& args) {
   }
   if (args.json) {
     nlohmann::json j = DiagnosisJson(r, options);
+    if (!r.series.series.empty()) j["series"] = SeriesJson(r.series);
     if (!args.out.empty()) j["out"] = args.out;
     AddWarnings(warnings, &j);
     PrintJson(j);
@@ -129,6 +187,7 @@ int RunModel(const ModelArgs& args) {
     std::printf("  validation series (frame only): %.4f -> %.4f mm\n",
                 r.nominal_validation_rms_mm, r.final_validation_rms_mm);
   }
+  PrintSeries(r.series);
   if (!args.out.empty()) std::printf("  wrote %s\n", args.out.c_str());
   return 0;
 }

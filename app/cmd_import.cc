@@ -5,6 +5,7 @@
 // and mrcal camera models into rig.yaml (kincal import cameramodel).
 
 #include <cstdio>
+#include <fstream>
 #include <memory>
 #include <sstream>
 
@@ -24,6 +25,8 @@ namespace {
 struct ImportArgs {
   std::string in, dir, out, robot, root, tip;
   int every = 1;
+  std::string series;   // --series: the label of every row ("" = none)
+  bool append = false;  // --append: add the rows to an existing --out
   bool json = false;
 };
 
@@ -34,17 +37,38 @@ std::vector<std::string> JointNames(const ImportArgs& args,
   return ReadRobot(args.robot, args.root, args.tip).JointNames();
 }
 
-Observations EveryNth(const Observations& obs, int every) {
+// Every N-th row, each labelled with `series` when given (spec v3 column
+// `series`: the rows of one measurement campaign).
+Observations EveryNth(const Observations& obs, int every,
+                      const std::string& series) {
   Require(every >= 1, "--every must be >= 1");
   std::vector<int> keep;
   for (int i = 0; i < static_cast<int>(obs.rows.size()); i += every) {
     keep.push_back(i);
   }
-  return Subset(obs, keep);
+  Observations out = Subset(obs, keep);
+  if (series.empty()) return out;
+  for (Observation& o : out.rows) {
+    o.series = series;
+    o.pose = series + "-" + o.pose;  // unique across concatenated series
+  }
+  return out;
 }
 
-int Finish(const ImportArgs& args, const Observations& obs,
-           const std::vector<std::string>& comment) {
+// With --append, the rows of the existing --out first, the new rows after
+// them (columns merged by name).
+int Finish(const ImportArgs& args, const Observations& imported,
+           std::vector<std::string> comment) {
+  Observations obs = imported;
+  if (args.append && std::ifstream(args.out).good()) {
+    obs = ReadObservationsCsv(args.out, imported.joint_names);
+    for (const Observation& o : imported.rows) obs.rows.push_back(o);
+    comment.insert(comment.begin(), "appended to the rows of " + args.out);
+    // Re-parse the result: duplicate pose ids and mixed columns are input
+    // errors of the concatenation.
+    ParseObservationsCsv(FormatObservationsCsv(obs, comment), args.out,
+                         imported.joint_names);
+  }
   WriteFileAtomic(args.out, FormatObservationsCsv(obs, comment));
   if (args.json) {
     PrintJson({{"rows", obs.rows.size()},
@@ -62,7 +86,7 @@ int Finish(const ImportArgs& args, const Observations& obs,
 int RunIpa(const ImportArgs& args) {
   const IpaSeries s =
       ReadIpaSeries(args.in, JointNames(args, IpaUr10JointNames()));
-  const Observations obs = EveryNth(s.observations, args.every);
+  const Observations obs = EveryNth(s.observations, args.every, args.series);
   std::ostringstream c;
   c << "imported from " << args.in
     << " (ipa-robot-accuracy UR10, Landgraf et al. 2021, MIT): joint angles "
@@ -78,8 +102,9 @@ int RunIpa(const ImportArgs& args) {
 }
 
 int RunMukca(const ImportArgs& args) {
-  const Observations obs = EveryNth(
-      ReadMukcaDir(args.dir, JointNames(args, PandaJointNames())), args.every);
+  const Observations obs =
+      EveryNth(ReadMukcaDir(args.dir, JointNames(args, PandaJointNames())),
+               args.every, args.series);
   return Finish(args, obs,
                 {"imported from " + args.dir +
                  " (MUKCa, platonics-delft/kinematics_calibration, MIT): "
@@ -155,6 +180,13 @@ void CommonOptions(CLI::App* sub, ImportArgs* args) {
                   "robot file whose joint names the columns map to (in order)");
   sub->add_option("--every", args->every, "keep every N-th row")
       ->capture_default_str();
+  sub->add_flag("--append", args->append,
+                "add the rows to those of --out when it exists (one file of "
+                "several series: give each its --series label)");
+  sub->add_option("--series", args->series,
+                  "label every row with this series (column `series`: one "
+                  "measuring frame per campaign when files are "
+                  "concatenated)");
   sub->add_flag("--json", args->json, "print one JSON object");
 }
 

@@ -394,7 +394,7 @@ void CalibrateOn(const Observations& obs, const Chain& nominal_chain,
       train.begin(), train.end(),
       [](const Measurement& m) { return m.kind == Measurement::kMeasured; });
   std::vector<ParamInfo> nuisance;  // frame and fixed points
-  if (any_measured) nuisance = FrameParams();
+  if (any_measured) nuisance = AllFrameParams(state);
   for (const ParamInfo& p : PointParams(state)) nuisance.push_back(p);
 
   // Frame / points alone first: a good start for the full fit.
@@ -551,6 +551,8 @@ CalibrateResult Calibrate(const Robot& nominal, const Observations& obs,
   ModelState& state = result.state;
   state.chain = nominal_chain;
   std::vector<Measurement> all = MakeMeasurements(nominal_chain, obs, &state);
+  // One measuring frame per series, the robot shared.
+  AssignSeriesFrames(obs, &all, &state);
   if (all.empty()) {
     throw InputError(obs.source, 0, 0,
                      "no row has a measured tip (x, y, z) or a fixed_point "

@@ -2,7 +2,8 @@
 #define KINCAL_CALIB_CALIBRATE_H_
 
 // The calibration workflow behind `kincal calibrate`: split poses into
-// training and held-out (seeded), register the measuring frame, decide which
+// training and held-out (seeded, within every series), register the
+// measuring frame (one per series, spec v3 column `series`), decide which
 // parameters the training data determine, fit them (bounded by the robot
 // file's +-delta), and report training and held-out error.
 

@@ -7,6 +7,8 @@
 
 #include "calib/evaluate.h"
 #include "data/error.h"
+#include "data/import_ipa.h"
+#include "data/rigid3.h"
 #include "data/robot.h"
 #include "data/urdf.h"
 #include "synth/simulate.h"
@@ -272,6 +274,145 @@ TEST(CalibrateTest, SinglePointLeastSquares) {
   // whole: never determined by fixed points.
   EXPECT_THAT(one.identifiability.UnidentifiableNames(),
               ::testing::Contains("j1.theta"));
+}
+
+// Two campaigns of one robot (BH-7, seed 8's hidden geometry), each with
+// its own hidden measuring frame: series A from the simulation's frame,
+// series B 60 poses of another seed with the instrument moved (rotation
+// vector z + 0.5 rad, 700 mm along x).
+struct TwoSeries {
+  SimulatedSession a, b;
+  Observations both;
+};
+
+TwoSeries TwoSeriesCampaign() {
+  TwoSeries t;
+  t.a = Session(8, 120, 0.02);
+  SimulateOptions so;
+  so.poses = 80;
+  so.seed = 21;
+  so.noise_mm = 0.02;
+  so.sigma_length_mm = 0.0;  // the same robot: a's truth, unchanged
+  so.sigma_angle_deg = 0.0;
+  const auto& f = t.a.meas_from_base;
+  so.meas_from_base =
+      std::array<double, 6>{f[0], f[1], f[2] + 0.5, f[3] + 700, f[4], f[5]};
+  t.b = Simulate(t.a.truth, so);
+  t.both = t.a.observations;
+  for (Observation& o : t.both.rows) o.series = "A";
+  for (Observation o : t.b.observations.rows) {
+    o.pose = "b" + o.pose;
+    o.series = "B";
+    t.both.rows.push_back(o);
+  }
+  return t;
+}
+
+// B's measuring frame seen from A's: invariant to the base transform the
+// frames share with the robot's base row.
+Rigid3 BFromA(const double* a, const double* b) {
+  return Rigid3FromPoseBlock(b) * Rigid3FromPoseBlock(a).Inverse();
+}
+
+// One frame per series, the robot shared: the fit recovers the robot (its
+// predictions of the true tips at the noise level) and both frames (B's
+// seen from A's); the split holds out a share of each series.
+TEST(CalibrateTest, TwoSeriesRecoverTheRobotAndBothFrames) {
+  const TwoSeries t = TwoSeriesCampaign();
+  const CalibrateResult r = Calibrate(t.a.nominal, t.both, {});
+  ASSERT_EQ(r.state.NumFrames(), 2);
+  EXPECT_EQ(r.state.frame_series, (std::vector<std::string>{"A", "B"}));
+  const double floor_mm = std::sqrt(3.0) * 0.02;
+  EXPECT_LT(r.heldout.rms_mm, 1.2 * floor_mm);
+  EXPECT_LT(r.train.rms_mm, 1.2 * floor_mm);
+  int held_a = 0, held_b = 0;
+  for (int row : r.heldout_rows) (row < 120 ? held_a : held_b) += 1;
+  EXPECT_EQ(held_a, 24);  // 20 % of each series
+  EXPECT_EQ(held_b, 16);
+  const Rigid3 fitted = BFromA(r.state.FrameBlock(0), r.state.FrameBlock(1));
+  const Rigid3 truth =
+      BFromA(t.a.meas_from_base.data(), t.b.meas_from_base.data());
+  EXPECT_LT((fitted.t - truth.t).norm(), 0.05);
+  EXPECT_LT((fitted.R - truth.R).norm(), 1e-4);
+  // The robot: the calibrated model's tips against the true ones, each in
+  // its base frame, on B's poses.
+  const Chain fitted_chain = Chain::FromRobot(r.calibrated);
+  const Chain true_chain = Chain::FromRobot(t.a.truth);
+  ModelState scratch;
+  scratch.chain = true_chain;
+  const std::vector<Measurement> ms =
+      MakeMeasurements(true_chain, t.b.observations, &scratch);
+  double worst = 0.0;
+  const Rigid3 base_from_base =
+      Rigid3FromPoseBlock(r.state.FrameBlock(1)).Inverse() *
+      Rigid3FromPoseBlock(t.b.meas_from_base.data());
+  for (const Measurement& m : ms) {
+    const Eigen::Vector3d truth_tip = TipInBase(true_chain, m.input);
+    const Eigen::Vector3d fitted_tip = TipInBase(fitted_chain, m.input);
+    worst = std::max(worst, (base_from_base * truth_tip - fitted_tip).norm());
+  }
+  EXPECT_LT(worst, 0.1);
+}
+
+// The same rows without the `series` label cannot share a frame: calibrate
+// and diagnose model refuse them with the hint to add the column.
+TEST(CalibrateTest, UnlabelledConcatenationStillRefused) {
+  TwoSeries t = TwoSeriesCampaign();
+  for (Observation& o : t.both.rows) o.series.clear();
+  try {
+    RequireNoFrameJump(t.a.nominal, t.both, "calibrate");
+    FAIL() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_THAT(e.what(), ::testing::HasSubstr("add a `series` column"));
+    EXPECT_THAT(e.what(),
+                ::testing::HasSubstr("fits one measuring frame per series"));
+  }
+  // Labelled, each series is searched on its own: no jump.
+  EXPECT_NO_THROW(
+      RequireNoFrameJump(t.a.nominal, TwoSeriesCampaign().both, "calibrate"));
+}
+
+// Real data (../shared/data, skipped when absent): the UR10 series A (every
+// 8th grid row) and C (every 2nd random pose), measured with the tracker
+// moved in between. Labelled, each gets its own frame and both are fitted
+// near C's single-series figure (0.50 mm held out); unlabelled, one frame
+// cannot hold both and the rows are refused.
+TEST(CalibrateTest, RealUr10SeriesAAndCWithAFramePerSeries) {
+  KINCAL_REQUIRE_SHARED_DATA("ipa-robot-accuracy");
+  const std::string dir = testing::SharedDataDir() + "/ipa-robot-accuracy/";
+  auto every = [](const Observations& obs, int n, const std::string& name) {
+    std::vector<int> keep;
+    for (int i = 0; i < static_cast<int>(obs.rows.size()); i += n)
+      keep.push_back(i);
+    Observations out = Subset(obs, keep);
+    for (Observation& o : out.rows) {
+      o.series = name;
+      o.pose = name + "-" + o.pose;
+    }
+    return out;
+  };
+  Observations both =
+      every(ReadIpaSeries(dir + "Series_A/measurements_grid.csv").observations,
+            8, "A");
+  const Observations c =
+      every(ReadIpaSeries(dir + "Series_C/measurements_random_poses.csv")
+                .observations,
+            2, "C");
+  for (const Observation& o : c.rows) both.rows.push_back(o);
+  const Robot ur10 =
+      ReadRobotYaml(testing::SourceDir() + "/data/robots/ur10.yaml");
+  const CalibrateResult r = Calibrate(ur10, both, {});
+  ASSERT_EQ(r.state.NumFrames(), 2);
+  EXPECT_LT(r.heldout.rms_mm, 0.6);
+  EXPECT_LT(r.train.rms_mm, 0.6);
+  // The instrument moved: the two frames differ by more than a metre or a
+  // large turn, which is why one frame cannot hold both.
+  const Rigid3 c_from_a = BFromA(r.state.FrameBlock(0), r.state.FrameBlock(1));
+  EXPECT_GT(c_from_a.t.norm() +
+                1000 * (c_from_a.R - Eigen::Matrix3d::Identity()).norm(),
+            100.0);
+  for (Observation& o : both.rows) o.series.clear();
+  EXPECT_THROW(RequireNoFrameJump(ur10, both, "calibrate"), InputError);
 }
 
 }  // namespace

@@ -198,6 +198,12 @@ FrameJump FindFrameJump(const Robot& robot, const Observations& obs,
 
 void RequireNoFrameJump(const Robot& robot, const Observations& obs,
                         const std::string& command) {
+  const std::vector<std::string> names = obs.SeriesNames();
+  if (names.size() > 1) {  // each series on its own frame
+    for (const std::string& name : names)
+      RequireNoFrameJump(robot, Subset(obs, obs.SeriesRows(name)), command);
+    return;
+  }
   const FrameJump jump = FindFrameJump(robot, obs);
   if (!jump.found) return;
   const Observation& row = obs.rows.at(jump.first_row_after);
@@ -209,8 +215,7 @@ void RequireNoFrameJump(const Robot& robot, const Observations& obs,
      << jump.one_frame_rms_mm << " mm RMS, one frame per block "
      << jump.before_rms_mm << " and " << jump.after_rms_mm
      << " mm; add a `series` column labelling each campaign (`kincal "
-        "evaluate` registers one frame per series; `kincal "
-     << command << "` needs the rows of one series per run)";
+     << command << "` fits one measuring frame per series)";
   throw InputError(obs.source, row.line, 0, os.str());
 }
 

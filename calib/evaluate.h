@@ -97,8 +97,9 @@ FrameJump FindFrameJump(const Robot& robot, const Observations& obs,
                         const FrameJumpOptions& options = {});
 
 // Throws InputError (at the first row of the second block) when
-// FindFrameJump finds a jump: the hint is to add a `series` column.
-// `command` names the refusing command in the message.
+// FindFrameJump finds a jump in the rows of one series (each series
+// searched on its own): the hint is to add a `series` column. `command`
+// names the refusing command in the message.
 void RequireNoFrameJump(const Robot& robot, const Observations& obs,
                         const std::string& command);
 

@@ -128,12 +128,12 @@ struct LinearFrame {
   Eigen::Vector3d t;
 };
 
-LinearFrame MakeLinearFrame(const ModelState& state) {
+LinearFrame MakeLinearFrame(const double* meas_from_base) {
   using Jet3 = ceres::Jet<double, 3>;
   LinearFrame frame;
   Jet3 f[kFrameBlockSize];
   for (int e = 0; e < kFrameBlockSize; ++e)
-    f[e] = e < 3 ? Jet3(state.meas_from_base[e], e) : Jet3(0.0);
+    f[e] = e < 3 ? Jet3(meas_from_base[e], e) : Jet3(0.0);
   for (int c = 0; c < 3; ++c) {
     Vec3<Jet3> unit(Jet3(0.0), Jet3(0.0), Jet3(0.0));
     unit[c] = Jet3(1.0);
@@ -143,8 +143,8 @@ LinearFrame MakeLinearFrame(const ModelState& state) {
       for (int d = 0; d < 3; ++d) frame.dr[d](a, c) = col[a].v[d];
     }
   }
-  frame.t = Eigen::Vector3d(state.meas_from_base[3], state.meas_from_base[4],
-                            state.meas_from_base[5]);
+  frame.t =
+      Eigen::Vector3d(meas_from_base[3], meas_from_base[4], meas_from_base[5]);
   return frame;
 }
 
@@ -353,6 +353,7 @@ struct PoseDerivatives {
   const Chain* chain = nullptr;
   const PoseInput* in = nullptr;
   const LinearFrame* frame = nullptr;
+  int frame_index = 0;  // Measurement::frame
   const JointValues* joints = nullptr;
   const ForwardPass* fwd = nullptr;
   const TipDerivatives* tip = nullptr;
@@ -390,6 +391,7 @@ Eigen::Vector3d JacobianColumn(const PoseDerivatives& d, const ParamInfo& p) {
       return col;
     }
     case ParamKind::kFrame:
+      if (p.block != d.frame_index) break;  // another series' frame
       return p.index < 3 ? Eigen::Vector3d(d.frame->dr[p.index] * d.tilted)
                          : Eigen::Vector3d::Unit(p.index - 3);
     case ParamKind::kPoint:
@@ -414,7 +416,9 @@ void ResidualsAndJacobian(const std::vector<Measurement>& measurements,
   if (J != nullptr) J->setZero(3 * m, k);
   ChainOps ops;
   MakeChainOps(chain, &ops);
-  const LinearFrame frame = MakeLinearFrame(state);
+  std::vector<LinearFrame> frames;
+  for (int f = 0; f < state.NumFrames(); ++f)
+    frames.push_back(MakeLinearFrame(state.FrameBlock(f)));
   const FreeHooks hooks = jacobian ? FindFreeHooks(params) : FreeHooks{};
   JointValues joints;
   ForwardPass fwd;
@@ -423,6 +427,7 @@ void ResidualsAndJacobian(const std::vector<Measurement>& measurements,
     const Measurement& meas = measurements[pose];
     if (meas.kind != Measurement::kMeasured) continue;
     const PoseInput& in = meas.input;
+    const LinearFrame& frame = frames.at(meas.frame);
     ComputeJointValues(chain, in, hooks, &joints);
     RunForwardPass(chain, ops, in, joints, jacobian, &fwd);
     // Drift and mount tilt (calib/chain.h TipInBase), then the frame.
@@ -443,6 +448,7 @@ void ResidualsAndJacobian(const std::vector<Measurement>& measurements,
     d.chain = &chain;
     d.in = &in;
     d.frame = &frame;
+    d.frame_index = meas.frame;
     d.joints = &joints;
     d.fwd = &fwd;
     d.tip = &tip;

@@ -178,7 +178,7 @@ std::vector<double*> BlocksOf(ModelState* s, const Measurement& m) {
   for (auto& e : s->chain.joint_errors) blocks.push_back(e.data());
   blocks.push_back(s->chain.drift.data());
   blocks.push_back(m.kind == Measurement::kMeasured
-                       ? s->meas_from_base.data()
+                       ? s->FrameBlock(m.frame)
                        : s->points_in_base.at(m.point).data());
   return blocks;
 }
@@ -235,10 +235,27 @@ std::vector<Measurement> MakeMeasurements(const Chain& nominal,
   return out;
 }
 
+int AssignSeriesFrames(const Observations& obs,
+                       std::vector<Measurement>* measurements,
+                       ModelState* state) {
+  const std::vector<std::string> names = obs.SeriesNames();
+  if (names.size() < 2) return 1;
+  std::map<std::string, int> frame_of;
+  for (size_t f = 0; f < names.size(); ++f)
+    frame_of[names[f]] = static_cast<int>(f);
+  for (Measurement& m : *measurements) {
+    if (m.kind == Measurement::kMeasured)
+      m.frame = frame_of.at(obs.rows.at(m.row).series);
+  }
+  state->frame_series = names;
+  state->more_frames.resize(names.size() - 1, state->meas_from_base);
+  return static_cast<int>(names.size());
+}
+
 Eigen::Vector3d Residual(const ModelState& state, const Measurement& m) {
   const Eigen::Vector3d tip = TipInBase(state.chain, m.input);
   if (m.kind == Measurement::kMeasured) {
-    return ApplyFrame(state.meas_from_base.data(), Vec3<double>(tip)) -
+    return ApplyFrame(state.FrameBlock(m.frame), Vec3<double>(tip)) -
            m.p_in_meas;
   }
   const auto& p = state.points_in_base.at(m.point);
@@ -525,30 +542,13 @@ Eigen::MatrixXd ResidualJacobian(const std::vector<Measurement>& measurements,
   return jac;
 }
 
-void InitializeFrameAndPoints(const std::vector<Measurement>& measurements,
-                              ModelState* state) {
-  // Fixed points: centroid of the model's tips of each group.
-  std::vector<Eigen::Vector3d> sums(state->points_in_base.size(),
-                                    Eigen::Vector3d::Zero());
-  std::vector<int> counts(state->points_in_base.size(), 0);
-  std::vector<Eigen::Vector3d> src, dst;
-  for (const Measurement& m : measurements) {
-    const Eigen::Vector3d tip = TipInBase(state->chain, m.input);
-    if (m.kind == Measurement::kFixedPoint) {
-      sums[m.point] += tip;
-      counts[m.point] += 1;
-    } else {
-      src.push_back(tip);
-      dst.push_back(m.p_in_meas);
-    }
-  }
-  for (size_t i = 0; i < sums.size(); ++i) {
-    if (counts[i] > 0) {
-      const Eigen::Vector3d c = sums[i] / counts[i];
-      state->points_in_base[i] = {c.x(), c.y(), c.z()};
-    }
-  }
-  if (src.empty()) return;
+namespace {
+
+// The rigid meas_from_base (Umeyama, no scale) carrying `src` (model tips)
+// onto `dst` (measured points); InputError when fewer than 3 or collinear.
+std::array<double, kFrameBlockSize> RegisterRigid(
+    const std::vector<Eigen::Vector3d>& src,
+    const std::vector<Eigen::Vector3d>& dst, const std::string& series) {
   Eigen::Matrix3Xd a(3, src.size()), b(3, dst.size());
   for (size_t i = 0; i < src.size(); ++i) {
     a.col(i) = src[i];
@@ -559,12 +559,56 @@ void InitializeFrameAndPoints(const std::vector<Measurement>& measurements,
   if (src.size() < 3 ||
       svd.singularValues()(1) < 1e-6 * svd.singularValues()(0)) {
     throw InputError(
-        "the measured tip points are fewer than 3 or all on one line: the "
-        "base-to-measuring-frame transform cannot be determined");
+        "the measured tip points" +
+        (series.empty() ? std::string() : " of series '" + series + "'") +
+        " are fewer than 3 or all on one line: the base-to-measuring-frame "
+        "transform cannot be determined");
   }
   const Eigen::Matrix4d meas_from_base = Eigen::umeyama(a, b, false);
-  state->meas_from_base =
-      PoseBlockFromRigid3(Rigid3::FromMatrix(meas_from_base));
+  return PoseBlockFromRigid3(Rigid3::FromMatrix(meas_from_base));
+}
+
+}  // namespace
+
+void InitializeFrameAndPoints(const std::vector<Measurement>& measurements,
+                              ModelState* state) {
+  // Fixed points: centroid of the model's tips of each group.
+  std::vector<Eigen::Vector3d> sums(state->points_in_base.size(),
+                                    Eigen::Vector3d::Zero());
+  std::vector<int> counts(state->points_in_base.size(), 0);
+  // Measured rows per frame: model tips and measured points.
+  std::map<int, std::pair<std::vector<Eigen::Vector3d>,
+                          std::vector<Eigen::Vector3d>>>
+      frames;
+  for (const Measurement& m : measurements) {
+    const Eigen::Vector3d tip = TipInBase(state->chain, m.input);
+    if (m.kind == Measurement::kFixedPoint) {
+      sums[m.point] += tip;
+      counts[m.point] += 1;
+    } else {
+      frames[m.frame].first.push_back(tip);
+      frames[m.frame].second.push_back(m.p_in_meas);
+    }
+  }
+  for (size_t i = 0; i < sums.size(); ++i) {
+    if (counts[i] > 0) {
+      const Eigen::Vector3d c = sums[i] / counts[i];
+      state->points_in_base[i] = {c.x(), c.y(), c.z()};
+    }
+  }
+  if (frames.empty()) return;
+  const int num_frames = frames.rbegin()->first + 1;
+  if (state->NumFrames() < num_frames)
+    state->more_frames.resize(num_frames - 1, state->meas_from_base);
+  for (const auto& [frame, points] : frames) {
+    const std::string series =
+        frame < static_cast<int>(state->frame_series.size())
+            ? state->frame_series[frame]
+            : std::string();
+    const std::array<double, kFrameBlockSize> block =
+        RegisterRigid(points.first, points.second, series);
+    std::copy(block.begin(), block.end(), state->FrameBlock(frame));
+  }
 }
 
 int DistinctPoses(const std::vector<Measurement>& measurements) {

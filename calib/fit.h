@@ -25,6 +25,8 @@ struct Measurement {
   PoseInput input;
   Eigen::Vector3d p_in_meas = Eigen::Vector3d::Zero();  // kMeasured
   int point = -1;  // kFixedPoint: index into ModelState::points_in_base
+  // kMeasured: the measuring frame (ModelState::FrameBlock) of its series.
+  int frame = 0;
 };
 
 // Rows with x,y,z become kMeasured; rows with only a fixed_point label become
@@ -35,8 +37,18 @@ std::vector<Measurement> MakeMeasurements(const Chain& nominal,
                                           const Observations& obs,
                                           ModelState* state);
 
+// One measuring frame per series (spec v3 column `series`) when `obs` has
+// more than one: each measured row of `measurements` (made from `obs`) gets
+// its series' frame index (Observations::SeriesNames order) and `state`
+// that many frames, labelled in state->frame_series. Data of one series are
+// left as they are (frame 0). Returns the number of frames.
+int AssignSeriesFrames(const Observations& obs,
+                       std::vector<Measurement>* measurements,
+                       ModelState* state);
+
 // The model's residual of one measurement (mm), 3 numbers:
-//   kMeasured:   meas_from_base * tip_in_base(q) - p_in_meas
+//   kMeasured:   meas_from_base * tip_in_base(q) - p_in_meas (the frame of
+//                the measurement's series)
 //   kFixedPoint: tip_in_base(q) - point_in_base
 Eigen::Vector3d Residual(const ModelState& state, const Measurement& m);
 
@@ -112,9 +124,11 @@ Eigen::MatrixXd ResidualJacobian(
     const std::vector<PointDistance>& distances = {});
 
 // Registers the measuring frame only (robot held fixed): an Umeyama
-// (rigid, no scale) initial value from the model's tips, refined by Fit.
-// Needs >= 3 measured rows that are not collinear; throws InputError
-// otherwise. Fixed points, if any, are set to their groups' centroids first.
+// (rigid, no scale) initial value from the model's tips, refined by Fit;
+// each frame (Measurement::frame) on its own rows, `state` given as many
+// frames as the measurements use. Needs >= 3 measured rows per frame that
+// are not collinear; throws InputError otherwise. Fixed points, if any, are set
+// to their groups' centroids first.
 void InitializeFrameAndPoints(const std::vector<Measurement>& measurements,
                               ModelState* state);
 

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
+#include <utility>
 
 namespace kincal {
 
@@ -41,17 +42,20 @@ HoldoutSplit HoldOutFold(const std::vector<int>& indices, int folds, int fold,
 
 HoldoutSplit SplitHoldout(const std::vector<Measurement>& measurements,
                           double fraction, uint64_t seed) {
-  std::map<int, std::vector<int>> groups;  // -1 = measured points
+  // (0, frame): the measured points of one series' frame; (1, point): the
+  // rows at one fixed point.
+  std::map<std::pair<int, int>, std::vector<int>> groups;
   for (size_t i = 0; i < measurements.size(); ++i) {
     const Measurement& m = measurements[i];
-    groups[m.kind == Measurement::kMeasured ? -1 : m.point].push_back(
+    const bool measured = m.kind == Measurement::kMeasured;
+    groups[{measured ? 0 : 1, measured ? m.frame : m.point}].push_back(
         static_cast<int>(i));
   }
   std::mt19937_64 rng(seed);
   HoldoutSplit split;
   for (const auto& group : groups) {
     const int n = static_cast<int>(group.second.size());
-    const int min_train = group.first < 0 ? 10 : 3;
+    const int min_train = group.first.first == 0 ? 10 : 3;
     const int hold =
         std::min(static_cast<int>(std::lround(fraction * n)), n - min_train);
     const HoldoutSplit part = HoldOutFirst(group.second, hold, &rng);

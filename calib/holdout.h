@@ -34,8 +34,9 @@ HoldoutSplit HoldOutFold(const std::vector<int>& indices, int folds, int fold,
                          uint64_t seed);
 
 // Measurement indices split into training and held-out, seeded (one
-// std::mt19937_64(seed) stream over the groups): measured points form one
-// group, each fixed point a group of its own; each group holds out
+// std::mt19937_64(seed) stream over the groups): the measured points of
+// each series' frame (Measurement::frame) form one group, stratifying the
+// split by series, each fixed point a group of its own; each group holds out
 // round(fraction x its size) but keeps at least 10 (measured) or 3 (fixed
 // point) training poses.
 HoldoutSplit SplitHoldout(const std::vector<Measurement>& measurements,

@@ -64,7 +64,7 @@ double* ParamAddress(ModelState* s, const ParamInfo& p) {
     case ParamKind::kDrift:
       return &s->chain.drift.at(p.index);
     case ParamKind::kFrame:
-      return &s->meas_from_base.at(p.index);
+      return s->FrameBlock(p.block) + p.index;
     case ParamKind::kPoint:
       return &s->points_in_base.at(p.block).at(p.index);
   }
@@ -118,6 +118,23 @@ std::vector<ParamInfo> FrameParams() {
           {"frame.z", ParamKind::kFrame, 0, 5, false}};
 }
 
+std::vector<ParamInfo> AllFrameParams(const ModelState& state) {
+  if (state.NumFrames() == 1) return FrameParams();
+  std::vector<ParamInfo> out;
+  for (int f = 0; f < state.NumFrames(); ++f) {
+    std::string label = f < static_cast<int>(state.frame_series.size())
+                            ? state.frame_series[f]
+                            : std::to_string(f);
+    if (label.empty()) label = "unlabelled";
+    for (ParamInfo p : FrameParams()) {
+      p.name = "frame." + label + p.name.substr(5);
+      p.block = f;
+      out.push_back(p);
+    }
+  }
+  return out;
+}
+
 std::vector<ParamInfo> PointParams(const ModelState& state) {
   std::vector<ParamInfo> out;
   for (int i = 0; i < static_cast<int>(state.point_labels.size()); ++i) {
@@ -152,7 +169,7 @@ std::vector<ParamInfo> MountParams() {
 
 ParamInfo FindParam(const ModelState& state, const std::string& name) {
   std::vector<ParamInfo> all = GeometryParams(state.chain);
-  for (const auto& p : FrameParams()) all.push_back(p);
+  for (const auto& p : AllFrameParams(state)) all.push_back(p);
   for (const auto& p : PointParams(state)) all.push_back(p);
   for (const auto& p : DriftParams()) all.push_back(p);
   for (const auto& p : MountParams()) all.push_back(p);

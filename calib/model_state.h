@@ -18,12 +18,29 @@ namespace kincal {
 struct ModelState {
   Chain chain;
   // meas_from_base: [rx, ry, rz] angle-axis (rad), [tx, ty, tz] (mm).
+  // The measuring frame of frame 0 (every row, for data of one series).
   std::array<double, kFrameBlockSize> meas_from_base{};
+  // Frames 1.. (data of several series, spec v3 column `series`: one
+  // measuring frame per series, the robot shared), same layout.
+  std::vector<std::array<double, kFrameBlockSize>> more_frames;
+  // The series label of each frame (frame_series[i] for frame i); empty for
+  // data of one series.
+  std::vector<std::string> frame_series;
   // Fixed points (the seed's single-point experiment), in the base frame.
   std::vector<std::string> point_labels;
   std::vector<std::array<double, 3>> points_in_base;
 
   int PointIndex(const std::string& label) const;  // -1 when absent
+  // Frames: 1 + more_frames.size(); frame i's block (0: meas_from_base).
+  int NumFrames() const { return 1 + static_cast<int>(more_frames.size()); }
+  double* FrameBlock(int frame) {
+    return frame == 0 ? meas_from_base.data()
+                      : more_frames.at(frame - 1).data();
+  }
+  const double* FrameBlock(int frame) const {
+    return frame == 0 ? meas_from_base.data()
+                      : more_frames.at(frame - 1).data();
+  }
 };
 
 enum class ParamKind { kRow, kJointError, kDrift, kFrame, kPoint };
@@ -57,7 +74,11 @@ ParamInfo AxisTiltParam(const Chain& chain, int row);
 // Rows whose next axis is nominally parallel (|alpha| < 1e-6, not urdf): the
 // rows where a beta is meaningful.
 std::vector<int> ParallelAxisRows(const Chain& chain);
+// Frame 0's parameters: frame.rx, .ry, .rz, .x, .y, .z.
 std::vector<ParamInfo> FrameParams();
+// Every frame's parameters (block = frame index): FrameParams() for one
+// frame; with several, frame.<series>.rx, ... named by state.frame_series.
+std::vector<ParamInfo> AllFrameParams(const ModelState& state);
 std::vector<ParamInfo> PointParams(const ModelState& state);
 // Joint error model parameters (index: JointErrorIndex) and drift.
 ParamInfo JointErrorParam(const Chain& chain, int joint, int index);

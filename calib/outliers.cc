@@ -3,6 +3,7 @@
 #include <Eigen/SVD>
 #include <algorithm>
 #include <map>
+#include <set>
 
 namespace kincal {
 
@@ -58,17 +59,20 @@ bool CanExclude(const std::vector<Measurement>& ms,
 
 namespace {
 
-// Weighted least-squares registration of fixed tips: meas_from_base for
-// the measured rows, a position per fixed point; returns every row's error.
-std::vector<double> RegisterTips(const std::vector<Measurement>& ms,
-                                 const std::vector<Eigen::Vector3d>& tips,
-                                 const std::vector<double>& w, int num_points) {
-  // Measured rows: weighted Kabsch (rotation and translation, no scale).
+// Weighted Kabsch (rotation and translation, no scale) of the measured rows
+// of one frame (Measurement::frame): their error under it, into `errors`.
+void RegisterFrame(const std::vector<Measurement>& ms,
+                   const std::vector<Eigen::Vector3d>& tips,
+                   const std::vector<double>& w, int frame,
+                   std::vector<double>* errors) {
+  auto in_frame = [&](size_t i) {
+    return ms[i].kind == Measurement::kMeasured && ms[i].frame == frame;
+  };
   double sw = 0.0;
   Eigen::Vector3d tip_mean = Eigen::Vector3d::Zero();
   Eigen::Vector3d meas_mean = Eigen::Vector3d::Zero();
   for (size_t i = 0; i < ms.size(); ++i) {
-    if (ms[i].kind != Measurement::kMeasured || w[i] <= 0) continue;
+    if (!in_frame(i) || w[i] <= 0) continue;
     sw += w[i];
     tip_mean += w[i] * tips[i];
     meas_mean += w[i] * ms[i].p_in_meas;
@@ -80,7 +84,7 @@ std::vector<double> RegisterTips(const std::vector<Measurement>& ms,
     meas_mean /= sw;
     Eigen::Matrix3d h = Eigen::Matrix3d::Zero();
     for (size_t i = 0; i < ms.size(); ++i) {
-      if (ms[i].kind != Measurement::kMeasured || w[i] <= 0) continue;
+      if (!in_frame(i) || w[i] <= 0) continue;
       h += w[i] * (tips[i] - tip_mean) *
            (ms[i].p_in_meas - meas_mean).transpose();
     }
@@ -93,6 +97,24 @@ std::vector<double> RegisterTips(const std::vector<Measurement>& ms,
     rotation = svd.matrixV() * d * svd.matrixU().transpose();
     translation = meas_mean - rotation * tip_mean;
   }
+  for (size_t i = 0; i < ms.size(); ++i) {
+    if (in_frame(i))
+      (*errors)[i] =
+          (rotation * tips[i] + translation - ms[i].p_in_meas).norm();
+  }
+}
+
+// Weighted least-squares registration of fixed tips: meas_from_base for
+// the measured rows (one per frame), a position per fixed point; returns
+// every row's error.
+std::vector<double> RegisterTips(const std::vector<Measurement>& ms,
+                                 const std::vector<Eigen::Vector3d>& tips,
+                                 const std::vector<double>& w, int num_points) {
+  std::vector<double> errors(ms.size(), 0.0);
+  std::set<int> frames;
+  for (const Measurement& m : ms)
+    if (m.kind == Measurement::kMeasured) frames.insert(m.frame);
+  for (int frame : frames) RegisterFrame(ms, tips, w, frame, &errors);
   // Fixed points: the weighted mean of their tips.
   std::vector<Eigen::Vector3d> points(num_points, Eigen::Vector3d::Zero());
   std::vector<double> point_w(num_points, 0.0);
@@ -103,12 +125,9 @@ std::vector<double> RegisterTips(const std::vector<Measurement>& ms,
   }
   for (int k = 0; k < num_points; ++k)
     if (point_w[k] > 0) points[k] /= point_w[k];
-  std::vector<double> errors(ms.size(), 0.0);
   for (size_t i = 0; i < ms.size(); ++i) {
-    errors[i] =
-        ms[i].kind == Measurement::kMeasured
-            ? (rotation * tips[i] + translation - ms[i].p_in_meas).norm()
-            : (tips[i] - points[ms[i].point]).norm();
+    if (ms[i].kind == Measurement::kFixedPoint)
+      errors[i] = (tips[i] - points[ms[i].point]).norm();
   }
   return errors;
 }

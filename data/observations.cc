@@ -79,7 +79,8 @@ void RequireOneSeries(const Observations& obs, const std::string& command) {
           "measuring frame; `kincal " + command +
           "` fits one frame and needs the rows of one series per run (e.g. "
           "keep one series' rows), while `kincal evaluate` registers one "
-          "frame per series");
+          "frame per series and `kincal calibrate` and `kincal diagnose "
+          "model` fit one frame per series with the robot shared");
 }
 
 namespace {

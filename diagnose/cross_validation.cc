@@ -57,14 +57,15 @@ FoldPlan MakeFolds(const std::vector<Measurement>& ms, int folds,
   FoldPlan plan;
   plan.folds = folds;
   plan.fold_of.assign(ms.size(), 0);
-  // Groups of identical joint readings, in order of first appearance.
-  std::map<std::vector<double>, int> group_of;
+  // Groups of identical joint readings within one series' frame, in order
+  // of first appearance.
+  std::map<std::pair<int, std::vector<double>>, int> group_of;
   std::vector<std::vector<int>> groups;
   for (size_t i = 0; i < ms.size(); ++i) {
-    auto it = group_of.find(ms[i].input.q);
+    const std::pair<int, std::vector<double>> key(ms[i].frame, ms[i].input.q);
+    auto it = group_of.find(key);
     if (it == group_of.end()) {
-      it = group_of.emplace(ms[i].input.q, static_cast<int>(groups.size()))
-               .first;
+      it = group_of.emplace(key, static_cast<int>(groups.size())).first;
       groups.emplace_back();
     }
     groups[it->second].push_back(static_cast<int>(i));
@@ -76,10 +77,13 @@ FoldPlan MakeFolds(const std::vector<Measurement>& ms, int folds,
   // split's shuffle (calib/holdout.h SplitHoldout uses `seed`).
   std::mt19937_64 rng(seed ^ 0x9e3779b97f4a7c15ULL);
   const std::vector<int> order = ShuffledIndices(groups_in_order, &rng);
-  // Each group to the fold with the fewest poses so far (lowest index on
-  // ties): round robin when every pose is distinct.
-  std::vector<int> size(folds, 0);
+  // Each group to the fold with the fewest poses of its series so far
+  // (lowest index on ties): round robin when every pose is distinct, and
+  // every series spread over the folds (stratified).
+  std::map<int, std::vector<int>> size_of_frame;
   for (int g : order) {
+    std::vector<int>& size = size_of_frame[ms[groups[g][0]].frame];
+    size.resize(folds, 0);
     const int f = static_cast<int>(std::min_element(size.begin(), size.end()) -
                                    size.begin());
     for (int i : groups[g]) plan.fold_of[i] = f;

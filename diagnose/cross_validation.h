@@ -37,9 +37,10 @@ struct FoldPlan {
   std::vector<int> fold_of;  // per measurement, in [0, folds)
 };
 
-// Seeded assignment of `ms` to `folds` folds of (nearly) equal size; groups
-// of identical joint readings stay together. Requires 2 <= folds <=
-// DistinctPoses(ms) (callers check and say so).
+// Seeded assignment of `ms` to `folds` folds of (nearly) equal size, each
+// series' frame (Measurement::frame) spread evenly over them; groups of
+// identical joint readings (within a series) stay together. Requires 2 <= folds
+// <= DistinctPoses(ms) (callers check and say so).
 FoldPlan MakeFolds(const std::vector<Measurement>& ms, int folds,
                    uint64_t seed);
 

@@ -106,7 +106,7 @@ void FitBase(const std::vector<Measurement>& fit_on, const Observations& obs,
   for (const Measurement& m : fit_on) {
     any_measured = any_measured || m.kind == Measurement::kMeasured;
   }
-  if (any_measured) nuisance = FrameParams();
+  if (any_measured) nuisance = AllFrameParams(state);
   for (const ParamInfo& p : PointParams(state)) nuisance.push_back(p);
   FitOptions frame_only;
   frame_only.free = nuisance;
@@ -169,6 +169,7 @@ std::vector<Measurement> Measurements(const Chain& nominal,
                                       const Observations& obs,
                                       ModelState* state) {
   std::vector<Measurement> all = MakeMeasurements(nominal, obs, state);
+  AssignSeriesFrames(obs, &all, state);  // one measuring frame per series
   std::vector<Measurement> measured;
   for (const Measurement& m : all) {
     if (m.kind == Measurement::kMeasured) measured.push_back(m);
@@ -213,8 +214,11 @@ SmoothInputs MakeSmoothInputs(const Observations& obs,
   };
   for (const Measurement& m : train) in.train.push_back(row(m));
   for (const Measurement& m : held) in.held.push_back(row(m));
+  // Measured points of one series only: those of several series lie in
+  // different measuring frames (the test runs per series instead).
   bool points = true;
-  for (const Measurement& m : train) points &= obs.rows[m.row].has_point;
+  for (const Measurement& m : train)
+    points &= obs.rows[m.row].has_point && m.frame == 0;
   if (points) {
     for (const Measurement& m : train) {
       in.point_train.push_back(obs.rows[m.row].p_in_meas);
@@ -238,22 +242,25 @@ double ValidationRms(const ModelState& state,
                      const std::vector<Measurement>& validation) {
   if (validation.empty()) return kNaN;
   ModelState s = state;
+  s.more_frames.clear();
+  s.frame_series.clear();
   InitializeFrameAndPoints(validation, &s);
   return Rms(s, validation);
 }
 
 // The same with the exact-Jacobian fit (calib/free_fit.h) of the frame,
 // started from `frame` (the current model's registered frame on the
-// validation series) instead of Umeyama: same problem, calib/fit.h's
+// validation series, one per series) instead of Umeyama: same problem, calib/fit.h's
 // tolerances.
-double ValidationRmsFrom(const ModelState& state,
-                         const std::array<double, kFrameBlockSize>& frame,
+double ValidationRmsFrom(const ModelState& state, const ModelState& frames,
                          const std::vector<Measurement>& validation) {
   if (validation.empty()) return kNaN;
   ModelState s = state;
-  s.meas_from_base = frame;
+  s.meas_from_base = frames.meas_from_base;
+  s.more_frames = frames.more_frames;
+  s.frame_series = frames.frame_series;
   FreeFitOptions o;
-  o.free = FrameParams();
+  o.free = AllFrameParams(s);
   o.max_iterations = 200;
   o.function_tolerance = o.parameter_tolerance = 1e-12;
   const double rss = FreeFit(validation, o, &s);
@@ -344,10 +351,14 @@ int FoldCount(const Problem& problem, const Observations& obs,
 std::vector<Measurement> ValidationMeasurements(
     const Chain& nominal, const DiagnoseOptions& options) {
   std::vector<Measurement> validation;
+  int frames = 0;  // one measuring frame per series of each file
   for (const Observations& v : options.validation) {
     ModelState scratch = StateWithChain(nominal);
-    for (const Measurement& m : Measurements(nominal, v, &scratch))
+    for (Measurement m : Measurements(nominal, v, &scratch)) {
+      m.frame += frames;
       validation.push_back(m);
+    }
+    frames += scratch.NumFrames();
   }
   return validation;
 }
@@ -419,9 +430,9 @@ CurrentModel BaseModel(const Selection& selection, DiagnosisResult* out) {
 // exact_jacobian.h), and the normal equations the candidates' Gauss-Newton
 // starts share.
 struct StepLinearization {
-  // The current model's measuring frame on the validation series: the
-  // start of every candidate's re-registration.
-  std::array<double, kFrameBlockSize> validation_frame{};
+  // The current model's measuring frames on the validation series (one per
+  // series): the start of every candidate's re-registration.
+  ModelState validation_frames;
   Eigen::VectorXd r0;                    // training residuals
   Eigen::MatrixXd cand_jac;              // columns of every candidate parameter
   std::map<std::string, int> column_of;  // a parameter's column, by name
@@ -453,9 +464,10 @@ StepLinearization Linearize(const Selection& selection,
   const Problem& problem = selection.problem;
   StepLinearization lin;
   if (!selection.validation.empty()) {
-    ModelState v = current.state;
-    InitializeFrameAndPoints(selection.validation, &v);
-    lin.validation_frame = v.meas_from_base;
+    lin.validation_frames = current.state;
+    lin.validation_frames.more_frames.clear();
+    lin.validation_frames.frame_series.clear();
+    InitializeFrameAndPoints(selection.validation, &lin.validation_frames);
   }
   Eigen::MatrixXd base_jac;
   ResidualsAndJacobian(problem.train, current.state, current.free, &lin.r0,
@@ -610,7 +622,7 @@ CandidateFit ScreenCandidate(const Selection& selection,
           ? s.cv_rms_mm < current.cv_rms_mm && s.cv_z > options.cv_min_z
           : problem.held.empty() || s.heldout_rms_mm < current.heldout_rms_mm;
   s.validation_rms_mm =
-      ValidationRmsFrom(fit.state, lin.validation_frame, selection.validation);
+      ValidationRmsFrom(fit.state, lin.validation_frames, selection.validation);
   const bool validation_better =
       selection.validation.empty() ||
       s.validation_rms_mm < current.validation_rms_mm;
@@ -948,6 +960,9 @@ DiagnosisResult DiagnoseModel(const Robot& nominal, const Observations& obs,
   UnexplainedRest(selection, current, &out);
   out.verdict = out.findings.empty() ? "no_significant_effect" : "effect_found";
   PerPoseResiduals(problem, final_state, &out);
+  if (current.state.NumFrames() > 1)
+    out.series = CheckSeries(obs, problem.train, problem.held, current.state,
+                             current.free, options.false_alarm);
   out.state = final_state;
   FitRecordInput record;
   record.obs = &obs;

@@ -44,6 +44,7 @@
 #include "data/robot.h"
 #include "data/warnings.h"
 #include "diagnose/catalogue.h"
+#include "diagnose/series_checks.h"
 #include "diagnose/statistics.h"
 
 namespace kincal {
@@ -186,6 +187,10 @@ struct DiagnosisResult {
   // travel, diagnose/travel_gaps.h).
   std::vector<Warning> warnings;
   ModelState state;  // final model (all poses)
+  // Several series (spec v3 column `series`, one measuring frame each): per
+  // series figures, robot or instrument, instrument scale
+  // (diagnose/series_checks.h); empty for one series.
+  SeriesChecks series;
   double seconds = 0.0;
 };
 
