@@ -28,8 +28,10 @@ namespace {
 struct CamcalArgs {
   std::string left, right, target, out;
   int distortion = 5;
-  std::string loss = "huber";
+  std::string loss = "none";
   double loss_scale_px = 3.0;
+  // Outlier rejection threshold (CalibrationOptions::reject_sigma; 0 = off).
+  double reject_sigma = CalibrationOptions().reject_sigma;
   // Distortion regulariser weight (CalibrationOptions::regularization).
   double regularization = CalibrationOptions().regularization;
   // Projection uncertainty: distance (target units; 0 = infinity) and the
@@ -72,6 +74,11 @@ CalibrationOptions ResolveOptions(const CamcalArgs& args) {
                      ": expected a weight >= 0 (0 = none)");
   }
   options.regularization = args.regularization;
+  if (args.reject_sigma < 0) {
+    throw InputError("--reject-sigma " + std::to_string(args.reject_sigma) +
+                     ": expected a threshold >= 0 (0 = no rejection)");
+  }
+  options.reject_sigma = args.reject_sigma;
   if (args.loss == "huber") {
     options.loss = CalibrationOptions::Loss::kHuber;
   } else if (args.loss == "cauchy") {
@@ -209,7 +216,11 @@ nlohmann::json CameraJson(const CalibrationSummary& sum, size_t c) {
       {"opencv_rms_px", cs.opencv_rms_px},
       {"views_used", cs.num_views},
       {"points", cs.num_points},
+      {"rejected_corners", cs.rejected_corners},
+      {"rejected_views", cs.rejected_views},
       {"holdout_rms_px", Nullable(cs.holdout_rms_px)},
+      {"half_diff_focus_radius_px", Nullable(cs.half_diff_focus_radius_px)},
+      {"half_diff_focus_rms_px", Nullable(cs.half_diff_focus_rms_px)},
       {"half_diff_rms_px", Nullable(cs.half_diff_rms_px)},
       {"half_diff_max_px", Nullable(cs.half_diff_max_px)},
       {"cam_from_rig", PoseJson(sum.rig.cameras[c].cam_from_rig)}};
@@ -267,6 +278,23 @@ void WriteCameraModels(const CamcalArgs& args, const CalibrationSummary& sum) {
   }
 }
 
+// The outlier rejection's settings and outcome over all cameras.
+nlohmann::json OutlierRejectionJson(const CamcalArgs& args,
+                                    const CalibrationSummary& sum) {
+  int corners = 0, views = 0;
+  for (const CameraCalibrationSummary& cs : sum.cameras) {
+    corners += cs.rejected_corners;
+    views += cs.rejected_views;
+  }
+  return {{"reject_sigma", args.reject_sigma},
+          {"trigger_sigma",
+           args.reject_sigma * CalibrationOptions().reject_trigger},
+          {"rounds", sum.rejection_rounds},
+          {"sigma_px", Nullable(sum.rejection_sigma_px)},
+          {"corners", corners},
+          {"views", views}};
+}
+
 nlohmann::json SummaryJson(const CamcalArgs& args, const CalibTargetSpec& spec,
                            const CalibrationProblem& problem,
                            const std::vector<std::vector<std::string>>& files,
@@ -292,6 +320,7 @@ nlohmann::json SummaryJson(const CamcalArgs& args, const CalibTargetSpec& spec,
                          {"cost", sum.regularization_cost},
                          {"share", sum.regularization_share}};
   j["residual_sigma_px"] = sum.residual_sigma_px;
+  j["outlier_rejection"] = OutlierRejectionJson(args, sum);
   j["seconds"] = sum.seconds;
   if (!sum.covariance_note.empty()) j["covariance_note"] = sum.covariance_note;
   nlohmann::json cams = nlohmann::json::array();
@@ -347,10 +376,17 @@ void PrintSummary(const CamcalArgs& args, const CalibTargetSpec& spec,
         "%.3f px, %d outliers\n",
         cs.num_views, cs.num_points, cs.rms_px, cs.opencv_rms_px, cs.max_px,
         cs.outliers);
+    if (options.reject_sigma > 0) {
+      std::printf(
+          "    outlier rejection (%g sigma): %d corners, %d views dropped\n",
+          options.reject_sigma, cs.rejected_corners, cs.rejected_views);
+    }
     std::printf(
-        "    cross-validation: held-out RMS %.4f px, even/odd "
-        "projection difference RMS %.3f px (max %.3f)\n",
-        cs.holdout_rms_px, cs.half_diff_rms_px, cs.half_diff_max_px);
+        "    cross-validation: held-out RMS %.4f px (inliers), even/odd "
+        "projection difference RMS %.3f px within %.0f px of the centre, "
+        "%.3f px over the image (max %.3f)\n",
+        cs.holdout_rms_px, cs.half_diff_focus_rms_px,
+        cs.half_diff_focus_radius_px, cs.half_diff_rms_px, cs.half_diff_max_px);
     double worst = 0;
     size_t worst_v = 0;
     for (size_t v = 0; v < cs.view_rms_px.size(); ++v) {
@@ -429,7 +465,11 @@ void AddCamcalCommand(CLI::App& app, Runner* run) {
                   "distortion regulariser weight, mrcal-style (default "
                   "0.005; 0 = none)");
   sub->add_option("--loss", args->loss,
-                  "robust loss: huber (default), cauchy or none");
+                  "loss on each corner: none (default, least squares on the "
+                  "inliers), huber or cauchy");
+  sub->add_option("--reject-sigma", args->reject_sigma,
+                  "outlier rejection: drop corners beyond this many sigma "
+                  "of the residuals, mrcal-style (default 3; 0 = none)");
   sub->add_option("--loss-scale", args->loss_scale_px,
                   "robust loss scale, px (default 3)");
   sub->add_option("--uncertainty-distance", args->uncertainty_distance,

@@ -113,7 +113,9 @@ TEST(CalibrateCameras, SyntheticStereoRecoversRigWithinSigma) {
     }
     EXPECT_EQ(cs.sigma[kK4], 0.0);  // not in the model
     EXPECT_EQ(cs.num_views, 16);
-    EXPECT_EQ(cs.num_points, 16 * 70);
+    // 3-sigma rejection takes a few Gaussian corners (~0.5 %), no more.
+    EXPECT_EQ(cs.num_points + cs.rejected_corners, 16 * 70);
+    EXPECT_LE(cs.rejected_corners, 16 * 70 / 100);
     // Held-out reprojection: noise plus a little for the fitted pose.
     EXPECT_GT(cs.holdout_rms_px, 0.9 * noise_px * std::sqrt(2.0) * 0.9);
     EXPECT_LT(cs.holdout_rms_px, 1.3 * noise_px * std::sqrt(2.0));
@@ -168,6 +170,7 @@ TEST(CalibrateCameras, ProjectionUncertaintyMatchesMonteCarlo) {
   fast.cross_validate = false;
   fast.compute_covariance = false;
   fast.loss = CalibrationOptions::Loss::kTrivial;
+  fast.reject_sigma = 0;  // plain least squares, as the prediction
   const std::vector<Rigid3> truth_poses =
       CalibrateCameras(base.problem, fast).rig_from_target;
   std::mt19937_64 rng(5);
@@ -238,6 +241,8 @@ TEST(CalibrateCameras, RobustLossResistsOutliers) {
   ASSERT_GT(corrupted, 2);
   CalibrationOptions options;
   options.cross_validate = false;
+  options.reject_sigma = 0;  // the loss alone
+  options.loss = CalibrationOptions::Loss::kHuber;
   const CalibrationSummary robust = CalibrateCameras(syn.problem, options);
   options.loss = CalibrationOptions::Loss::kTrivial;
   const CalibrationSummary plain = CalibrateCameras(syn.problem, options);
@@ -260,6 +265,84 @@ TEST(CalibrateCameras, RobustLossResistsOutliers) {
   EXPECT_GT(std::abs(plain.rig.cameras[0].intrinsics.fx - truth_fx),
             10 * std::abs(robust.rig.cameras[0].intrinsics.fx - truth_fx));
   EXPECT_GE(robust.cameras[0].outliers, corrupted);
+}
+
+// The default (least squares with 3-sigma outlier rejection) finds every
+// corrupted corner (and a few Gaussian ones, as on clean data) and lands
+// where the clean data does.
+TEST(CalibrateCameras, OutlierRejectionFindsTheCorruptedCorners) {
+  Synthetic syn = MakeSynthetic(1, 10, 0.2, 11);
+  CalibrationOptions options;
+  options.cross_validate = false;
+  const CalibrationSummary clean = CalibrateCameras(syn.problem, options);
+  const int points =
+      clean.cameras[0].num_points + clean.cameras[0].rejected_corners;
+  EXPECT_LE(clean.cameras[0].rejected_corners, points / 100);
+  std::mt19937_64 rng(3);
+  int corrupted = 0;
+  std::vector<Eigen::Vector2d> corrupted_pixels;
+  for (CalibrationView& v : syn.problem.views) {
+    for (Eigen::Vector2d& px : v.observations[0].pixels) {
+      if (rng() % 100 == 0) {
+        px += Eigen::Vector2d(30, -20);
+        corrupted_pixels.push_back(px);
+        ++corrupted;
+      }
+    }
+  }
+  ASSERT_GT(corrupted, 2);
+  const CalibrationSummary sum = CalibrateCameras(syn.problem, options);
+  // No corrupted corner is left among the inliers.
+  int corrupted_kept = 0;
+  for (const CalibrationView& view : sum.inlier_views) {
+    for (const Eigen::Vector2d& px : view.observations[0].pixels) {
+      for (const Eigen::Vector2d& bad : corrupted_pixels) {
+        corrupted_kept += (px - bad).norm() < 1e-12;
+      }
+    }
+  }
+  EXPECT_EQ(corrupted_kept, 0);
+  EXPECT_GE(sum.cameras[0].rejected_corners, corrupted);
+  EXPECT_LE(sum.cameras[0].rejected_corners, corrupted + points / 100);
+  EXPECT_EQ(sum.cameras[0].rejected_views, 0);
+  EXPECT_GE(sum.rejection_rounds, 1);
+  EXPECT_NEAR(sum.rejection_sigma_px, 0.2, 0.03);
+  // The corrupted corners are gone: the clean data's solution within a
+  // fraction of sigma.
+  EXPECT_NEAR(sum.rig.cameras[0].intrinsics.fx,
+              clean.rig.cameras[0].intrinsics.fx,
+              0.5 * sum.cameras[0].sigma[kFx]);
+  EXPECT_LT(std::abs(sum.rig.cameras[0].intrinsics.fx -
+                     syn.truth.cameras[0].intrinsics.fx),
+            3 * sum.cameras[0].sigma[kFx]);
+  // Without rejection least squares is pulled far off.
+  options.reject_sigma = 0;
+  const CalibrationSummary plain = CalibrateCameras(syn.problem, options);
+  EXPECT_GT(std::abs(plain.rig.cameras[0].intrinsics.fx -
+                     syn.truth.cameras[0].intrinsics.fx),
+            10 * sum.cameras[0].sigma[kFx]);
+}
+
+// A board found in the wrong place (most of its corners far off) is dropped
+// whole rather than corner by corner.
+TEST(CalibrateCameras, OutlierRejectionDropsAMisdetectedView) {
+  Synthetic syn = MakeSynthetic(1, 10, 0.2, 11);
+  CalibrationOptions options;
+  options.cross_validate = false;
+  const CalibrationSummary clean = CalibrateCameras(syn.problem, options);
+  std::mt19937_64 rng(5);
+  std::uniform_real_distribution<double> shift(-15, 15);
+  for (Eigen::Vector2d& px : syn.problem.views[4].observations[0].pixels) {
+    px += Eigen::Vector2d(shift(rng), shift(rng));
+  }
+  const CalibrationSummary sum = CalibrateCameras(syn.problem, options);
+  EXPECT_EQ(sum.cameras[0].rejected_views, 1);
+  EXPECT_TRUE(std::isnan(sum.cameras[0].view_rms_px[4]));
+  EXPECT_EQ(sum.cameras[0].num_views, clean.cameras[0].num_views - 1);
+  EXPECT_TRUE(sum.inlier_views[4].observations[0].empty());
+  EXPECT_LT(std::abs(sum.rig.cameras[0].intrinsics.fx -
+                     syn.truth.cameras[0].intrinsics.fx),
+            3 * sum.cameras[0].sigma[kFx]);
 }
 
 TEST(CalibrateCameras, TooFewViewsIsInputError) {
@@ -297,14 +380,23 @@ TEST(CalibrateCameras, SolveFailureNamesNonConvergenceAndAbsurdRms) {
 
 TEST(ProjectionDifference, ZeroForSameModelAndRotationRemoved) {
   CameraIntrinsics a{"a", 640, 480, 800, 800, 320, 240, {-0.2, 0.1, 0, 0, 0}};
-  EXPECT_LT(ProjectionDifferencePx(a, a).first, 1e-9);
+  const ProjectionDifference same = ProjectionDifferenceOf(a, a);
+  EXPECT_LT(same.rms_px, 1e-9);
+  EXPECT_LT(same.focus_rms_px, 1e-9);
+  EXPECT_DOUBLE_EQ(same.focus_radius_px, 160.0);  // a third of 480
   // A principal point shift of 2 px is (mostly) a rotation.
   CameraIntrinsics b = a;
   b.cx += 2;
-  EXPECT_LT(ProjectionDifferencePx(a, b).first, 0.2);
+  EXPECT_LT(ProjectionDifferenceOf(a, b).rms_px, 0.2);
+  // 1% focal: ~0.01 * r at radius r, not a rotation; near the centre small.
   b = a;
-  b.fx *= 1.01;  // 1% focal: up to ~3 px at the edge, not a rotation
-  EXPECT_GT(ProjectionDifferencePx(a, b).second, 2.0);
+  b.fx *= 1.01;
+  const ProjectionDifference focal = ProjectionDifferenceOf(a, b);
+  EXPECT_GT(focal.max_px, 2.0);
+  EXPECT_LT(focal.focus_rms_px, 1.2);
+  EXPECT_GT(focal.rms_px, focal.focus_rms_px);
+  EXPECT_DOUBLE_EQ(ProjectionDifferenceOf(a, b, 50).focus_radius_px, 50.0);
+  EXPECT_LT(ProjectionDifferenceOf(a, b, 50).focus_rms_px, focal.focus_rms_px);
 }
 
 // ---------------------------------------------------------------- real data

@@ -25,6 +25,40 @@ std::string StereoDir() {
   return testing::SharedDataDir() + "/opencv-stereo-left-right";
 }
 
+// The default (least squares, 3-sigma outlier rejection) on the stereo
+// pairs: its even/odd halves agree at least as well as mrcal's default's
+// halves on the same corners (projection difference, rays at infinity,
+// rotation fitted within 160 px of the centre: RMS within 160 px and over
+// the whole image), and its intrinsics are within 3 of mrcal's sigma of
+// mrcal's default solution. mrcal's figures were measured by
+// bench/mrcal_crossval.py (mrcal 2.2, outlier rejection and
+// regularisation, OPENCV5): halves 0.057 / 0.206 px within 160 px and
+// 3.586 / 0.481 px over the image (left / right); fx 534.187 / 537.708,
+// cx 342.154 / 327.055, sigma fx 0.311 / 0.315, sigma cx 0.420 / 0.449.
+void ExpectDefaultAsConsistentAsMrcal(const nlohmann::json& j) {
+  const auto& rejection = j.at("outlier_rejection");
+  EXPECT_EQ(rejection.at("reject_sigma").get<double>(), 3.0);
+  // A few per cent of the 1404 corners (mrcal's 4 sigma: 28).
+  EXPECT_GT(rejection.at("corners").get<int>(), 14);
+  EXPECT_LT(rejection.at("corners").get<int>(), 100);
+  const double mrcal_focus[2] = {0.057, 0.206}, mrcal_whole[2] = {3.586, 0.481};
+  const double mrcal_fx[2] = {534.187, 537.708}, sigma_fx[2] = {0.311, 0.315};
+  const double mrcal_cx[2] = {342.154, 327.055}, sigma_cx[2] = {0.420, 0.449};
+  for (size_t c = 0; c < 2; ++c) {
+    const auto& cam = j.at("cameras")[c];
+    EXPECT_EQ(cam.at("half_diff_focus_radius_px").get<double>(), 160.0);
+    EXPECT_LE(cam.at("half_diff_focus_rms_px").get<double>(), mrcal_focus[c]);
+    EXPECT_LE(cam.at("half_diff_rms_px").get<double>(), mrcal_whole[c]);
+    EXPECT_LT(std::abs(cam.at("fx").get<double>() - mrcal_fx[c]),
+              3 * sigma_fx[c]);
+    EXPECT_LT(std::abs(cam.at("cx").get<double>() - mrcal_cx[c]),
+              3 * sigma_cx[c]);
+    // Held out on the other half's inliers: close to the inlier RMS.
+    EXPECT_LT(cam.at("holdout_rms_px").get<double>(), 0.25);
+    EXPECT_LT(cam.at("rms_px").get<double>(), 0.2);
+  }
+}
+
 TEST(CamcalCli, StereoChessboardJsonAndRig) {
   KINCAL_REQUIRE_SHARED_DATA("opencv-stereo-left-right");
   const std::string out = testing::MakeTempDir("camcal") + "/rig.yaml";
@@ -69,12 +103,16 @@ TEST(CamcalCli, StereoChessboardJsonAndRig) {
                            g["mean_dy_px"][k].get<double>()),
                 g["rms_px"][k].get<double>() + 1e-12);
     }
-    EXPECT_EQ(corners, 13 * 54);
+    // The cells hold the inliers; with the rejected corners, every corner.
+    EXPECT_EQ(corners, c.at("points").get<int>());
+    EXPECT_EQ(c.at("rejected_views").get<int>(), 0);
+    EXPECT_EQ(corners + c.at("rejected_corners").get<int>(), 13 * 54);
     EXPECT_GT(cells_seen, 20);
     EXPECT_NEAR(std::sqrt(ss / corners), c.at("rms_px").get<double>(), 1e-9);
   }
   EXPECT_NE(j.at("command").get<std::string>().find("camcal"),
             std::string::npos);
+  ExpectDefaultAsConsistentAsMrcal(j);
   // The rig file reads back and agrees with the JSON.
   const Rig rig = ReadRigYaml(out);
   ASSERT_EQ(rig.cameras.size(), 2u);
