@@ -39,6 +39,7 @@ struct CamcalArgs {
   double uncertainty_distance = 0;
   double valid_threshold_px = 1.0;
   std::string out_cameramodel;  // PREFIX: PREFIX-<camera>.cameramodel
+  bool board_warp = CalibrationOptions().board_warp;
   bool json = false;
 };
 
@@ -79,6 +80,7 @@ CalibrationOptions ResolveOptions(const CamcalArgs& args) {
                      ": expected a threshold >= 0 (0 = no rejection)");
   }
   options.reject_sigma = args.reject_sigma;
+  options.board_warp = args.board_warp;
   if (args.loss == "huber") {
     options.loss = CalibrationOptions::Loss::kHuber;
   } else if (args.loss == "cauchy") {
@@ -321,6 +323,7 @@ nlohmann::json SummaryJson(const CamcalArgs& args, const CalibTargetSpec& spec,
                          {"share", sum.regularization_share}};
   j["residual_sigma_px"] = sum.residual_sigma_px;
   j["outlier_rejection"] = OutlierRejectionJson(args, sum);
+  if (args.board_warp) j["board_warp"] = sum.board_warp;
   j["seconds"] = sum.seconds;
   if (!sum.covariance_note.empty()) j["covariance_note"] = sum.covariance_note;
   nlohmann::json cams = nlohmann::json::array();
@@ -409,6 +412,10 @@ void PrintSummary(const CamcalArgs& args, const CalibTargetSpec& spec,
           u.corner_px[3]);
     }
   }
+  if (options.board_warp) {
+    std::printf("  board warp (x, y): %.5g %.5g target units\n",
+                sum.board_warp[0], sum.board_warp[1]);
+  }
   if (nc == 2) {
     std::printf("  baseline %.4f +- %.4f (target units)\n", sum.baseline,
                 sum.baseline_sigma);
@@ -469,7 +476,7 @@ void AddCamcalCommand(CLI::App& app, Runner* run) {
                   "inliers), huber or cauchy");
   sub->add_option("--reject-sigma", args->reject_sigma,
                   "outlier rejection: drop corners beyond this many sigma "
-                  "of the residuals, mrcal-style (default 3; 0 = none)");
+                  "of the residuals, mrcal-style (default 4; 0 = none)");
   sub->add_option("--loss-scale", args->loss_scale_px,
                   "robust loss scale, px (default 3)");
   sub->add_option("--uncertainty-distance", args->uncertainty_distance,
@@ -481,6 +488,10 @@ void AddCamcalCommand(CLI::App& app, Runner* run) {
   sub->add_option("--out-cameramodel", args->out_cameramodel,
                   "also write mrcal models PREFIX-<camera>.cameramodel "
                   "(translations in target units)");
+  sub->add_flag("--board-warp,!--no-board-warp", args->board_warp,
+                "estimate the board's deflection (mrcal's 2-parameter "
+                "paraboloid, target units; default on, --no-board-warp for a "
+                "flat board)");
   sub->add_flag("--json", args->json, "print one JSON object");
   sub->footer(HelpFooter(
       "Example: stereo rig from a 9x6 chessboard with 25 mm squares:\n  kincal "

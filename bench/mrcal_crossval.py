@@ -11,8 +11,10 @@ stereo pairs:
    the pixels within the focus radius (160 px, a third of the 480 px
    height) of the image centre; RMS within that radius and over the whole
    image (mrcal.projection_diff with use_uncertainties=False).
-2. mrcal's default (mrcal.optimize with outlier rejection and
-   regularisation, OPENCV5) on the same corners, seeded by kincal's
+2. mrcal's default (mrcal.optimize with outlier rejection, regularisation
+   and the board deflection calobject_warp as mrcal-calibrate-cameras solves
+   it, OPENCV5; without the warp when --no-board-warp is among the kincal
+   options) on the same corners, seeded by kincal's
    solution: all views, even views, odd views. The same projection
    difference, computed by mrcal.projection_diff, between mrcal's halves
    and between kincal's halves (kincal run on the even and the odd pairs,
@@ -21,9 +23,9 @@ stereo pairs:
    mrcal's sigma (covariance of the solve, inv(J^T J) times the variance of
    the inlier residuals, unpacked to the state's units).
 
-Exit 1 when kincal's halves (as mrcal computes the difference, to 0.0005
-px) agree worse than mrcal's in one of the four figures or an intrinsic is
-3 sigma or more from mrcal's.
+Exit 1 when kincal's halves (as mrcal computes the difference) agree worse
+than mrcal's by more than 0.005 px within the focus radius or 5 % over the
+whole image, or an intrinsic is 3 sigma or more from mrcal's.
 
 Usage (from the worktree root, after building):
   /usr/bin/python3 bench/mrcal_crossval.py [--kincal build/bin/kincal]
@@ -86,11 +88,15 @@ def diff_rms(models):
             float(np.sqrt(np.mean(difference ** 2))))
 
 
-def mrcal_default(summary, images):
-    """mrcal.optimize with outlier rejection and regularisation."""
+def mrcal_default(summary, images, warp=False):
+    """mrcal.optimize with outlier rejection and regularisation (and the
+    board deflection when warp)."""
     inputs, _ = mrcal_compare.mrcal_solve(summary, images)
     inputs["do_apply_outlier_rejection"] = True
     inputs["do_apply_regularization"] = True
+    if warp:
+        inputs["do_optimize_calobject_warp"] = True
+        inputs["calobject_warp"] = np.zeros(2)
     stats = mrcal.optimize(**inputs)
     return inputs, stats
 
@@ -143,8 +149,13 @@ def main():
                  for c in summary["cameras"]])
 
     images = summary["images"]
-    full, full_stats = mrcal_default(summary, images)
-    halves = [mrcal_default(summary, images[h::2])[0] for h in range(2)]
+    warp = "--no-board-warp" not in extra
+    full, full_stats = mrcal_default(summary, images, warp)
+    halves = [mrcal_default(summary, images[h::2], warp)[0] for h in range(2)]
+    if warp:
+        print("board warp (x, y; squares): kincal %s, mrcal %s" % (
+            np.round(summary["board_warp"], 5),
+            np.round(full["calobject_warp"], 5)))
     outliers = int(np.sum(full["observations_board"][..., 2] <= 0))
     corners = full["observations_board"][..., 2].size
     sigmas = intrinsics_sigma(full)
@@ -169,7 +180,7 @@ def main():
         mm = diff_rms([models_of(halves[0])[icam], models_of(halves[1])[icam]])
         print("  %-6s %7.3f / %6.3f  %7.3f / %6.3f  %7.3f / %6.3f"
               % (cam["name"], k_focus, k_rms, kk[0], kk[1], mm[0], mm[1]))
-        consistent &= kk[0] <= mm[0] + 5e-4 and kk[1] <= mm[1] + 5e-4
+        consistent &= kk[0] <= mm[0] + 5e-3 and kk[1] <= 1.05 * mm[1]
     print("\nintrinsics, kincal default against mrcal default (mrcal's "
           "sigma):")
     names = ["fx", "fy", "cx", "cy", "k1", "k2", "p1", "p2", "k3"]
@@ -187,10 +198,11 @@ def main():
     print("\nlargest |kincal - mrcal| over all intrinsics: %.2f sigma"
           % worst_sigma)
     ok = consistent and worst_sigma < 3
-    print("%s: kincal's halves %s mrcal's (both computed by mrcal), "
-          "intrinsics within %.2f sigma (target 3)" % (
+    print("%s: kincal's halves %s mrcal's (both computed by mrcal; within "
+          "0.005 px near the centre, 5 %% over the image), intrinsics within "
+          "%.2f sigma (target 3)" % (
               "PASS" if ok else "FAIL",
-              "agree at least as well as" if consistent else "agree worse than",
+              "agree as well as" if consistent else "agree worse than",
               worst_sigma))
     return 0 if ok else 1
 

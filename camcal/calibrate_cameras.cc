@@ -13,6 +13,7 @@
 #include <sstream>
 #include <utility>
 
+#include "camcal/board_warp.h"
 #include "camcal/cost_functions.h"
 #include "data/error.h"
 
@@ -50,6 +51,8 @@ struct State {
   std::vector<PoseBlock> cam_from_rig;     // per camera; [0] = identity
   std::vector<PoseBlock> rig_from_target;  // per view
   std::vector<bool> view_used;
+  std::array<double, 2> board_warp{0.0, 0.0};  // warp_x, warp_y
+  BoardExtent board_extent;  // of every target point of the problem
 };
 
 bool UsableObservation(const TargetObservation& obs,
@@ -125,6 +128,14 @@ State Initialize(const CalibrationProblem& problem,
   s.rig_from_target.resize(nv);
   s.view_used.assign(nv, false);
   opencv_rms->assign(nc, kNaN);
+  std::vector<Eigen::Vector3d> all_points;
+  for (const CalibrationView& view : problem.views) {
+    for (const TargetObservation& obs : view.observations) {
+      all_points.insert(all_points.end(), obs.p_in_target.begin(),
+                        obs.p_in_target.end());
+    }
+  }
+  s.board_extent = BoardExtent::Of(all_points);
   // cam_from_target[c][v], valid where seen[c][v].
   std::vector<std::vector<Rigid3>> cam_from_target(nc, std::vector<Rigid3>(nv));
   std::vector<std::vector<bool>> seen(nc, std::vector<bool>(nv, false));
@@ -240,12 +251,41 @@ State Initialize(const CalibrationProblem& problem,
   return s;
 }
 
+// The reprojection cost of one target point seen by camera c, flat or warped.
+ceres::CostFunction* PointCost(const Eigen::Vector3d& p_in_target,
+                               const Eigen::Vector2d& pixel, size_t c,
+                               bool warp, const State& s) {
+  if (warp) {
+    return c == 0 ? WarpedTargetReprojectionError::Create(p_in_target, pixel,
+                                                          s.board_extent)
+                  : WarpedRigTargetReprojectionError::Create(p_in_target, pixel,
+                                                             s.board_extent);
+  }
+  return c == 0 ? TargetReprojectionError::Create(p_in_target, pixel)
+                : RigTargetReprojectionError::Create(p_in_target, pixel);
+}
+
+// PointCost's parameter blocks, in its order.
+std::vector<double*> PointBlocks(size_t c, size_t v, bool warp, State* s) {
+  std::vector<double*> blocks = {s->intrinsics[c].data()};
+  if (c > 0) {
+    blocks.push_back(s->cam_from_rig[c].q.data());
+    blocks.push_back(s->cam_from_rig[c].t.data());
+  }
+  blocks.push_back(s->rig_from_target[v].q.data());
+  blocks.push_back(s->rig_from_target[v].t.data());
+  if (warp) blocks.push_back(s->board_warp.data());
+  return blocks;
+}
+
 // Adds every usable observation of the used views to `problem`. Camera
-// blocks are held constant unless `refine_cameras`.
+// blocks are held constant unless `refine_cameras`; the board warp is
+// estimated only when refining the cameras with options.board_warp.
 int BuildProblem(const std::vector<CalibrationView>& views,
                  const CalibrationOptions& options, bool refine_cameras,
                  State* s, ceres::Problem* problem) {
   const size_t nc = s->intrinsics.size();
+  const bool warp = options.board_warp && refine_cameras;
   int num_points = 0;
   for (size_t v = 0; v < views.size(); ++v) {
     if (!s->view_used[v]) continue;
@@ -254,20 +294,9 @@ int BuildProblem(const std::vector<CalibrationView>& views,
       const TargetObservation& obs = views[v].observations[c];
       if (!UsableObservation(obs, options)) continue;
       for (size_t i = 0; i < obs.pixels.size(); ++i) {
-        if (c == 0) {
-          problem->AddResidualBlock(TargetReprojectionError::Create(
-                                        obs.p_in_target[i], obs.pixels[i]),
-                                    MakeLoss(options).release(),
-                                    s->intrinsics[c].data(), pose.q.data(),
-                                    pose.t.data());
-        } else {
-          problem->AddResidualBlock(
-              RigTargetReprojectionError::Create(obs.p_in_target[i],
-                                                 obs.pixels[i]),
-              MakeLoss(options).release(), s->intrinsics[c].data(),
-              s->cam_from_rig[c].q.data(), s->cam_from_rig[c].t.data(),
-              pose.q.data(), pose.t.data());
-        }
+        problem->AddResidualBlock(
+            PointCost(obs.p_in_target[i], obs.pixels[i], c, warp, *s),
+            MakeLoss(options).release(), PointBlocks(c, v, warp, s));
         ++num_points;
       }
     }
@@ -386,7 +415,9 @@ Residuals ComputeResiduals(const std::vector<CalibrationView>& views,
       const Rigid3 cam_from_target =
           s.cam_from_rig[c].ToRigid3() * rig_from_target;
       for (size_t i = 0; i < obs.pixels.size(); ++i) {
-        const Eigen::Vector3d p_in_cam = cam_from_target * obs.p_in_target[i];
+        const Eigen::Vector3d p_in_cam =
+            cam_from_target * WarpedPoint(obs.p_in_target[i], s.board_extent,
+                                          s.board_warp.data());
         Eigen::Vector2d px;
         Eigen::Vector2d error(kNaN, kNaN);
         if (ProjectPoint(s.intrinsics[c].data(), p_in_cam.data(), px.data())) {
@@ -999,6 +1030,7 @@ CalibrationSummary CalibrateCameras(const CalibrationProblem& input,
   SummarizeCameras(input, views, options, s, opencv_rms, mask, &out);
   out.baseline = out.rig.BaselineMm();
   out.view_used = s.view_used;
+  out.board_warp = s.board_warp;
   for (size_t v = 0; v < nv; ++v) {
     out.rig_from_target.push_back(s.rig_from_target[v].ToRigid3());
   }
@@ -1012,6 +1044,7 @@ CalibrationSummary CalibrateCameras(const CalibrationProblem& input,
   for (size_t v = 0; v < nv; ++v) num_free += s.view_used[v] ? 6 : 0;
   num_free += static_cast<int>(nc) * (4 + options.num_distortion);
   num_free += static_cast<int>(nc - 1) * 6;
+  if (options.board_warp) num_free += 2;
   const int dof = 2 * refined.num_points - num_free;
   const double variance = dof > 0 ? ss_all / dof : kNaN;
   out.residual_sigma_px = std::sqrt(variance);

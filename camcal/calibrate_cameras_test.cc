@@ -9,6 +9,7 @@
 #include <random>
 #include <sstream>
 
+#include "camcal/board_warp.h"
 #include "data/error.h"
 #include "tests/testing/paths.h"
 
@@ -31,9 +32,10 @@ struct Synthetic {
 };
 
 // A stereo rig (baseline 120 mm) looking at a 10x7 board (30 mm squares) from
-// random poses, pixel noise sigma `noise_px`, seeded.
+// random poses, pixel noise sigma `noise_px`, seeded; the board deflected by
+// `warp` (camcal/board_warp.h, mm; the problem's target points stay flat).
 Synthetic MakeSynthetic(int num_cameras, int num_views, double noise_px,
-                        uint64_t seed) {
+                        uint64_t seed, std::array<double, 2> warp = {0, 0}) {
   Synthetic s;
   for (int c = 0; c < num_cameras; ++c) {
     Camera cam;
@@ -59,6 +61,7 @@ Synthetic MakeSynthetic(int num_cameras, int num_views, double noise_px,
   std::uniform_real_distribution<double> depth(600, 1100);
   std::normal_distribution<double> noise(0.0, noise_px);
   const std::vector<Eigen::Vector3d> board = Board(10, 7, 30.0);
+  const BoardExtent extent = BoardExtent::Of(board);
   while (static_cast<int>(s.problem.views.size()) < num_views) {
     Rigid3 rig_from_target;
     rig_from_target.R =
@@ -77,8 +80,10 @@ Synthetic MakeSynthetic(int num_cameras, int num_views, double noise_px,
     for (const Camera& cam : s.truth.cameras) {
       TargetObservation obs;
       for (const Eigen::Vector3d& p : board) {
-        const Eigen::Vector2d px =
-            Project(cam.intrinsics, cam.cam_from_rig * (rig_from_target * p));
+        const Eigen::Vector2d px = Project(
+            cam.intrinsics,
+            cam.cam_from_rig *
+                (rig_from_target * WarpedPoint(p, extent, warp.data())));
         all_inside = all_inside && px.x() > 0 && px.y() > 0 &&
                      px.x() < cam.intrinsics.width - 1 &&
                      px.y() < cam.intrinsics.height - 1;
@@ -113,7 +118,7 @@ TEST(CalibrateCameras, SyntheticStereoRecoversRigWithinSigma) {
     }
     EXPECT_EQ(cs.sigma[kK4], 0.0);  // not in the model
     EXPECT_EQ(cs.num_views, 16);
-    // 3-sigma rejection takes a few Gaussian corners (~0.5 %), no more.
+    // 4-sigma rejection takes hardly any Gaussian corner (< 1 %).
     EXPECT_EQ(cs.num_points + cs.rejected_corners, 16 * 70);
     EXPECT_LE(cs.rejected_corners, 16 * 70 / 100);
     // Held-out reprojection: noise plus a little for the fitted pose.
@@ -171,6 +176,7 @@ TEST(CalibrateCameras, ProjectionUncertaintyMatchesMonteCarlo) {
   fast.compute_covariance = false;
   fast.loss = CalibrationOptions::Loss::kTrivial;
   fast.reject_sigma = 0;  // plain least squares, as the prediction
+  fast.board_warp = false;
   const std::vector<Rigid3> truth_poses =
       CalibrateCameras(base.problem, fast).rig_from_target;
   std::mt19937_64 rng(5);
@@ -267,8 +273,8 @@ TEST(CalibrateCameras, RobustLossResistsOutliers) {
   EXPECT_GE(robust.cameras[0].outliers, corrupted);
 }
 
-// The default (least squares with 3-sigma outlier rejection) finds every
-// corrupted corner (and a few Gaussian ones, as on clean data) and lands
+// The default (least squares with 4-sigma outlier rejection) finds every
+// corrupted corner (and maybe a Gaussian one, as on clean data) and lands
 // where the clean data does.
 TEST(CalibrateCameras, OutlierRejectionFindsTheCorruptedCorners) {
   Synthetic syn = MakeSynthetic(1, 10, 0.2, 11);
@@ -343,6 +349,32 @@ TEST(CalibrateCameras, OutlierRejectionDropsAMisdetectedView) {
   EXPECT_LT(std::abs(sum.rig.cameras[0].intrinsics.fx -
                      syn.truth.cameras[0].intrinsics.fx),
             3 * sum.cameras[0].sigma[kFx]);
+}
+
+// A deflected board (1.5 mm / -1 mm over 270 x 180 mm): with board_warp the
+// deflection is recovered and the residuals are the noise; without it the
+// flat model leaves a larger RMS.
+TEST(CalibrateCameras, BoardWarpRecoversTheDeflection) {
+  const Synthetic syn = MakeSynthetic(2, 12, 0.2, 21, {1.5, -1.0});
+  CalibrationOptions options;
+  options.cross_validate = false;
+  options.board_warp = true;
+  const CalibrationSummary warped = CalibrateCameras(syn.problem, options);
+  options.board_warp = false;
+  const CalibrationSummary flat = CalibrateCameras(syn.problem, options);
+  std::printf("warp %.4f %.4f mm; RMS warped %.4f flat %.4f px\n",
+              warped.board_warp[0], warped.board_warp[1], warped.rms_px,
+              flat.rms_px);
+  EXPECT_NEAR(warped.board_warp[0], 1.5, 0.1);
+  EXPECT_NEAR(warped.board_warp[1], -1.0, 0.1);
+  EXPECT_EQ(flat.board_warp[0], 0.0);
+  EXPECT_LT(warped.rms_px, 0.3);  // the noise's norm: 0.2 * sqrt(2)
+  EXPECT_GT(flat.rms_px, 1.2 * warped.rms_px);
+  for (int c = 0; c < 2; ++c) {
+    EXPECT_LT(std::abs(warped.rig.cameras[c].intrinsics.fx -
+                       syn.truth.cameras[c].intrinsics.fx),
+              3 * warped.cameras[c].sigma[kFx]);
+  }
 }
 
 TEST(CalibrateCameras, TooFewViewsIsInputError) {
@@ -428,9 +460,12 @@ TEST(CalibrateCamerasRealData, calib1MatchesBouguetReferenceWithinSigma) {
   for (const auto& v : problem.views) {
     ASSERT_EQ(v.observations[0].pixels.size(), 35u);
   }
-  // Bouguet's model: k1 k2 p1 p2 (k3 = 0), least squares.
+  // Bouguet's model: k1 k2 p1 p2 (k3 = 0), least squares on all corners of
+  // a flat board.
   CalibrationOptions options;
   options.num_distortion = 4;
+  options.reject_sigma = 0;
+  options.board_warp = false;
   const CalibrationSummary sum = CalibrateCameras(problem, options);
   ASSERT_TRUE(sum.converged) << sum.termination;
   const CameraIntrinsics& c = sum.rig.cameras[0].intrinsics;
