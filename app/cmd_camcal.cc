@@ -34,6 +34,8 @@ struct CamcalArgs {
   double reject_sigma = CalibrationOptions().reject_sigma;
   // Distortion regulariser weight (CalibrationOptions::regularization).
   double regularization = CalibrationOptions().regularization;
+  // mrcal's lens regulariser weight (CalibrationOptions::lens_regularization).
+  double lens_regularization = CalibrationOptions().lens_regularization;
   // Projection uncertainty: distance (target units; 0 = infinity) and the
   // valid-intrinsics threshold (px).
   double uncertainty_distance = 0;
@@ -75,6 +77,12 @@ CalibrationOptions ResolveOptions(const CamcalArgs& args) {
                      ": expected a weight >= 0 (0 = none)");
   }
   options.regularization = args.regularization;
+  if (args.lens_regularization < 0) {
+    throw InputError("--regularize-lens " +
+                     std::to_string(args.lens_regularization) +
+                     ": expected a weight >= 0 (0 = none)");
+  }
+  options.lens_regularization = args.lens_regularization;
   if (args.reject_sigma < 0) {
     throw InputError("--reject-sigma " + std::to_string(args.reject_sigma) +
                      ": expected a threshold >= 0 (0 = no rejection)");
@@ -319,6 +327,7 @@ nlohmann::json SummaryJson(const CamcalArgs& args, const CalibTargetSpec& spec,
   j["converged"] = sum.converged;
   j["iterations"] = sum.iterations;
   j["regularization"] = {{"weight", args.regularization},
+                         {"lens_weight", args.lens_regularization},
                          {"cost", sum.regularization_cost},
                          {"share", sum.regularization_share}};
   j["residual_sigma_px"] = sum.residual_sigma_px;
@@ -359,8 +368,11 @@ void PrintSummary(const CamcalArgs& args, const CalibTargetSpec& spec,
   std::printf("  Ceres: %s after %d iterations, %.2f s\n",
               sum.termination.c_str(), sum.iterations, sum.seconds);
   if (sum.regularization_cost > 0) {
-    std::printf("  k4..k6 regulariser: weight %g, %.3g of the cost\n",
-                options.regularization, sum.regularization_share);
+    std::printf(
+        "  regularisers: k4..k6 weight %g, lens weight %g; %.3g of the "
+        "cost\n",
+        options.regularization, options.lens_regularization,
+        sum.regularization_share);
   }
   for (size_t c = 0; c < nc; ++c) {
     const CameraCalibrationSummary& cs = sum.cameras[c];
@@ -471,6 +483,10 @@ void AddCamcalCommand(CLI::App& app, Runner* run) {
   sub->add_option("--regularize", args->regularization,
                   "distortion regulariser weight, mrcal-style (default "
                   "0.005; 0 = none)");
+  sub->add_option("--regularize-lens", args->lens_regularization,
+                  "mrcal's lens regulariser (distortion toward 0, principal "
+                  "point toward the image centre), weight relative to "
+                  "mrcal's (default 1; 0 = none)");
   sub->add_option("--loss", args->loss,
                   "loss on each corner: none (default, least squares on the "
                   "inliers), huber or cauchy");

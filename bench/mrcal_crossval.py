@@ -22,6 +22,10 @@ stereo pairs:
 3. kincal's intrinsics against mrcal's default solution in units of
    mrcal's sigma (covariance of the solve, inv(J^T J) times the variance of
    the inlier residuals, unpacked to the state's units).
+4. Where the whole-image difference comes from: its RMS inside and outside
+   the convex hull of the corners each camera saw, and the share of the
+   squared difference outside that hull (the image the boards never
+   covered, where only the distortion polynomial's extrapolation speaks).
 
 Exit 1 when kincal's halves (as mrcal computes the difference) agree worse
 than mrcal's by more than 0.005 px within the focus radius or 5 % over the
@@ -86,6 +90,29 @@ def diff_rms(models):
     inside = np.linalg.norm(q0 - centre, axis=-1) <= FOCUS_RADIUS_PX
     return (float(np.sqrt(np.mean(difference[inside] ** 2))),
             float(np.sqrt(np.mean(difference ** 2))))
+
+
+def coverage_split(models, inputs, icam):
+    """RMS projection difference inside and outside the convex hull of the
+    corners camera icam saw (all views), and the share of the squared
+    difference outside."""
+    import cv2
+    w, h = models[0].imagersize()
+    centre = np.array([(w - 1) / 2.0, (h - 1) / 2.0])
+    difference, _, q0, _ = mrcal.projection_diff(
+        models, use_uncertainties=False, focus_center=centre,
+        focus_radius=FOCUS_RADIUS_PX)
+    seen = inputs["indices_frame_camintrinsics_camextrinsics"][:, 1] == icam
+    corners = inputs["observations_board"][seen][..., :2].reshape(-1, 2)
+    hull = cv2.convexHull(corners.astype(np.float32))
+    q = q0.reshape(-1, 2)
+    d = difference.ravel()
+    inside = np.array([cv2.pointPolygonTest(hull, (float(x), float(y)), False)
+                       >= 0 for x, y in q])
+    return (float(np.sqrt(np.mean(d[inside] ** 2))),
+            float(np.sqrt(np.mean(d[~inside] ** 2))),
+            float(np.mean(~inside)),
+            float(np.sum(d[~inside] ** 2) / np.sum(d ** 2)))
 
 
 def mrcal_default(summary, images, warp=False):
@@ -173,6 +200,7 @@ def main():
                                         "kincal (mrcal)", "mrcal default"))
     worst_sigma = 0.0
     consistent = True
+    coverage = []
     for icam, cam in enumerate(summary["cameras"]):
         k_focus = cam.get("half_diff_focus_rms_px", float("nan"))
         k_rms = cam["half_diff_rms_px"]
@@ -181,6 +209,18 @@ def main():
         print("  %-6s %7.3f / %6.3f  %7.3f / %6.3f  %7.3f / %6.3f"
               % (cam["name"], k_focus, k_rms, kk[0], kk[1], mm[0], mm[1]))
         consistent &= kk[0] <= mm[0] + 5e-3 and kk[1] <= 1.05 * mm[1]
+        coverage.append((cam["name"], coverage_split(
+            [kincal_halves[0][icam], kincal_halves[1][icam]], full, icam),
+            coverage_split([models_of(halves[0])[icam],
+                            models_of(halves[1])[icam]], full, icam)))
+    print("\nwhere the whole-image difference is (RMS inside / outside the "
+          "convex hull of the corners the camera saw; share of the image "
+          "outside; share of the squared difference outside):")
+    for name, k, m in coverage:
+        print("  %-6s kincal %.3f / %.3f px, %.0f %% of the image, %.1f %% "
+              "of the difference; mrcal %.3f / %.3f px, %.1f %%"
+              % (name, k[0], k[1], 100 * k[2], 100 * k[3], m[0], m[1],
+                 100 * m[3]))
     print("\nintrinsics, kincal default against mrcal default (mrcal's "
           "sigma):")
     names = ["fx", "fy", "cx", "cy", "k1", "k2", "p1", "p2", "k3"]

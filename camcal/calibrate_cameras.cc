@@ -53,6 +53,9 @@ struct State {
   std::vector<bool> view_used;
   std::array<double, 2> board_warp{0.0, 0.0};  // warp_x, warp_y
   BoardExtent board_extent;  // of every target point of the problem
+  // Per camera: the image centre ((width - 1) / 2, (height - 1) / 2), px,
+  // where the lens regulariser pulls the principal point.
+  std::vector<Eigen::Vector2d> image_centre;
 };
 
 bool UsableObservation(const TargetObservation& obs,
@@ -127,6 +130,9 @@ State Initialize(const CalibrationProblem& problem,
   s.cam_from_rig.resize(nc);
   s.rig_from_target.resize(nv);
   s.view_used.assign(nv, false);
+  for (const CameraIntrinsics& cam : problem.cameras) {
+    s.image_centre.emplace_back((cam.width - 1) / 2.0, (cam.height - 1) / 2.0);
+  }
   opencv_rms->assign(nc, kNaN);
   std::vector<Eigen::Vector3d> all_points;
   for (const CalibrationView& view : problem.views) {
@@ -332,47 +338,101 @@ int BuildProblem(const std::vector<CalibrationView>& views,
   return num_points;
 }
 
-// Adds the rational-term regulariser of every camera (RationalDistortion-
-// RegularizationError) to `problem`; returns per camera its scale s (0 when
-// none is added: regularisation off, a model without k4..k6, or a camera
-// that saw nothing).
-std::vector<double> AddDistortionRegularizer(
+// Pixel residual coordinates (2 per corner) of camera c in the used views.
+int NumPixelResiduals(const std::vector<CalibrationView>& views,
+                      const CalibrationOptions& options, const State& s,
+                      size_t c) {
+  int num = 0;
+  for (size_t v = 0; v < views.size(); ++v) {
+    const TargetObservation& obs = views[v].observations[c];
+    if (s.view_used[v] && UsableObservation(obs, options)) {
+      num += 2 * static_cast<int>(obs.pixels.size());
+    }
+  }
+  return num;
+}
+
+// The scales of one camera's regularisers (0 = that regulariser is off).
+struct RegularizationScales {
+  double rational = 0;    // k4..k6 (RationalDistortionRegularizationError)
+  double distortion = 0;  // every coefficient (LensRegularizationError)
+  double centre = 0;      // principal point, per px (LensRegularizationError)
+};
+
+// mrcal's sizing of its lens regularisation (measured from
+// mrcal.optimizer_callback: identical scales): the distortion terms and the
+// principal-point terms each cost 0.25 % of the cost of 0.1 px errors on
+// every pixel residual when the coefficients are 0.2 and the principal
+// point is 50 px off centre:
+//   distortion_scale^2 = w * N * 0.0025 * 0.1^2 / (n_distortion * 0.2^2)
+//   centre_scale^2     = w * N * 0.0025 * 0.1^2 / (2 * 50^2)
+// with N the camera's pixel residuals and w = options.lens_regularization.
+constexpr double kLensRegularizationShare = 0.0025;
+constexpr double kNormalPixelErrorPx = 0.1;
+constexpr double kNormalDistortion = 0.2;
+constexpr double kNormalCentreOffsetPx = 50.0;
+
+// Adds every camera's regularisers to `problem`: the rational-term one
+// (options.regularization, 8-coefficient model) and mrcal's lens
+// regulariser (options.lens_regularization); returns their scales per
+// camera (all 0 for a camera that saw nothing).
+std::vector<RegularizationScales> AddRegularizers(
     const std::vector<CalibrationView>& views,
     const CalibrationOptions& options, State* s, ceres::Problem* problem) {
-  using Regularizer = RationalDistortionRegularizationError;
+  using Rational = RationalDistortionRegularizationError;
   const size_t nc = s->intrinsics.size();
-  std::vector<double> scale(nc, 0.0);
-  if (options.regularization <= 0 ||
-      kK1 + options.num_distortion <= Regularizer::kK4) {
-    return scale;
-  }
+  std::vector<RegularizationScales> scales(nc);
+  const bool rational = options.regularization > 0 &&
+                        kK1 + options.num_distortion > Rational::kK4;
+  const bool lens = options.lens_regularization > 0;
   for (size_t c = 0; c < nc; ++c) {
     double* intrinsics = s->intrinsics[c].data();
     if (!problem->HasParameterBlock(intrinsics)) continue;
-    int num_pixel_residuals = 0;
-    for (size_t v = 0; v < views.size(); ++v) {
-      const TargetObservation& obs = views[v].observations[c];
-      if (s->view_used[v] && UsableObservation(obs, options)) {
-        num_pixel_residuals += 2 * static_cast<int>(obs.pixels.size());
-      }
+    const double num = NumPixelResiduals(views, options, *s, c);
+    if (rational) {
+      scales[c].rational =
+          std::sqrt(options.regularization * num / Rational::kNumRational);
+      problem->AddResidualBlock(Rational::Create(scales[c].rational), nullptr,
+                                intrinsics);
     }
-    scale[c] = std::sqrt(options.regularization * num_pixel_residuals /
-                         Regularizer::kNumRational);
-    problem->AddResidualBlock(Regularizer::Create(scale[c]), nullptr,
-                              intrinsics);
+    if (!lens) continue;
+    const double pixel_cost = options.lens_regularization * num *
+                              kLensRegularizationShare * kNormalPixelErrorPx *
+                              kNormalPixelErrorPx;
+    if (options.num_distortion > 0) {
+      scales[c].distortion =
+          std::sqrt(pixel_cost / (options.num_distortion * kNormalDistortion *
+                                  kNormalDistortion));
+    }
+    scales[c].centre = std::sqrt(
+        pixel_cost / (2 * kNormalCentreOffsetPx * kNormalCentreOffsetPx));
+    problem->AddResidualBlock(
+        LensRegularizationError::Create(scales[c].distortion, scales[c].centre,
+                                        s->image_centre[c].x(),
+                                        s->image_centre[c].y()),
+        nullptr, intrinsics);
   }
-  return scale;
+  return scales;
 }
 
-// The regulariser's part of the final cost: 1/2 s_c^2 |k4..k6 of c|^2.
-double RegularizationCost(const State& s, const std::vector<double>& scale) {
+// The regularisers' part of the final cost.
+double RegularizationCost(const State& s,
+                          const std::vector<RegularizationScales>& scales) {
   double cost = 0;
-  for (size_t c = 0; c < s.intrinsics.size(); ++c) {
-    for (int i = RationalDistortionRegularizationError::kK4; i < kNumIntrinsics;
-         ++i) {
-      const double r = scale[c] * s.intrinsics[c][i];
+  for (size_t c = 0; c < scales.size(); ++c) {
+    const std::array<double, kNumIntrinsics>& intr = s.intrinsics[c];
+    for (int i = kK1; i < kNumIntrinsics; ++i) {
+      const double r = scales[c].distortion * intr[i];
       cost += 0.5 * r * r;
     }
+    for (int i = RationalDistortionRegularizationError::kK4; i < kNumIntrinsics;
+         ++i) {
+      const double r = scales[c].rational * intr[i];
+      cost += 0.5 * r * r;
+    }
+    const double dx = scales[c].centre * (intr[kCx] - s.image_centre[c].x());
+    const double dy = scales[c].centre * (intr[kCy] - s.image_centre[c].y());
+    cost += 0.5 * (dx * dx + dy * dy);
   }
   return cost;
 }
@@ -544,6 +604,8 @@ void CalibrationOptions::Check() const {
   Require(max_iterations > 0, "calibration: max_iterations must be > 0");
   Require(max_rms_px > 0, "calibration: max_rms_px must be > 0");
   Require(regularization >= 0, "calibration: regularization must be >= 0");
+  Require(lens_regularization >= 0,
+          "calibration: lens_regularization must be >= 0");
   Require(uncertainty.distance > 0,
           "calibration: the uncertainty distance must be > 0");
   Require(uncertainty.valid_threshold_px > 0,
@@ -803,7 +865,7 @@ void CrossValidateHalves(const CalibrationProblem& input,
 struct Refinement {
   std::unique_ptr<ceres::Problem> problem;
   ceres::Solver::Summary solver;
-  std::vector<double> regularization_scale;
+  std::vector<RegularizationScales> regularization_scale;
   int num_points = 0;
 };
 
@@ -813,8 +875,7 @@ Refinement Refine(const std::vector<CalibrationView>& views,
   r.problem = std::make_unique<ceres::Problem>();
   r.num_points =
       BuildProblem(views, options, /*refine_cameras=*/true, s, r.problem.get());
-  r.regularization_scale =
-      AddDistortionRegularizer(views, options, s, r.problem.get());
+  r.regularization_scale = AddRegularizers(views, options, s, r.problem.get());
   ceres::Solve(SolverOptions(options), r.problem.get(), &r.solver);
   return r;
 }

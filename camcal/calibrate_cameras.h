@@ -97,6 +97,14 @@ struct CalibrationOptions {
   // aims its regularisation at ~0.5 % of the cost); the 5-coefficient
   // default model has no k4..k6 and is unaffected.
   double regularization = 0.005;
+  // Weight of mrcal's lens regulariser (cost_functions.h,
+  // LensRegularizationError): every distortion coefficient pulled toward 0
+  // and the principal point toward the image centre, with mrcal's scales
+  // times this weight (1 = mrcal's; 0 = none). The data outside the area
+  // the boards covered do not pin the distortion polynomial; the pull
+  // keeps it from extrapolating wildly there. Default 1, as
+  // mrcal-calibrate-cameras (docs/CAMCAL.md, "Lens regularisation").
+  double lens_regularization = 1.0;
   // A final RMS point residual above this (px) is no calibration: the
   // target's size or layout does not match the images (SolveFailure).
   double max_rms_px = 10.0;
@@ -189,8 +197,8 @@ struct CalibrationSummary {
   bool converged = false;
   int iterations = 0;
   double initial_cost = 0, final_cost = 0;
-  // Part of final_cost due to the distortion regulariser, and its share of
-  // final_cost (0 when the regulariser is off).
+  // Part of final_cost due to the regularisers (k4..k6 and the lens
+  // regulariser), and its share of final_cost (0 when they are off).
   double regularization_cost = 0;
   double regularization_share = 0;
   std::string covariance_note;  // why sigma is missing, if it is
