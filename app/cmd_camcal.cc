@@ -29,16 +29,21 @@ namespace {
 struct CamcalArgs {
   std::string left, right, target, out;
   int distortion = 5;
-  std::string loss = "huber";
+  std::string loss = "none";
   double loss_scale_px = 3.0;
+  // Outlier rejection threshold (CalibrationOptions::reject_sigma; 0 = off).
+  double reject_sigma = CalibrationOptions().reject_sigma;
   // Distortion regulariser weight (CalibrationOptions::regularization).
   double regularization = CalibrationOptions().regularization;
+  // mrcal's lens regulariser weight (CalibrationOptions::lens_regularization).
+  double lens_regularization = CalibrationOptions().lens_regularization;
   // Projection uncertainty: distance (target units; 0 = infinity) and the
   // valid-intrinsics threshold (px).
   double uncertainty_distance = 0;
   double valid_threshold_px = 1.0;
   std::string out_cameramodel;  // PREFIX: PREFIX-<camera>.cameramodel
   bool tiny_board = false;      // skip the board-in-metres checks
+  bool board_warp = CalibrationOptions().board_warp;
   bool json = false;
 };
 
@@ -74,6 +79,18 @@ CalibrationOptions ResolveOptions(const CamcalArgs& args) {
                      ": expected a weight >= 0 (0 = none)");
   }
   options.regularization = args.regularization;
+  if (args.lens_regularization < 0) {
+    throw InputError("--regularize-lens " +
+                     std::to_string(args.lens_regularization) +
+                     ": expected a weight >= 0 (0 = none)");
+  }
+  options.lens_regularization = args.lens_regularization;
+  if (args.reject_sigma < 0) {
+    throw InputError("--reject-sigma " + std::to_string(args.reject_sigma) +
+                     ": expected a threshold >= 0 (0 = no rejection)");
+  }
+  options.reject_sigma = args.reject_sigma;
+  options.board_warp = args.board_warp;
   if (args.loss == "huber") {
     options.loss = CalibrationOptions::Loss::kHuber;
   } else if (args.loss == "cauchy") {
@@ -211,7 +228,11 @@ nlohmann::json CameraJson(const CalibrationSummary& sum, size_t c) {
       {"opencv_rms_px", cs.opencv_rms_px},
       {"views_used", cs.num_views},
       {"points", cs.num_points},
+      {"rejected_corners", cs.rejected_corners},
+      {"rejected_views", cs.rejected_views},
       {"holdout_rms_px", Nullable(cs.holdout_rms_px)},
+      {"half_diff_focus_radius_px", Nullable(cs.half_diff_focus_radius_px)},
+      {"half_diff_focus_rms_px", Nullable(cs.half_diff_focus_rms_px)},
       {"half_diff_rms_px", Nullable(cs.half_diff_rms_px)},
       {"half_diff_max_px", Nullable(cs.half_diff_max_px)},
       {"cam_from_rig", PoseJson(sum.rig.cameras[c].cam_from_rig)}};
@@ -269,6 +290,23 @@ void WriteCameraModels(const CamcalArgs& args, const CalibrationSummary& sum) {
   }
 }
 
+// The outlier rejection's settings and outcome over all cameras.
+nlohmann::json OutlierRejectionJson(const CamcalArgs& args,
+                                    const CalibrationSummary& sum) {
+  int corners = 0, views = 0;
+  for (const CameraCalibrationSummary& cs : sum.cameras) {
+    corners += cs.rejected_corners;
+    views += cs.rejected_views;
+  }
+  return {{"reject_sigma", args.reject_sigma},
+          {"trigger_sigma",
+           args.reject_sigma * CalibrationOptions().reject_trigger},
+          {"rounds", sum.rejection_rounds},
+          {"sigma_px", Nullable(sum.rejection_sigma_px)},
+          {"corners", corners},
+          {"views", views}};
+}
+
 nlohmann::json SummaryJson(const CamcalArgs& args, const CalibTargetSpec& spec,
                            const CalibrationProblem& problem,
                            const std::vector<std::vector<std::string>>& files,
@@ -291,9 +329,12 @@ nlohmann::json SummaryJson(const CamcalArgs& args, const CalibTargetSpec& spec,
   j["converged"] = sum.converged;
   j["iterations"] = sum.iterations;
   j["regularization"] = {{"weight", args.regularization},
+                         {"lens_weight", args.lens_regularization},
                          {"cost", sum.regularization_cost},
                          {"share", sum.regularization_share}};
   j["residual_sigma_px"] = sum.residual_sigma_px;
+  j["outlier_rejection"] = OutlierRejectionJson(args, sum);
+  if (args.board_warp) j["board_warp"] = sum.board_warp;
   j["seconds"] = sum.seconds;
   if (!sum.covariance_note.empty()) j["covariance_note"] = sum.covariance_note;
   nlohmann::json cams = nlohmann::json::array();
@@ -329,8 +370,11 @@ void PrintSummary(const CamcalArgs& args, const CalibTargetSpec& spec,
   std::printf("  Ceres: %s after %d iterations, %.2f s\n",
               sum.termination.c_str(), sum.iterations, sum.seconds);
   if (sum.regularization_cost > 0) {
-    std::printf("  k4..k6 regulariser: weight %g, %.3g of the cost\n",
-                options.regularization, sum.regularization_share);
+    std::printf(
+        "  regularisers: k4..k6 weight %g, lens weight %g; %.3g of the "
+        "cost\n",
+        options.regularization, options.lens_regularization,
+        sum.regularization_share);
   }
   for (size_t c = 0; c < nc; ++c) {
     const CameraCalibrationSummary& cs = sum.cameras[c];
@@ -349,10 +393,17 @@ void PrintSummary(const CamcalArgs& args, const CalibTargetSpec& spec,
         "%.3f px, %d outliers\n",
         cs.num_views, cs.num_points, cs.rms_px, cs.opencv_rms_px, cs.max_px,
         cs.outliers);
+    if (options.reject_sigma > 0) {
+      std::printf(
+          "    outlier rejection (%g sigma): %d corners, %d views dropped\n",
+          options.reject_sigma, cs.rejected_corners, cs.rejected_views);
+    }
     std::printf(
-        "    cross-validation: held-out RMS %.4f px, even/odd "
-        "projection difference RMS %.3f px (max %.3f)\n",
-        cs.holdout_rms_px, cs.half_diff_rms_px, cs.half_diff_max_px);
+        "    cross-validation: held-out RMS %.4f px (inliers), even/odd "
+        "projection difference RMS %.3f px within %.0f px of the centre, "
+        "%.3f px over the image (max %.3f)\n",
+        cs.holdout_rms_px, cs.half_diff_focus_rms_px,
+        cs.half_diff_focus_radius_px, cs.half_diff_rms_px, cs.half_diff_max_px);
     double worst = 0;
     size_t worst_v = 0;
     for (size_t v = 0; v < cs.view_rms_px.size(); ++v) {
@@ -374,6 +425,10 @@ void PrintSummary(const CamcalArgs& args, const CalibTargetSpec& spec,
           u.centre_px, u.corner_px[0], u.corner_px[1], u.corner_px[2],
           u.corner_px[3]);
     }
+  }
+  if (options.board_warp) {
+    std::printf("  board warp (x, y): %.5g %.5g target units\n",
+                sum.board_warp[0], sum.board_warp[1]);
   }
   if (nc == 2) {
     std::printf("  baseline %.4f +- %.4f (target units)\n", sum.baseline,
@@ -438,8 +493,16 @@ void AddCamcalCommand(CLI::App& app, Runner* run) {
   sub->add_option("--regularize", args->regularization,
                   "distortion regulariser weight, mrcal-style (default "
                   "0.005; 0 = none)");
+  sub->add_option("--regularize-lens", args->lens_regularization,
+                  "mrcal's lens regulariser (distortion toward 0, principal "
+                  "point toward the image centre), weight relative to "
+                  "mrcal's (default 1; 0 = none)");
   sub->add_option("--loss", args->loss,
-                  "robust loss: huber (default), cauchy or none");
+                  "loss on each corner: none (default, least squares on the "
+                  "inliers), huber or cauchy");
+  sub->add_option("--reject-sigma", args->reject_sigma,
+                  "outlier rejection: drop corners beyond this many sigma "
+                  "of the residuals, mrcal-style (default 4; 0 = none)");
   sub->add_option("--loss-scale", args->loss_scale_px,
                   "robust loss scale, px (default 3)");
   sub->add_option("--uncertainty-distance", args->uncertainty_distance,
@@ -455,6 +518,10 @@ void AddCamcalCommand(CLI::App& app, Runner* run) {
                 "the board really is this small (sizes in mm): skip the "
                 "board-in-metres checks (a square or tag under 1 mm, the "
                 "board seen within 20 mm, a baseline under 1 mm)");
+  sub->add_flag("--board-warp,!--no-board-warp", args->board_warp,
+                "estimate the board's deflection (mrcal's 2-parameter "
+                "paraboloid, target units; default on, --no-board-warp for a "
+                "flat board)");
   sub->add_flag("--json", args->json, "print one JSON object");
   sub->footer(HelpFooter(
       "Example: stereo rig from a 9x6 chessboard with 25 mm squares:\n  kincal "

@@ -4,8 +4,9 @@
 Runs where mrcal is installed (Debian: apt-get install mrcal python3-mrcal;
 the script needs the system python3 that has the mrcal module, and cv2).
 
-1. Projection uncertainty. `kincal camcal --loss none` (plain least squares)
-   reports mrcal's projection uncertainty (worst-direction 1-sigma, points at
+1. Projection uncertainty. `kincal camcal --loss none --reject-sigma 0
+   --no-board-warp --regularize-lens 0` (plain least squares) reports mrcal's projection
+   uncertainty (worst-direction 1-sigma, points at
    infinity) at the image centre and corners. The same corners (OpenCV's
    findChessboardCorners + cornerSubPix 11x11, as kincal detects them) are
    solved by mrcal.optimize without regularisation or outlier rejection,
@@ -45,6 +46,7 @@ def run_kincal(kincal, data, out_dir, distance):
            "--left", os.path.join(data, "left*.jpg"),
            "--right", os.path.join(data, "right*.jpg"),
            "--target", "chessboard:9x6:1", "--loss", "none",
+           "--reject-sigma", "0", "--no-board-warp", "--regularize-lens", "0",
            "--out", os.path.join(out_dir, "rig.yaml"),
            "--out-cameramodel", os.path.join(out_dir, "kincal"), "--json"]
     out = subprocess.run(cmd, check=True, capture_output=True, text=True)
@@ -248,8 +250,10 @@ def main():
     args = parser.parse_args()
     with tempfile.TemporaryDirectory() as out_dir:
         summary = run_kincal(args.kincal, args.data, out_dir, args.distance)
-        print("kincal camcal --loss none: RMS %.4f px, residual sigma %.4f px "
-              "(per coordinate, dof-corrected)" %
+        print("kincal camcal --loss none --reject-sigma 0 --no-board-warp "
+              "--regularize-lens 0: "
+              "RMS %.4f px, residual sigma %.4f px (per coordinate, "
+              "dof-corrected)" %
               (summary["rms_px"], summary["residual_sigma_px"]))
         print("points at %s" % ("infinity" if args.distance == 0 else
                                 "%g squares" % args.distance))

@@ -2,8 +2,9 @@
 """kincal's regularised 8-coefficient model against mrcal's OPENCV8.
 
 Runs where mrcal is installed (see bench/mrcal_compare.py). `kincal camcal
---distortion 8 --loss none` (plain least squares plus kincal's k4..k6
-regulariser) on OpenCV's stereo pairs; then mrcal.optimize with mrcal's own
+--distortion 8 --loss none --reject-sigma 0 --no-board-warp` (plain least
+squares plus
+kincal's k4..k6 regulariser) on OpenCV's stereo pairs; then mrcal.optimize with mrcal's own
 regularisation on the same corners (no outlier rejection), seeded by
 kincal's solution. Prints fx, cx, cy and the distortion of both.
 
@@ -35,7 +36,8 @@ def main():
     with tempfile.TemporaryDirectory() as out_dir:
         cmd = [args.kincal, "camcal", "--left", args.data + "/left*.jpg",
                "--right", args.data + "/right*.jpg", "--target",
-               "chessboard:9x6:1", "--loss", "none", "--distortion", "8",
+               "chessboard:9x6:1", "--loss", "none", "--reject-sigma", "0",
+               "--no-board-warp", "--distortion", "8",
                "--out", os.path.join(out_dir, "rig.yaml"), "--json"]
         summary = json.loads(subprocess.run(
             cmd, check=True, capture_output=True, text=True).stdout)

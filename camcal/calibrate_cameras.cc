@@ -13,6 +13,7 @@
 #include <sstream>
 #include <utility>
 
+#include "camcal/board_warp.h"
 #include "camcal/cost_functions.h"
 #include "data/error.h"
 
@@ -50,6 +51,11 @@ struct State {
   std::vector<PoseBlock> cam_from_rig;     // per camera; [0] = identity
   std::vector<PoseBlock> rig_from_target;  // per view
   std::vector<bool> view_used;
+  std::array<double, 2> board_warp{0.0, 0.0};  // warp_x, warp_y
+  BoardExtent board_extent;  // of every target point of the problem
+  // Per camera: the image centre ((width - 1) / 2, (height - 1) / 2), px,
+  // where the lens regulariser pulls the principal point.
+  std::vector<Eigen::Vector2d> image_centre;
 };
 
 bool UsableObservation(const TargetObservation& obs,
@@ -124,7 +130,18 @@ State Initialize(const CalibrationProblem& problem,
   s.cam_from_rig.resize(nc);
   s.rig_from_target.resize(nv);
   s.view_used.assign(nv, false);
+  for (const CameraIntrinsics& cam : problem.cameras) {
+    s.image_centre.emplace_back((cam.width - 1) / 2.0, (cam.height - 1) / 2.0);
+  }
   opencv_rms->assign(nc, kNaN);
+  std::vector<Eigen::Vector3d> all_points;
+  for (const CalibrationView& view : problem.views) {
+    for (const TargetObservation& obs : view.observations) {
+      all_points.insert(all_points.end(), obs.p_in_target.begin(),
+                        obs.p_in_target.end());
+    }
+  }
+  s.board_extent = BoardExtent::Of(all_points);
   // cam_from_target[c][v], valid where seen[c][v].
   std::vector<std::vector<Rigid3>> cam_from_target(nc, std::vector<Rigid3>(nv));
   std::vector<std::vector<bool>> seen(nc, std::vector<bool>(nv, false));
@@ -240,12 +257,41 @@ State Initialize(const CalibrationProblem& problem,
   return s;
 }
 
+// The reprojection cost of one target point seen by camera c, flat or warped.
+ceres::CostFunction* PointCost(const Eigen::Vector3d& p_in_target,
+                               const Eigen::Vector2d& pixel, size_t c,
+                               bool warp, const State& s) {
+  if (warp) {
+    return c == 0 ? WarpedTargetReprojectionError::Create(p_in_target, pixel,
+                                                          s.board_extent)
+                  : WarpedRigTargetReprojectionError::Create(p_in_target, pixel,
+                                                             s.board_extent);
+  }
+  return c == 0 ? TargetReprojectionError::Create(p_in_target, pixel)
+                : RigTargetReprojectionError::Create(p_in_target, pixel);
+}
+
+// PointCost's parameter blocks, in its order.
+std::vector<double*> PointBlocks(size_t c, size_t v, bool warp, State* s) {
+  std::vector<double*> blocks = {s->intrinsics[c].data()};
+  if (c > 0) {
+    blocks.push_back(s->cam_from_rig[c].q.data());
+    blocks.push_back(s->cam_from_rig[c].t.data());
+  }
+  blocks.push_back(s->rig_from_target[v].q.data());
+  blocks.push_back(s->rig_from_target[v].t.data());
+  if (warp) blocks.push_back(s->board_warp.data());
+  return blocks;
+}
+
 // Adds every usable observation of the used views to `problem`. Camera
-// blocks are held constant unless `refine_cameras`.
+// blocks are held constant unless `refine_cameras`; the board warp is
+// estimated only when refining the cameras with options.board_warp.
 int BuildProblem(const std::vector<CalibrationView>& views,
                  const CalibrationOptions& options, bool refine_cameras,
                  State* s, ceres::Problem* problem) {
   const size_t nc = s->intrinsics.size();
+  const bool warp = options.board_warp && refine_cameras;
   int num_points = 0;
   for (size_t v = 0; v < views.size(); ++v) {
     if (!s->view_used[v]) continue;
@@ -254,24 +300,15 @@ int BuildProblem(const std::vector<CalibrationView>& views,
       const TargetObservation& obs = views[v].observations[c];
       if (!UsableObservation(obs, options)) continue;
       for (size_t i = 0; i < obs.pixels.size(); ++i) {
-        if (c == 0) {
-          problem->AddResidualBlock(TargetReprojectionError::Create(
-                                        obs.p_in_target[i], obs.pixels[i]),
-                                    MakeLoss(options).release(),
-                                    s->intrinsics[c].data(), pose.q.data(),
-                                    pose.t.data());
-        } else {
-          problem->AddResidualBlock(
-              RigTargetReprojectionError::Create(obs.p_in_target[i],
-                                                 obs.pixels[i]),
-              MakeLoss(options).release(), s->intrinsics[c].data(),
-              s->cam_from_rig[c].q.data(), s->cam_from_rig[c].t.data(),
-              pose.q.data(), pose.t.data());
-        }
+        problem->AddResidualBlock(
+            PointCost(obs.p_in_target[i], obs.pixels[i], c, warp, *s),
+            MakeLoss(options).release(), PointBlocks(c, v, warp, s));
         ++num_points;
       }
     }
-    problem->SetManifold(pose.q.data(), new ceres::EigenQuaternionManifold);
+    if (problem->HasParameterBlock(pose.q.data())) {
+      problem->SetManifold(pose.q.data(), new ceres::EigenQuaternionManifold);
+    }
   }
   for (size_t c = 0; c < nc; ++c) {
     double* intr = s->intrinsics[c].data();
@@ -289,7 +326,7 @@ int BuildProblem(const std::vector<CalibrationView>& views,
                              new ceres::SubsetManifold(kNumIntrinsics, fixed));
       }
     }
-    if (c > 0) {
+    if (c > 0 && problem->HasParameterBlock(s->cam_from_rig[c].q.data())) {
       problem->SetManifold(s->cam_from_rig[c].q.data(),
                            new ceres::EigenQuaternionManifold);
       if (!refine_cameras) {
@@ -301,47 +338,101 @@ int BuildProblem(const std::vector<CalibrationView>& views,
   return num_points;
 }
 
-// Adds the rational-term regulariser of every camera (RationalDistortion-
-// RegularizationError) to `problem`; returns per camera its scale s (0 when
-// none is added: regularisation off, a model without k4..k6, or a camera
-// that saw nothing).
-std::vector<double> AddDistortionRegularizer(
+// Pixel residual coordinates (2 per corner) of camera c in the used views.
+int NumPixelResiduals(const std::vector<CalibrationView>& views,
+                      const CalibrationOptions& options, const State& s,
+                      size_t c) {
+  int num = 0;
+  for (size_t v = 0; v < views.size(); ++v) {
+    const TargetObservation& obs = views[v].observations[c];
+    if (s.view_used[v] && UsableObservation(obs, options)) {
+      num += 2 * static_cast<int>(obs.pixels.size());
+    }
+  }
+  return num;
+}
+
+// The scales of one camera's regularisers (0 = that regulariser is off).
+struct RegularizationScales {
+  double rational = 0;    // k4..k6 (RationalDistortionRegularizationError)
+  double distortion = 0;  // every coefficient (LensRegularizationError)
+  double centre = 0;      // principal point, per px (LensRegularizationError)
+};
+
+// mrcal's sizing of its lens regularisation (measured from
+// mrcal.optimizer_callback: identical scales): the distortion terms and the
+// principal-point terms each cost 0.25 % of the cost of 0.1 px errors on
+// every pixel residual when the coefficients are 0.2 and the principal
+// point is 50 px off centre:
+//   distortion_scale^2 = w * N * 0.0025 * 0.1^2 / (n_distortion * 0.2^2)
+//   centre_scale^2     = w * N * 0.0025 * 0.1^2 / (2 * 50^2)
+// with N the camera's pixel residuals and w = options.lens_regularization.
+constexpr double kLensRegularizationShare = 0.0025;
+constexpr double kNormalPixelErrorPx = 0.1;
+constexpr double kNormalDistortion = 0.2;
+constexpr double kNormalCentreOffsetPx = 50.0;
+
+// Adds every camera's regularisers to `problem`: the rational-term one
+// (options.regularization, 8-coefficient model) and mrcal's lens
+// regulariser (options.lens_regularization); returns their scales per
+// camera (all 0 for a camera that saw nothing).
+std::vector<RegularizationScales> AddRegularizers(
     const std::vector<CalibrationView>& views,
     const CalibrationOptions& options, State* s, ceres::Problem* problem) {
-  using Regularizer = RationalDistortionRegularizationError;
+  using Rational = RationalDistortionRegularizationError;
   const size_t nc = s->intrinsics.size();
-  std::vector<double> scale(nc, 0.0);
-  if (options.regularization <= 0 ||
-      kK1 + options.num_distortion <= Regularizer::kK4) {
-    return scale;
-  }
+  std::vector<RegularizationScales> scales(nc);
+  const bool rational = options.regularization > 0 &&
+                        kK1 + options.num_distortion > Rational::kK4;
+  const bool lens = options.lens_regularization > 0;
   for (size_t c = 0; c < nc; ++c) {
     double* intrinsics = s->intrinsics[c].data();
     if (!problem->HasParameterBlock(intrinsics)) continue;
-    int num_pixel_residuals = 0;
-    for (size_t v = 0; v < views.size(); ++v) {
-      const TargetObservation& obs = views[v].observations[c];
-      if (s->view_used[v] && UsableObservation(obs, options)) {
-        num_pixel_residuals += 2 * static_cast<int>(obs.pixels.size());
-      }
+    const double num = NumPixelResiduals(views, options, *s, c);
+    if (rational) {
+      scales[c].rational =
+          std::sqrt(options.regularization * num / Rational::kNumRational);
+      problem->AddResidualBlock(Rational::Create(scales[c].rational), nullptr,
+                                intrinsics);
     }
-    scale[c] = std::sqrt(options.regularization * num_pixel_residuals /
-                         Regularizer::kNumRational);
-    problem->AddResidualBlock(Regularizer::Create(scale[c]), nullptr,
-                              intrinsics);
+    if (!lens) continue;
+    const double pixel_cost = options.lens_regularization * num *
+                              kLensRegularizationShare * kNormalPixelErrorPx *
+                              kNormalPixelErrorPx;
+    if (options.num_distortion > 0) {
+      scales[c].distortion =
+          std::sqrt(pixel_cost / (options.num_distortion * kNormalDistortion *
+                                  kNormalDistortion));
+    }
+    scales[c].centre = std::sqrt(
+        pixel_cost / (2 * kNormalCentreOffsetPx * kNormalCentreOffsetPx));
+    problem->AddResidualBlock(
+        LensRegularizationError::Create(scales[c].distortion, scales[c].centre,
+                                        s->image_centre[c].x(),
+                                        s->image_centre[c].y()),
+        nullptr, intrinsics);
   }
-  return scale;
+  return scales;
 }
 
-// The regulariser's part of the final cost: 1/2 s_c^2 |k4..k6 of c|^2.
-double RegularizationCost(const State& s, const std::vector<double>& scale) {
+// The regularisers' part of the final cost.
+double RegularizationCost(const State& s,
+                          const std::vector<RegularizationScales>& scales) {
   double cost = 0;
-  for (size_t c = 0; c < s.intrinsics.size(); ++c) {
-    for (int i = RationalDistortionRegularizationError::kK4; i < kNumIntrinsics;
-         ++i) {
-      const double r = scale[c] * s.intrinsics[c][i];
+  for (size_t c = 0; c < scales.size(); ++c) {
+    const std::array<double, kNumIntrinsics>& intr = s.intrinsics[c];
+    for (int i = kK1; i < kNumIntrinsics; ++i) {
+      const double r = scales[c].distortion * intr[i];
       cost += 0.5 * r * r;
     }
+    for (int i = RationalDistortionRegularizationError::kK4; i < kNumIntrinsics;
+         ++i) {
+      const double r = scales[c].rational * intr[i];
+      cost += 0.5 * r * r;
+    }
+    const double dx = scales[c].centre * (intr[kCx] - s.image_centre[c].x());
+    const double dy = scales[c].centre * (intr[kCy] - s.image_centre[c].y());
+    cost += 0.5 * (dx * dx + dy * dy);
   }
   return cost;
 }
@@ -361,6 +452,8 @@ ceres::Solver::Options SolverOptions(const CalibrationOptions& options) {
 // Point residuals (pixel error norms) per camera and view.
 struct Residuals {
   std::vector<std::vector<std::vector<double>>> norms;  // [c][v][point]
+  // projected - detected, [c][v][point]; NaN behind the camera.
+  std::vector<std::vector<std::vector<Eigen::Vector2d>>> errors;
   // Detected pixel and residual vector (projected - detected) of every
   // point with a finite residual: [c] -> (pixel, residual).
   std::vector<std::vector<std::pair<Eigen::Vector2d, Eigen::Vector2d>>> vectors;
@@ -371,6 +464,7 @@ Residuals ComputeResiduals(const std::vector<CalibrationView>& views,
   const size_t nc = s.intrinsics.size();
   Residuals r;
   r.norms.assign(nc, std::vector<std::vector<double>>(views.size()));
+  r.errors.assign(nc, std::vector<std::vector<Eigen::Vector2d>>(views.size()));
   r.vectors.resize(nc);
   for (size_t v = 0; v < views.size(); ++v) {
     if (!s.view_used[v]) continue;
@@ -381,14 +475,17 @@ Residuals ComputeResiduals(const std::vector<CalibrationView>& views,
       const Rigid3 cam_from_target =
           s.cam_from_rig[c].ToRigid3() * rig_from_target;
       for (size_t i = 0; i < obs.pixels.size(); ++i) {
-        const Eigen::Vector3d p_in_cam = cam_from_target * obs.p_in_target[i];
+        const Eigen::Vector3d p_in_cam =
+            cam_from_target * WarpedPoint(obs.p_in_target[i], s.board_extent,
+                                          s.board_warp.data());
         Eigen::Vector2d px;
-        double err = kNaN;
+        Eigen::Vector2d error(kNaN, kNaN);
         if (ProjectPoint(s.intrinsics[c].data(), p_in_cam.data(), px.data())) {
-          err = (px - obs.pixels[i]).norm();
-          r.vectors[c].emplace_back(obs.pixels[i], px - obs.pixels[i]);
+          error = px - obs.pixels[i];
+          r.vectors[c].emplace_back(obs.pixels[i], error);
         }
-        r.norms[c][v].push_back(err);
+        r.norms[c][v].push_back(error.norm());
+        r.errors[c][v].push_back(error);
       }
     }
   }
@@ -507,6 +604,8 @@ void CalibrationOptions::Check() const {
   Require(max_iterations > 0, "calibration: max_iterations must be > 0");
   Require(max_rms_px > 0, "calibration: max_rms_px must be > 0");
   Require(regularization >= 0, "calibration: regularization must be >= 0");
+  Require(lens_regularization >= 0,
+          "calibration: lens_regularization must be >= 0");
   Require(uncertainty.distance > 0,
           "calibration: the uncertainty distance must be > 0");
   Require(uncertainty.valid_threshold_px > 0,
@@ -553,45 +652,64 @@ std::vector<double> HeldOutRmsPx(const Rig& rig,
   return rms;
 }
 
-std::pair<double, double> ProjectionDifferencePx(const CameraIntrinsics& a,
-                                                 const CameraIntrinsics& b) {
-  const int nx = 32, ny = 24;
-  std::vector<Eigen::Vector3d> rays;
+ProjectionDifference ProjectionDifferenceOf(const CameraIntrinsics& a,
+                                            const CameraIntrinsics& b,
+                                            double focus_radius_px,
+                                            int grid_width) {
+  ProjectionDifference out;
+  out.focus_radius_px =
+      focus_radius_px > 0 ? focus_radius_px : std::min(a.width, a.height) / 3.0;
+  // mrcal.sample_imager: grid_width columns over 0..width-1, rows in
+  // proportion over 0..height-1.
+  const int nx = std::max(grid_width, 2);
+  const int ny = static_cast<int>(std::lround(static_cast<double>(a.height) /
+                                              a.width * (nx - 1))) +
+                 1;
+  const Eigen::Vector2d centre((a.width - 1) / 2.0, (a.height - 1) / 2.0);
   std::vector<Eigen::Vector2d> pixels;
+  std::vector<Eigen::Vector3d> rays_a, rays_b;
+  Eigen::Matrix3d correlation = Eigen::Matrix3d::Zero();
   for (int j = 0; j < ny; ++j) {
     for (int i = 0; i < nx; ++i) {
-      const Eigen::Vector2d px((a.width - 1) * (i + 0.5) / nx,
-                               (a.height - 1) * (j + 0.5) / ny);
-      rays.push_back(Unproject(a, px));
+      const Eigen::Vector2d px((a.width - 1) * i / (nx - 1.0),
+                               (a.height - 1) * j / std::max(ny - 1.0, 1.0));
+      const Eigen::Vector3d ray_a = Unproject(a, px);
+      const Eigen::Vector3d ray_b = Unproject(b, px);
+      if (!ray_a.allFinite() || !ray_b.allFinite()) continue;
       pixels.push_back(px);
+      rays_a.push_back(ray_a);
+      if ((px - centre).norm() <= out.focus_radius_px) {
+        correlation += ray_b * ray_a.transpose();
+      }
     }
   }
-  const std::array<double, kNumIntrinsics> intr_b = b.ToArray();
-  double rotation_aa[3] = {0, 0, 0};
-  ceres::Problem problem;
-  for (size_t k = 0; k < rays.size(); ++k) {
-    problem.AddResidualBlock(
-        RotatedRayError::Create(rays[k], pixels[k], intr_b), nullptr,
-        rotation_aa);
-  }
-  ceres::Solver::Options options;
-  options.linear_solver_type = ceres::DENSE_QR;
-  options.logging_type = ceres::SILENT;
-  ceres::Solver::Summary summary;
-  ceres::Solve(options, &problem, &summary);
-  double ss = 0, max = 0;
-  int n = 0;
-  for (size_t k = 0; k < rays.size(); ++k) {
-    Eigen::Vector3d p_in_b;
-    ceres::AngleAxisRotatePoint(rotation_aa, rays[k].data(), p_in_b.data());
-    const Eigen::Vector2d px = Project(b, p_in_b);
+  // b_from_a = argmin sum |R ray_a - ray_b|^2 over the focus (Kabsch).
+  const Eigen::JacobiSVD<Eigen::Matrix3d> svd(
+      correlation, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  Eigen::Matrix3d sign = Eigen::Matrix3d::Identity();
+  sign(2, 2) = (svd.matrixU() * svd.matrixV().transpose()).determinant() < 0
+                   ? -1.0
+                   : 1.0;
+  const Eigen::Matrix3d b_from_a =
+      svd.matrixU() * sign * svd.matrixV().transpose();
+  double ss = 0, ss_focus = 0;
+  int n = 0, n_focus = 0;
+  for (size_t k = 0; k < pixels.size(); ++k) {
+    const Eigen::Vector2d px = Project(b, b_from_a * rays_a[k]);
     if (!px.allFinite()) continue;
     const double e = (px - pixels[k]).norm();
     ss += e * e;
-    max = std::max(max, e);
+    out.max_px = std::max(out.max_px, e);
     ++n;
+    if ((pixels[k] - centre).norm() <= out.focus_radius_px) {
+      ss_focus += e * e;
+      ++n_focus;
+    }
   }
-  return {n ? std::sqrt(ss / n) : kNaN, n ? max : kNaN};
+  out.rms_px = n ? std::sqrt(ss / n) : kNaN;
+  out.focus_rms_px = n_focus ? std::sqrt(ss_focus / n_focus) : kNaN;
+  if (n == 0) out.max_px = kNaN;
+  return out;
 }
 
 namespace {
@@ -722,53 +840,175 @@ void CrossValidateHalves(const CalibrationProblem& input,
   try {
     const CalibrationSummary a = CalibrateCameras(half[0], sub);
     const CalibrationSummary b = CalibrateCameras(half[1], sub);
-    const std::vector<double> a_on_b = HeldOutRmsPx(a.rig, half[1].views, sub);
-    const std::vector<double> b_on_a = HeldOutRmsPx(b.rig, half[0].views, sub);
+    // Held out on the inliers of the other half's own solve.
+    const std::vector<double> a_on_b = HeldOutRmsPx(a.rig, b.inlier_views, sub);
+    const std::vector<double> b_on_a = HeldOutRmsPx(b.rig, a.inlier_views, sub);
     for (size_t c = 0; c < nc; ++c) {
       out->cameras[c].holdout_rms_px =
           std::sqrt(0.5 * (a_on_b[c] * a_on_b[c] + b_on_a[c] * b_on_a[c]));
-      const auto diff = ProjectionDifferencePx(a.rig.cameras[c].intrinsics,
-                                               b.rig.cameras[c].intrinsics);
-      out->cameras[c].half_diff_rms_px = diff.first;
-      out->cameras[c].half_diff_max_px = diff.second;
+      const ProjectionDifference diff = ProjectionDifferenceOf(
+          a.rig.cameras[c].intrinsics, b.rig.cameras[c].intrinsics,
+          options.half_diff_focus_radius_px);
+      CameraCalibrationSummary& cs = out->cameras[c];
+      cs.half_diff_focus_radius_px = diff.focus_radius_px;
+      cs.half_diff_focus_rms_px = diff.focus_rms_px;
+      cs.half_diff_rms_px = diff.rms_px;
+      cs.half_diff_max_px = diff.max_px;
     }
   } catch (const InputError&) {
     // Too few views in a half: cross-validation figures stay NaN.
   }
 }
 
-}  // namespace
+// One refinement of all intrinsics, view poses and extrinsics on `views`,
+// starting from `s`, with the distortion regulariser.
+struct Refinement {
+  std::unique_ptr<ceres::Problem> problem;
+  ceres::Solver::Summary solver;
+  std::vector<RegularizationScales> regularization_scale;
+  int num_points = 0;
+};
 
-CalibrationSummary CalibrateCameras(const CalibrationProblem& input,
-                                    const CalibrationOptions& options) {
-  const auto start = std::chrono::steady_clock::now();
-  ValidateProblem(input, options);
-  const size_t nc = input.cameras.size();
-  const size_t nv = input.views.size();
+Refinement Refine(const std::vector<CalibrationView>& views,
+                  const CalibrationOptions& options, State* s) {
+  Refinement r;
+  r.problem = std::make_unique<ceres::Problem>();
+  r.num_points =
+      BuildProblem(views, options, /*refine_cameras=*/true, s, r.problem.get());
+  r.regularization_scale = AddRegularizers(views, options, s, r.problem.get());
+  ceres::Solve(SolverOptions(options), r.problem.get(), &r.solver);
+  return r;
+}
 
-  CalibrationSummary out;
-  std::vector<double> opencv_rms;
-  State s = Initialize(input, options, &opencv_rms);
+// Which corners of the problem's views the solve keeps: inlier[c][v][i];
+// dropped[c][v] when the whole observation is rejected; counts per camera.
+struct InlierMask {
+  std::vector<std::vector<std::vector<bool>>> inlier;
+  std::vector<std::vector<bool>> dropped;
+  std::vector<int> rejected_corners, rejected_views;
+};
 
-  ceres::Problem problem;
-  const int num_points = BuildProblem(input.views, options,
-                                      /*refine_cameras=*/true, &s, &problem);
-  const std::vector<double> regularization_scale =
-      AddDistortionRegularizer(input.views, options, &s, &problem);
-  ceres::Solver::Summary solver_summary;
-  ceres::Solve(SolverOptions(options), &problem, &solver_summary);
-  out.termination = TerminationName(solver_summary.termination_type);
-  out.converged = solver_summary.termination_type == ceres::CONVERGENCE;
-  out.iterations = static_cast<int>(solver_summary.iterations.size()) - 1;
-  out.initial_cost = solver_summary.initial_cost;
-  out.final_cost = solver_summary.final_cost;
-  out.regularization_cost = RegularizationCost(s, regularization_scale);
-  if (out.final_cost > 0) {
-    out.regularization_share = out.regularization_cost / out.final_cost;
+InlierMask AllInliers(const CalibrationProblem& problem) {
+  const size_t nc = problem.cameras.size();
+  InlierMask mask;
+  mask.inlier.resize(nc);
+  mask.dropped.assign(nc, std::vector<bool>(problem.views.size(), false));
+  mask.rejected_corners.assign(nc, 0);
+  mask.rejected_views.assign(nc, 0);
+  for (size_t c = 0; c < nc; ++c) {
+    for (const CalibrationView& view : problem.views) {
+      mask.inlier[c].emplace_back(view.observations[c].pixels.size(), true);
+    }
   }
+  return mask;
+}
 
-  // Rig and per-camera summaries.
-  const Residuals res = ComputeResiduals(input.views, options, s);
+// The views with only the inlier corners.
+std::vector<CalibrationView> InlierViews(
+    const std::vector<CalibrationView>& views, const InlierMask& mask) {
+  std::vector<CalibrationView> out;
+  for (size_t v = 0; v < views.size(); ++v) {
+    CalibrationView view;
+    view.label = views[v].label;
+    for (size_t c = 0; c < views[v].observations.size(); ++c) {
+      const TargetObservation& obs = views[v].observations[c];
+      TargetObservation kept;
+      for (size_t i = 0; i < obs.pixels.size(); ++i) {
+        if (!mask.inlier[c][v][i]) continue;
+        kept.p_in_target.push_back(obs.p_in_target[i]);
+        kept.pixels.push_back(obs.pixels[i]);
+      }
+      view.observations.push_back(std::move(kept));
+    }
+    out.push_back(std::move(view));
+  }
+  return out;
+}
+
+// RMS of the residual coordinates (x and y of every finite corner).
+double CoordinateSigma(const Residuals& r) {
+  double ss = 0;
+  int n = 0;
+  for (const auto& camera : r.errors) {
+    for (const auto& view : camera) {
+      for (const Eigen::Vector2d& e : view) {
+        if (!e.allFinite()) continue;
+        ss += e.squaredNorm();
+        n += 2;
+      }
+    }
+  }
+  return n ? std::sqrt(ss / n) : kNaN;
+}
+
+// One round of outlier rejection (CalibrationOptions::reject_sigma) on the
+// residuals `r` of InlierViews(views, *mask); returns whether a corner was
+// rejected.
+bool RejectOutliers(const std::vector<CalibrationView>& views,
+                    const Residuals& r, const CalibrationOptions& options,
+                    InlierMask* mask) {
+  const double sigma = CoordinateSigma(r);
+  const double limit = options.reject_sigma * sigma;
+  const double trigger = options.reject_trigger * limit;
+  auto beyond = [](const Eigen::Vector2d& e, double l) {
+    return e.allFinite() && (std::abs(e.x()) > l || std::abs(e.y()) > l);
+  };
+  bool triggered = false;
+  for (const auto& camera : r.errors) {
+    for (const auto& view : camera) {
+      for (const Eigen::Vector2d& e : view) triggered |= beyond(e, trigger);
+    }
+  }
+  if (!triggered) return false;
+  for (size_t c = 0; c < r.errors.size(); ++c) {
+    for (size_t v = 0; v < views.size(); ++v) {
+      std::vector<bool>& inlier = mask->inlier[c][v];
+      const std::vector<Eigen::Vector2d>& errors = r.errors[c][v];
+      if (mask->dropped[c][v] ||
+          errors.size() != static_cast<size_t>(std::count(
+                               inlier.begin(), inlier.end(), true))) {
+        continue;  // not in the solve (too few points)
+      }
+      size_t k = 0;
+      for (size_t i = 0; i < inlier.size(); ++i) {
+        if (!inlier[i]) continue;
+        if (beyond(errors[k++], limit)) {
+          inlier[i] = false;
+          ++mask->rejected_corners[c];
+        }
+      }
+      const size_t kept = std::count(inlier.begin(), inlier.end(), true);
+      if (2 * kept < inlier.size()) {
+        inlier.assign(inlier.size(), false);
+        mask->dropped[c][v] = true;
+        ++mask->rejected_views[c];
+      }
+    }
+  }
+  return true;
+}
+
+// A view stays used while some camera still has a usable observation of it.
+void UpdateViewsUsed(const std::vector<CalibrationView>& views,
+                     const CalibrationOptions& options, State* s) {
+  for (size_t v = 0; v < views.size(); ++v) {
+    bool usable = false;
+    for (const TargetObservation& obs : views[v].observations) {
+      usable |= UsableObservation(obs, options);
+    }
+    s->view_used[v] = s->view_used[v] && usable;
+  }
+}
+
+// Per camera: the solved intrinsics into the rig and the camera summary
+// (residual statistics over `views`); the overall RMS into out->rms_px.
+void SummarizeCameras(const CalibrationProblem& input,
+                      const std::vector<CalibrationView>& views,
+                      const CalibrationOptions& options, const State& s,
+                      const std::vector<double>& opencv_rms,
+                      const InlierMask& mask, CalibrationSummary* out) {
+  const size_t nc = input.cameras.size();
+  const Residuals res = ComputeResiduals(views, options, s);
   double ss_all = 0;
   int n_all = 0;
   for (size_t c = 0; c < nc; ++c) {
@@ -779,13 +1019,15 @@ CalibrationSummary CalibrateCameras(const CalibrationProblem& input,
     cam.intrinsics.width = input.cameras[c].width;
     cam.intrinsics.height = input.cameras[c].height;
     cam.cam_from_rig = c == 0 ? Rigid3() : s.cam_from_rig[c].ToRigid3();
-    out.rig.cameras.push_back(cam);
+    out->rig.cameras.push_back(cam);
 
     CameraCalibrationSummary cs;
     cs.intrinsics = cam.intrinsics;
     cs.opencv_rms_px = opencv_rms[c];
+    cs.rejected_corners = mask.rejected_corners[c];
+    cs.rejected_views = mask.rejected_views[c];
     std::vector<double> all;
-    for (size_t v = 0; v < nv; ++v) {
+    for (size_t v = 0; v < views.size(); ++v) {
       const std::vector<double>& e = res.norms[c][v];
       cs.view_rms_px.push_back(Rms(e));
       if (!e.empty()) ++cs.num_views;
@@ -803,27 +1045,75 @@ CalibrationSummary CalibrateCameras(const CalibrationProblem& input,
     for (double e : all) {
       if (e > options.outlier_factor * cs.rms_px) ++cs.outliers;
     }
-    out.cameras.push_back(cs);
+    out->cameras.push_back(cs);
   }
-  out.rms_px = n_all ? std::sqrt(ss_all / n_all) : kNaN;
+  out->rms_px = n_all ? std::sqrt(ss_all / n_all) : kNaN;
+  out->rejection_sigma_px = CoordinateSigma(res);
+}
+
+}  // namespace
+
+CalibrationSummary CalibrateCameras(const CalibrationProblem& input,
+                                    const CalibrationOptions& options) {
+  const auto start = std::chrono::steady_clock::now();
+  ValidateProblem(input, options);
+  const size_t nc = input.cameras.size();
+  const size_t nv = input.views.size();
+
+  CalibrationSummary out;
+  std::vector<double> opencv_rms;
+  State s = Initialize(input, options, &opencv_rms);
+
+  // Solve, reject outliers, solve again on the inliers until none is left.
+  InlierMask mask = AllInliers(input);
+  std::vector<CalibrationView> views = input.views;
+  Refinement refined = Refine(views, options, &s);
+  while (options.reject_sigma > 0 &&
+         out.rejection_rounds < options.max_rejection_rounds &&
+         RejectOutliers(views, ComputeResiduals(views, options, s), options,
+                        &mask)) {
+    ++out.rejection_rounds;
+    views = InlierViews(input.views, mask);
+    UpdateViewsUsed(views, options, &s);
+    refined = Refine(views, options, &s);
+  }
+  const ceres::Solver::Summary& solver_summary = refined.solver;
+  out.termination = TerminationName(solver_summary.termination_type);
+  out.converged = solver_summary.termination_type == ceres::CONVERGENCE;
+  out.iterations = static_cast<int>(solver_summary.iterations.size()) - 1;
+  out.initial_cost = solver_summary.initial_cost;
+  out.final_cost = solver_summary.final_cost;
+  out.regularization_cost = RegularizationCost(s, refined.regularization_scale);
+  if (out.final_cost > 0) {
+    out.regularization_share = out.regularization_cost / out.final_cost;
+  }
+
+  SummarizeCameras(input, views, options, s, opencv_rms, mask, &out);
   out.baseline = out.rig.BaselineMm();
   out.view_used = s.view_used;
+  out.board_warp = s.board_warp;
   for (size_t v = 0; v < nv; ++v) {
     out.rig_from_target.push_back(s.rig_from_target[v].ToRigid3());
   }
 
   // Residual variance per coordinate: sum r^2 / (m - n).
+  double ss_all = 0;
+  for (const CameraCalibrationSummary& cs : out.cameras) {
+    ss_all += cs.rms_px * cs.rms_px * cs.num_points;
+  }
   int num_free = 0;
   for (size_t v = 0; v < nv; ++v) num_free += s.view_used[v] ? 6 : 0;
   num_free += static_cast<int>(nc) * (4 + options.num_distortion);
   num_free += static_cast<int>(nc - 1) * 6;
-  const int dof = 2 * num_points - num_free;
+  if (options.board_warp) num_free += 2;
+  const int dof = 2 * refined.num_points - num_free;
   const double variance = dof > 0 ? ss_all / dof : kNaN;
   out.residual_sigma_px = std::sqrt(variance);
 
   if (options.compute_covariance && dof > 0) {
-    AddCovariance(s, variance, options, &problem, &out);
+    AddCovariance(s, variance, options, refined.problem.get(), &out);
   }
+  out.inlier_views = std::move(views);
   if (options.cross_validate) CrossValidateHalves(input, options, &out);
   out.seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start)

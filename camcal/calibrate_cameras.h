@@ -21,6 +21,7 @@
 // reprojection RMS, and (b) report the projection difference of the two
 // halves' intrinsics over the imager.
 
+#include <array>
 #include <limits>
 #include <string>
 #include <utility>
@@ -58,14 +59,27 @@ struct CalibrationOptions {
   // Distortion coefficients estimated: 0, 4 (k1 k2 p1 p2), 5 (+k3) or 8
   // (rational: +k4 k5 k6). Default 5, OpenCV's default model.
   int num_distortion = 5;
-  // Robust loss on each point's pixel error (x and y together, norm).
-  // Default Huber with scale 3 px: quadratic for every corner a sub-pixel
-  // detector can produce, linear for gross outliers (wrong corner, wrong
-  // tag). A smaller scale also down-weights the few 1-3 px corners of real
-  // data, which raised the held-out RMS on OpenCV's stereo set (1 px: 0.463
-  // / 0.510 px held-out vs 0.441 / 0.486 px at 3 px).
-  Loss loss = Loss::kHuber;
+  // Loss on each point's pixel error (x and y together, norm). Default none
+  // (plain least squares on the inliers that outlier rejection keeps, as
+  // mrcal): chosen by the even/odd cross-validation on OpenCV's stereo set
+  // (docs/CAMCAL.md, "Robust by default"). Huber / Cauchy remain options;
+  // loss_scale_px is their scale.
+  Loss loss = Loss::kTrivial;
   double loss_scale_px = 3.0;
+  // Outlier rejection (mrcal's criterion): after each solve, sigma = RMS of
+  // the inlier residual coordinates (x and y of every camera's corners);
+  // when some corner has |dx| or |dy| above reject_trigger * reject_sigma *
+  // sigma, every corner above reject_sigma * sigma is rejected and the
+  // problem solved again on the rest, until no corner passes the trigger or
+  // after max_rejection_rounds. An observation (camera, view) that loses
+  // more than half of its corners is dropped whole (a misdetected board).
+  // Default 4 sigma with the trigger at 5 sigma, mrcal's thresholds: with
+  // the board warp on, the setting whose even/odd halves agree best on
+  // OpenCV's stereo set, as well as mrcal's default (docs/CAMCAL.md,
+  // "Robust by default"). 0 = no rejection.
+  double reject_sigma = 4.0;
+  double reject_trigger = 1.25;
+  int max_rejection_rounds = 20;
   // An observation (one camera, one view) needs this many points to be used.
   int min_points_per_view = 6;
   // Each camera needs the target in at least this many views.
@@ -83,6 +97,14 @@ struct CalibrationOptions {
   // aims its regularisation at ~0.5 % of the cost); the 5-coefficient
   // default model has no k4..k6 and is unaffected.
   double regularization = 0.005;
+  // Weight of mrcal's lens regulariser (cost_functions.h,
+  // LensRegularizationError): every distortion coefficient pulled toward 0
+  // and the principal point toward the image centre, with mrcal's scales
+  // times this weight (1 = mrcal's; 0 = none). The data outside the area
+  // the boards covered do not pin the distortion polynomial; the pull
+  // keeps it from extrapolating wildly there. Default 1, as
+  // mrcal-calibrate-cameras (docs/CAMCAL.md, "Lens regularisation").
+  double lens_regularization = 1.0;
   // A final RMS point residual above this (px) is no calibration: the
   // target's size or layout does not match the images (SolveFailure).
   double max_rms_px = 10.0;
@@ -92,8 +114,18 @@ struct CalibrationOptions {
   // Distance, grid and valid-region threshold of the projection
   // uncertainty (default: points at infinity, 8 x 6 cells, 1 px).
   UncertaintyOptions uncertainty;
+  // Estimate mrcal's board deflection (camcal/board_warp.h: a paraboloid
+  // with two parameters, target units, shared by all views) with the rest.
+  // Default on, as mrcal-calibrate-cameras: printed boards are not flat to
+  // a fraction of a pixel, and on OpenCV's stereo set the halves agree
+  // better with it (docs/CAMCAL.md). The held-out RMS fits flat boards.
+  bool board_warp = true;
   // Run the even/odd cross-validation (needs 2 * min_views views per camera).
   bool cross_validate = true;
+  // Radius around the image centre of the half-vs-half projection
+  // difference's rotation fit and of its "focus" RMS, px; 0 = a third of
+  // the smaller image side (160 px at 640x480).
+  double half_diff_focus_radius_px = 0;
   // Points with a residual above this many times the camera's RMS are
   // counted as outliers in the summary (they are not removed).
   double outlier_factor = 5.0;
@@ -136,11 +168,17 @@ struct CameraCalibrationSummary {
   // Cross-validation (NaN when not run): held-out reprojection RMS, each
   // half's cameras on the other half's views with only the view pose fitted.
   double holdout_rms_px = std::numeric_limits<double>::quiet_NaN();
-  // Projection difference between the even-half and odd-half intrinsics over
-  // a 32x24 grid of the imager (rays at infinity, best common rotation
-  // removed, as mrcal's projection_diff): RMS and max.
+  // Projection difference between the even-half and odd-half intrinsics
+  // (ProjectionDifference): RMS within the focus radius of the centre, RMS
+  // and max over the whole image.
+  double half_diff_focus_radius_px = std::numeric_limits<double>::quiet_NaN();
+  double half_diff_focus_rms_px = std::numeric_limits<double>::quiet_NaN();
   double half_diff_rms_px = std::numeric_limits<double>::quiet_NaN();
   double half_diff_max_px = std::numeric_limits<double>::quiet_NaN();
+  // Outlier rejection: corners rejected one by one, and observations of
+  // this camera dropped whole (their remaining corners not counted above).
+  int rejected_corners = 0;
+  int rejected_views = 0;
 };
 
 struct CalibrationSummary {
@@ -159,11 +197,21 @@ struct CalibrationSummary {
   bool converged = false;
   int iterations = 0;
   double initial_cost = 0, final_cost = 0;
-  // Part of final_cost due to the distortion regulariser, and its share of
-  // final_cost (0 when the regulariser is off).
+  // Part of final_cost due to the regularisers (k4..k6 and the lens
+  // regulariser), and its share of final_cost (0 when they are off).
   double regularization_cost = 0;
   double regularization_share = 0;
   std::string covariance_note;  // why sigma is missing, if it is
+  // Board deflection (warp_x, warp_y, target units) when
+  // CalibrationOptions::board_warp; zeros otherwise.
+  std::array<double, 2> board_warp{0.0, 0.0};
+  // Outlier rejection: rounds of re-solving and the final residual sigma
+  // (RMS of the inlier coordinates, px) its thresholds are relative to.
+  int rejection_rounds = 0;
+  double rejection_sigma_px = std::numeric_limits<double>::quiet_NaN();
+  // The views as the final solve used them: the problem's views without
+  // the rejected corners and dropped observations.
+  std::vector<CalibrationView> inlier_views;
   // Per view: rig_from_target (NaN-free only for used views) and whether used.
   std::vector<Rigid3> rig_from_target;
   std::vector<bool> view_used;
@@ -191,11 +239,24 @@ std::vector<double> HeldOutRmsPx(const Rig& rig,
                                  const std::vector<CalibrationView>& views,
                                  const CalibrationOptions& options);
 
-// mrcal-style projection difference between two models of the same camera:
-// for a 32x24 grid of pixels of `a`, the ray at infinity is projected by `b`
-// after the rotation that best aligns the two (fitted); returns {rms, max} px.
-std::pair<double, double> ProjectionDifferencePx(const CameraIntrinsics& a,
-                                                 const CameraIntrinsics& b);
+// mrcal-style projection difference between two models of the same camera
+// (mrcal.projection_diff with use_uncertainties=False, rays at infinity):
+// a grid of pixels over the imager (grid_width columns, rows in proportion,
+// as mrcal.sample_imager) is unprojected by both models; the rotation that
+// best maps a's rays onto b's rays of the pixels within focus_radius_px of
+// the image centre is fitted (Procrustes on the unit vectors); each of a's
+// rays, rotated, is projected by b and compared with its pixel.
+struct ProjectionDifference {
+  double focus_radius_px = 0;  // the radius used
+  double focus_rms_px = 0;     // RMS over the pixels within the radius
+  double rms_px = 0;           // RMS over the whole grid
+  double max_px = 0;           // largest over the whole grid
+};
+// focus_radius_px <= 0: a third of the smaller image side.
+ProjectionDifference ProjectionDifferenceOf(const CameraIntrinsics& a,
+                                            const CameraIntrinsics& b,
+                                            double focus_radius_px = 0,
+                                            int grid_width = 60);
 
 }  // namespace kincal
 

@@ -9,6 +9,7 @@
 #include <random>
 #include <sstream>
 
+#include "camcal/board_warp.h"
 #include "data/error.h"
 #include "tests/testing/paths.h"
 
@@ -31,9 +32,10 @@ struct Synthetic {
 };
 
 // A stereo rig (baseline 120 mm) looking at a 10x7 board (30 mm squares) from
-// random poses, pixel noise sigma `noise_px`, seeded.
+// random poses, pixel noise sigma `noise_px`, seeded; the board deflected by
+// `warp` (camcal/board_warp.h, mm; the problem's target points stay flat).
 Synthetic MakeSynthetic(int num_cameras, int num_views, double noise_px,
-                        uint64_t seed) {
+                        uint64_t seed, std::array<double, 2> warp = {0, 0}) {
   Synthetic s;
   for (int c = 0; c < num_cameras; ++c) {
     Camera cam;
@@ -59,6 +61,7 @@ Synthetic MakeSynthetic(int num_cameras, int num_views, double noise_px,
   std::uniform_real_distribution<double> depth(600, 1100);
   std::normal_distribution<double> noise(0.0, noise_px);
   const std::vector<Eigen::Vector3d> board = Board(10, 7, 30.0);
+  const BoardExtent extent = BoardExtent::Of(board);
   while (static_cast<int>(s.problem.views.size()) < num_views) {
     Rigid3 rig_from_target;
     rig_from_target.R =
@@ -77,8 +80,10 @@ Synthetic MakeSynthetic(int num_cameras, int num_views, double noise_px,
     for (const Camera& cam : s.truth.cameras) {
       TargetObservation obs;
       for (const Eigen::Vector3d& p : board) {
-        const Eigen::Vector2d px =
-            Project(cam.intrinsics, cam.cam_from_rig * (rig_from_target * p));
+        const Eigen::Vector2d px = Project(
+            cam.intrinsics,
+            cam.cam_from_rig *
+                (rig_from_target * WarpedPoint(p, extent, warp.data())));
         all_inside = all_inside && px.x() > 0 && px.y() > 0 &&
                      px.x() < cam.intrinsics.width - 1 &&
                      px.y() < cam.intrinsics.height - 1;
@@ -113,7 +118,9 @@ TEST(CalibrateCameras, SyntheticStereoRecoversRigWithinSigma) {
     }
     EXPECT_EQ(cs.sigma[kK4], 0.0);  // not in the model
     EXPECT_EQ(cs.num_views, 16);
-    EXPECT_EQ(cs.num_points, 16 * 70);
+    // 4-sigma rejection takes hardly any Gaussian corner (< 1 %).
+    EXPECT_EQ(cs.num_points + cs.rejected_corners, 16 * 70);
+    EXPECT_LE(cs.rejected_corners, 16 * 70 / 100);
     // Held-out reprojection: noise plus a little for the fitted pose.
     EXPECT_GT(cs.holdout_rms_px, 0.9 * noise_px * std::sqrt(2.0) * 0.9);
     EXPECT_LT(cs.holdout_rms_px, 1.3 * noise_px * std::sqrt(2.0));
@@ -168,6 +175,8 @@ TEST(CalibrateCameras, ProjectionUncertaintyMatchesMonteCarlo) {
   fast.cross_validate = false;
   fast.compute_covariance = false;
   fast.loss = CalibrationOptions::Loss::kTrivial;
+  fast.reject_sigma = 0;  // plain least squares, as the prediction
+  fast.board_warp = false;
   const std::vector<Rigid3> truth_poses =
       CalibrateCameras(base.problem, fast).rig_from_target;
   std::mt19937_64 rng(5);
@@ -238,6 +247,8 @@ TEST(CalibrateCameras, RobustLossResistsOutliers) {
   ASSERT_GT(corrupted, 2);
   CalibrationOptions options;
   options.cross_validate = false;
+  options.reject_sigma = 0;  // the loss alone
+  options.loss = CalibrationOptions::Loss::kHuber;
   const CalibrationSummary robust = CalibrateCameras(syn.problem, options);
   options.loss = CalibrationOptions::Loss::kTrivial;
   const CalibrationSummary plain = CalibrateCameras(syn.problem, options);
@@ -260,6 +271,110 @@ TEST(CalibrateCameras, RobustLossResistsOutliers) {
   EXPECT_GT(std::abs(plain.rig.cameras[0].intrinsics.fx - truth_fx),
             10 * std::abs(robust.rig.cameras[0].intrinsics.fx - truth_fx));
   EXPECT_GE(robust.cameras[0].outliers, corrupted);
+}
+
+// The default (least squares with 4-sigma outlier rejection) finds every
+// corrupted corner (and maybe a Gaussian one, as on clean data) and lands
+// where the clean data does.
+TEST(CalibrateCameras, OutlierRejectionFindsTheCorruptedCorners) {
+  Synthetic syn = MakeSynthetic(1, 10, 0.2, 11);
+  CalibrationOptions options;
+  options.cross_validate = false;
+  const CalibrationSummary clean = CalibrateCameras(syn.problem, options);
+  const int points =
+      clean.cameras[0].num_points + clean.cameras[0].rejected_corners;
+  EXPECT_LE(clean.cameras[0].rejected_corners, points / 100);
+  std::mt19937_64 rng(3);
+  int corrupted = 0;
+  std::vector<Eigen::Vector2d> corrupted_pixels;
+  for (CalibrationView& v : syn.problem.views) {
+    for (Eigen::Vector2d& px : v.observations[0].pixels) {
+      if (rng() % 100 == 0) {
+        px += Eigen::Vector2d(30, -20);
+        corrupted_pixels.push_back(px);
+        ++corrupted;
+      }
+    }
+  }
+  ASSERT_GT(corrupted, 2);
+  const CalibrationSummary sum = CalibrateCameras(syn.problem, options);
+  // No corrupted corner is left among the inliers.
+  int corrupted_kept = 0;
+  for (const CalibrationView& view : sum.inlier_views) {
+    for (const Eigen::Vector2d& px : view.observations[0].pixels) {
+      for (const Eigen::Vector2d& bad : corrupted_pixels) {
+        corrupted_kept += (px - bad).norm() < 1e-12;
+      }
+    }
+  }
+  EXPECT_EQ(corrupted_kept, 0);
+  EXPECT_GE(sum.cameras[0].rejected_corners, corrupted);
+  EXPECT_LE(sum.cameras[0].rejected_corners, corrupted + points / 100);
+  EXPECT_EQ(sum.cameras[0].rejected_views, 0);
+  EXPECT_GE(sum.rejection_rounds, 1);
+  EXPECT_NEAR(sum.rejection_sigma_px, 0.2, 0.03);
+  // The corrupted corners are gone: the clean data's solution within a
+  // fraction of sigma.
+  EXPECT_NEAR(sum.rig.cameras[0].intrinsics.fx,
+              clean.rig.cameras[0].intrinsics.fx,
+              0.5 * sum.cameras[0].sigma[kFx]);
+  EXPECT_LT(std::abs(sum.rig.cameras[0].intrinsics.fx -
+                     syn.truth.cameras[0].intrinsics.fx),
+            3 * sum.cameras[0].sigma[kFx]);
+  // Without rejection least squares is pulled far off.
+  options.reject_sigma = 0;
+  const CalibrationSummary plain = CalibrateCameras(syn.problem, options);
+  EXPECT_GT(std::abs(plain.rig.cameras[0].intrinsics.fx -
+                     syn.truth.cameras[0].intrinsics.fx),
+            10 * sum.cameras[0].sigma[kFx]);
+}
+
+// A board found in the wrong place (most of its corners far off) is dropped
+// whole rather than corner by corner.
+TEST(CalibrateCameras, OutlierRejectionDropsAMisdetectedView) {
+  Synthetic syn = MakeSynthetic(1, 10, 0.2, 11);
+  CalibrationOptions options;
+  options.cross_validate = false;
+  const CalibrationSummary clean = CalibrateCameras(syn.problem, options);
+  std::mt19937_64 rng(5);
+  std::uniform_real_distribution<double> shift(-15, 15);
+  for (Eigen::Vector2d& px : syn.problem.views[4].observations[0].pixels) {
+    px += Eigen::Vector2d(shift(rng), shift(rng));
+  }
+  const CalibrationSummary sum = CalibrateCameras(syn.problem, options);
+  EXPECT_EQ(sum.cameras[0].rejected_views, 1);
+  EXPECT_TRUE(std::isnan(sum.cameras[0].view_rms_px[4]));
+  EXPECT_EQ(sum.cameras[0].num_views, clean.cameras[0].num_views - 1);
+  EXPECT_TRUE(sum.inlier_views[4].observations[0].empty());
+  EXPECT_LT(std::abs(sum.rig.cameras[0].intrinsics.fx -
+                     syn.truth.cameras[0].intrinsics.fx),
+            3 * sum.cameras[0].sigma[kFx]);
+}
+
+// A deflected board (1.5 mm / -1 mm over 270 x 180 mm): with board_warp the
+// deflection is recovered and the residuals are the noise; without it the
+// flat model leaves a larger RMS.
+TEST(CalibrateCameras, BoardWarpRecoversTheDeflection) {
+  const Synthetic syn = MakeSynthetic(2, 12, 0.2, 21, {1.5, -1.0});
+  CalibrationOptions options;
+  options.cross_validate = false;
+  options.board_warp = true;
+  const CalibrationSummary warped = CalibrateCameras(syn.problem, options);
+  options.board_warp = false;
+  const CalibrationSummary flat = CalibrateCameras(syn.problem, options);
+  std::printf("warp %.4f %.4f mm; RMS warped %.4f flat %.4f px\n",
+              warped.board_warp[0], warped.board_warp[1], warped.rms_px,
+              flat.rms_px);
+  EXPECT_NEAR(warped.board_warp[0], 1.5, 0.1);
+  EXPECT_NEAR(warped.board_warp[1], -1.0, 0.1);
+  EXPECT_EQ(flat.board_warp[0], 0.0);
+  EXPECT_LT(warped.rms_px, 0.3);  // the noise's norm: 0.2 * sqrt(2)
+  EXPECT_GT(flat.rms_px, 1.2 * warped.rms_px);
+  for (int c = 0; c < 2; ++c) {
+    EXPECT_LT(std::abs(warped.rig.cameras[c].intrinsics.fx -
+                       syn.truth.cameras[c].intrinsics.fx),
+              3 * warped.cameras[c].sigma[kFx]);
+  }
 }
 
 TEST(CalibrateCameras, TooFewViewsIsInputError) {
@@ -297,14 +412,23 @@ TEST(CalibrateCameras, SolveFailureNamesNonConvergenceAndAbsurdRms) {
 
 TEST(ProjectionDifference, ZeroForSameModelAndRotationRemoved) {
   CameraIntrinsics a{"a", 640, 480, 800, 800, 320, 240, {-0.2, 0.1, 0, 0, 0}};
-  EXPECT_LT(ProjectionDifferencePx(a, a).first, 1e-9);
+  const ProjectionDifference same = ProjectionDifferenceOf(a, a);
+  EXPECT_LT(same.rms_px, 1e-9);
+  EXPECT_LT(same.focus_rms_px, 1e-9);
+  EXPECT_DOUBLE_EQ(same.focus_radius_px, 160.0);  // a third of 480
   // A principal point shift of 2 px is (mostly) a rotation.
   CameraIntrinsics b = a;
   b.cx += 2;
-  EXPECT_LT(ProjectionDifferencePx(a, b).first, 0.2);
+  EXPECT_LT(ProjectionDifferenceOf(a, b).rms_px, 0.2);
+  // 1% focal: ~0.01 * r at radius r, not a rotation; near the centre small.
   b = a;
-  b.fx *= 1.01;  // 1% focal: up to ~3 px at the edge, not a rotation
-  EXPECT_GT(ProjectionDifferencePx(a, b).second, 2.0);
+  b.fx *= 1.01;
+  const ProjectionDifference focal = ProjectionDifferenceOf(a, b);
+  EXPECT_GT(focal.max_px, 2.0);
+  EXPECT_LT(focal.focus_rms_px, 1.2);
+  EXPECT_GT(focal.rms_px, focal.focus_rms_px);
+  EXPECT_DOUBLE_EQ(ProjectionDifferenceOf(a, b, 50).focus_radius_px, 50.0);
+  EXPECT_LT(ProjectionDifferenceOf(a, b, 50).focus_rms_px, focal.focus_rms_px);
 }
 
 // ---------------------------------------------------------------- real data
@@ -336,9 +460,13 @@ TEST(CalibrateCamerasRealData, calib1MatchesBouguetReferenceWithinSigma) {
   for (const auto& v : problem.views) {
     ASSERT_EQ(v.observations[0].pixels.size(), 35u);
   }
-  // Bouguet's model: k1 k2 p1 p2 (k3 = 0), least squares.
+  // Bouguet's model: k1 k2 p1 p2 (k3 = 0), least squares on all corners of
+  // a flat board, no regularisation.
   CalibrationOptions options;
   options.num_distortion = 4;
+  options.reject_sigma = 0;
+  options.board_warp = false;
+  options.lens_regularization = 0;
   const CalibrationSummary sum = CalibrateCameras(problem, options);
   ASSERT_TRUE(sum.converged) << sum.termination;
   const CameraIntrinsics& c = sum.rig.cameras[0].intrinsics;
@@ -477,8 +605,10 @@ TEST(CalibrateCamerasRealData, StereoLeftRightReachesOpenCvRms) {
 }
 
 // The 8-coefficient (rational) model converges with the distortion
-// regulariser, and without it stops at max_iterations; the regulariser
-// leaves the 5-coefficient solve unchanged (it has no k4..k6).
+// regularisers, and without any stops at max_iterations; mrcal's lens
+// regulariser alone (mrcal's OPENCV8 setting) makes it converge too; the
+// k4..k6 regulariser leaves the 5-coefficient solve unchanged (it has no
+// k4..k6).
 TEST(CalibrateCamerasRealData, StereoRationalModelConvergesRegularized) {
   KINCAL_REQUIRE_SHARED_DATA("opencv-stereo-left-right");
   const CalibrationProblem problem = StereoLeftRightProblem();
@@ -492,10 +622,13 @@ TEST(CalibrateCamerasRealData, StereoRationalModelConvergesRegularized) {
   options.num_distortion = 8;
   const CalibrationSummary eight = CalibrateCameras(problem, options);
   plain.num_distortion = 8;
+  const CalibrationSummary eight_lens_only = CalibrateCameras(problem, plain);
+  plain.lens_regularization = 0;
   const CalibrationSummary eight_plain = CalibrateCameras(problem, plain);
 
   EXPECT_FALSE(eight_plain.converged) << eight_plain.termination;
   EXPECT_EQ(eight_plain.regularization_cost, 0.0);
+  EXPECT_TRUE(eight_lens_only.converged) << eight_lens_only.termination;
   ASSERT_TRUE(eight.converged) << eight.termination;
   EXPECT_TRUE(SolveFailure(eight, options).empty());
   EXPECT_LT(eight.iterations, options.max_iterations);
@@ -514,7 +647,8 @@ TEST(CalibrateCamerasRealData, StereoRationalModelConvergesRegularized) {
     EXPECT_LT(std::abs(b.cx - a.cx), 1.0) << c;
     EXPECT_LT(std::abs(b.cy - a.cy), 1.0) << c;
     std::printf(
-        "camera %zu: 5 coeff fx %.3f cx %.3f cy %.3f rms %.4f (unregularised "
+        "camera %zu: 5 coeff fx %.3f cx %.3f cy %.3f rms %.4f (no k4..k6 "
+        "regulariser "
         "fx %.3f rms %.4f); 8 coeff fx %.3f cx %.3f cy %.3f rms %.4f\n",
         c, a.fx, a.cx, a.cy, five.cameras[c].rms_px, p.fx,
         five_plain.cameras[c].rms_px, b.fx, b.cx, b.cy,
@@ -522,15 +656,20 @@ TEST(CalibrateCamerasRealData, StereoRationalModelConvergesRegularized) {
   }
   std::printf(
       "8 coeff: %d iterations (%s), rms %.4f px, regulariser share %.4g; "
-      "unregularised: %d iterations (%s)\n",
+      "lens regulariser only: %d iterations (%s); unregularised: %d "
+      "iterations (%s)\n",
       eight.iterations, eight.termination.c_str(), eight.rms_px,
-      eight.regularization_share, eight_plain.iterations,
+      eight.regularization_share, eight_lens_only.iterations,
+      eight_lens_only.termination.c_str(), eight_plain.iterations,
       eight_plain.termination.c_str());
 }
 
 TEST(CalibrateCameras, NegativeRegularizationIsInputError) {
   CalibrationOptions options;
   options.regularization = -0.1;
+  EXPECT_THROW(options.Check(), InputError);
+  options.regularization = 0;
+  options.lens_regularization = -1;
   EXPECT_THROW(options.Check(), InputError);
 }
 

@@ -132,6 +132,54 @@ class RationalDistortionRegularizationError {
   const double scale_;
 };
 
+// mrcal's lens regulariser: every distortion coefficient pulled toward 0
+// and the principal point toward the image centre (centre_x, centre_y):
+//   residual_i     = distortion_scale * intrinsics[kK1 + i],  i = 0 .. 7
+//   residual_8, _9 = centre_scale * (cx - centre_x), centre_scale * (cy -
+//   centre_y)
+// Coefficients beyond the model are fixed at 0 and add nothing. The scales
+// are sized by the caller relative to the number of pixel residuals
+// (calibrate_cameras.cc, LensRegularizationScales).
+class LensRegularizationError {
+ public:
+  static constexpr int kNumDistortion = kNumIntrinsics - kK1;
+  static constexpr int kNumResiduals = kNumDistortion + 2;
+
+  LensRegularizationError(double distortion_scale, double centre_scale,
+                          double centre_x, double centre_y)
+      : distortion_scale_(distortion_scale),
+        centre_scale_(centre_scale),
+        centre_x_(centre_x),
+        centre_y_(centre_y) {}
+
+  template <typename T>
+  bool operator()(const T* intrinsics, T* residuals) const {
+    for (int i = 0; i < kNumDistortion; ++i) {
+      residuals[i] = T(distortion_scale_) * intrinsics[kK1 + i];
+    }
+    residuals[kNumDistortion] =
+        T(centre_scale_) * (intrinsics[kCx] - T(centre_x_));
+    residuals[kNumDistortion + 1] =
+        T(centre_scale_) * (intrinsics[kCy] - T(centre_y_));
+    return true;
+  }
+
+  static ceres::CostFunction* Create(double distortion_scale,
+                                     double centre_scale, double centre_x,
+                                     double centre_y) {
+    return new ceres::AutoDiffCostFunction<LensRegularizationError,
+                                           kNumResiduals, kNumIntrinsics>(
+        new LensRegularizationError(distortion_scale, centre_scale, centre_x,
+                                    centre_y));
+  }
+
+ private:
+  const double distortion_scale_;
+  const double centre_scale_;
+  const double centre_x_;
+  const double centre_y_;
+};
+
 // A ray at infinity of one model, rotated, projected by another model:
 //   residual = ProjectPoint(intrinsics_b, R(rotation_aa) * ray_a) - pixel
 class RotatedRayError {

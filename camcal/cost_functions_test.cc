@@ -51,6 +51,25 @@ TEST(CostFunctionsTest, RationalRegularizationScalesK4ToK6) {
   EXPECT_DOUBLE_EQ(r[2], 1.2);
 }
 
+TEST(CostFunctionsTest, LensRegularizerPullsDistortionAndCentre) {
+  std::array<double, kNumIntrinsics> intr = Pinhole().ToArray();
+  intr[kCx] = 330.0;
+  intr[kCy] = 235.0;
+  intr[kK1] = -0.3;
+  intr[kK1 + 4] = 0.1;  // k3
+  std::unique_ptr<ceres::CostFunction> cost(
+      LensRegularizationError::Create(0.5, 0.01, 319.5, 239.5));
+  ASSERT_EQ(cost->num_residuals(), 10);
+  double r[10];
+  ASSERT_TRUE(Evaluate(*cost, {intr.data()}, r));
+  EXPECT_DOUBLE_EQ(r[0], -0.15);
+  EXPECT_DOUBLE_EQ(r[1], 0.0);
+  EXPECT_DOUBLE_EQ(r[4], 0.05);
+  EXPECT_DOUBLE_EQ(r[7], 0.0);
+  EXPECT_NEAR(r[8], 0.105, 1e-12);
+  EXPECT_NEAR(r[9], -0.045, 1e-12);
+}
+
 TEST(CostFunctionsTest, RigTargetAppliesCamFromRig) {
   const std::array<double, kNumIntrinsics> intr = Pinhole().ToArray();
   const double q_identity[4] = {0, 0, 0, 1};

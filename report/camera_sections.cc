@@ -106,6 +106,103 @@ std::vector<Plot> ImageGridPlots(const nlohmann::json& cameras,
   return plots;
 }
 
+// Per camera of camcal's JSON with a projection_uncertainty grid: the
+// worst-direction 1-sigma of projecting a point (camcal's distance) as a
+// heat map over the imager (cols x rows cells, sigma at each centre), one
+// colour scale from 0 for all cameras, capped at *cap_px (4x the largest
+// centre sigma, at least the valid-region threshold) so the extrapolated
+// corners do not wash out the rest; sigma above the cap shows at the cap.
+std::vector<Plot> UncertaintyPlots(const nlohmann::json& cameras,
+                                   double* cap_px) {
+  std::vector<Plot> plots;
+  double centre_max = 0.0, threshold = 0.0;
+  for (const auto& c : cameras) {
+    if (!c.contains("projection_uncertainty") ||
+        !c["projection_uncertainty"].is_object()) {
+      continue;
+    }
+    const nlohmann::json& u = c["projection_uncertainty"];
+    if (!u.contains("grid") || !u["grid"].is_object()) continue;
+    const nlohmann::json& g = u["grid"];
+    const int cols = g.value("cols", 0), rows = g.value("rows", 0);
+    const int width = c.value("width", 0), height = c.value("height", 0);
+    if (cols <= 0 || rows <= 0 || width <= 0 || height <= 0 ||
+        !g.contains("sigma_px") || !g["sigma_px"].is_array() ||
+        g["sigma_px"].size() != static_cast<size_t>(cols) * rows) {
+      continue;
+    }
+    if (u.contains("centre") && u["centre"].is_object()) {
+      centre_max = std::max(centre_max, u["centre"].value("sigma_px", 0.0));
+    }
+    threshold = std::max(threshold, u.value("valid_threshold_px", 0.0));
+    Plot p;
+    p.title = c.value("name", "?") + ": projection uncertainty";
+    p.x_label = "image column (px)";
+    p.y_label = "image row (px, downwards)";
+    p.width = 500;
+    p.height = 420;
+    p.y_down = true;
+    p.equal_axes = true;
+    PlotSeries cells;
+    cells.points = true;
+    cells.color_label = "sigma (px)";
+    cells.cell_w = static_cast<double>(width) / cols;
+    cells.cell_h = static_cast<double>(height) / rows;
+    for (int j = 0; j < rows; ++j) {
+      for (int i = 0; i < cols; ++i) {
+        const nlohmann::json& v =
+            g["sigma_px"][static_cast<size_t>(j) * cols + i];
+        if (!v.is_number()) continue;
+        cells.x.push_back((i + 0.5) * cells.cell_w);
+        cells.y.push_back((j + 0.5) * cells.cell_h);
+        cells.color.push_back(v.get<double>());
+      }
+    }
+    if (cells.x.empty()) continue;
+    p.x_min = 0.0;
+    p.x_max = width;
+    p.y_min = 0.0;
+    p.y_max = height;
+    p.series = {cells};
+    plots.push_back(p);
+  }
+  const double cap = std::max(4.0 * centre_max, threshold);
+  *cap_px = cap > 0 ? cap : 1.0;
+  for (Plot& p : plots) {
+    for (double& v : p.series[0].color) v = std::min(v, *cap_px);
+    p.series[0].color_lo = 0.0;
+    p.series[0].color_hi = *cap_px;
+  }
+  return plots;
+}
+
+// The uncertainty maps with their caption (nothing without a grid).
+void AddUncertaintyFigure(const nlohmann::json& cameras, HtmlReport* page) {
+  double cap_px = 1.0;
+  const std::vector<Plot> plots = UncertaintyPlots(cameras, &cap_px);
+  if (plots.empty()) return;
+  std::string distance = "infinity";
+  for (const auto& c : cameras) {
+    if (c.contains("projection_uncertainty") &&
+        c["projection_uncertainty"].contains("distance") &&
+        c["projection_uncertainty"]["distance"].is_number()) {
+      distance = Fmt(c["projection_uncertainty"]["distance"].get<double>(), 4) +
+                 " target units";
+    }
+  }
+  page->FigureRow(
+      plots,
+      "Projection uncertainty over the image (mrcal's definition): the "
+      "worst-direction 1-sigma of projecting a point at " +
+          distance +
+          " through the calibrated camera, propagated from the covariance of "
+          "the intrinsics, the extrinsics and every board pose. One scale "
+          "from 0 for all cameras, capped at " +
+          Fmt(cap_px, 3) +
+          " px (cells above show the cap). Low where the boards were; high "
+          "where the model is extrapolated: use the image there with care.");
+}
+
 }  // namespace
 
 void AddCameraSection(const Rig& rig, const nlohmann::json& camcal,
@@ -182,6 +279,7 @@ void AddCameraSection(const Rig& rig, const nlohmann::json& camcal,
               "inwards at the edges) mean the distortion model is too weak; "
               "random arrows mean noise.");
     }
+    AddUncertaintyFigure(camcal["cameras"], page);
   } else {
     page->Paragraph(
         "Per-view reprojection errors and the sigma of the intrinsics are "

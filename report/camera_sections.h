@@ -6,6 +6,8 @@
 //   camera    rig intrinsics and baseline; with camcal's JSON the RMS, sigma
 //             of the intrinsics, the error per view and over the image
 //             (camcal's image_grid: RMS and mean residual vector per cell)
+//             and the projection uncertainty map (camcal's
+//             projection_uncertainty grid) as a heat map
 //   tracking  tip quality per frame (points.csv of kincal track)
 
 #include <nlohmann/json.hpp>

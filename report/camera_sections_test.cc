@@ -55,6 +55,38 @@ TEST(CameraSectionsTest, CamcalJsonGivesPerViewAndImageFigures) {
   EXPECT_THAT(html, Not(HasSubstr(">0.437<")));
 }
 
+// camcal's projection_uncertainty grid becomes a heat map whose colour scale
+// is capped at 4x the centre's sigma (the extrapolated corner shows at the
+// cap), named in the caption.
+TEST(CameraSectionsTest, ProjectionUncertaintyGridGivesAHeatMap) {
+  nlohmann::json camcal = {
+      {"cameras",
+       {{{"name", "left"},
+         {"width", 640},
+         {"height", 480},
+         {"projection_uncertainty",
+          {{"distance", nullptr},
+           {"centre", {{"pixel", {319.5, 239.5}}, {"sigma_px", 0.25}}},
+           {"valid_threshold_px", 0.5},
+           {"grid",
+            {{"cols", 2},
+             {"rows", 2},
+             {"sigma_px", {0.2, 0.3, 0.4, 10.8}}}}}}}}}};
+  HtmlReport page("t");
+  AddCameraSection(TwoCameras(), camcal, "c.json", &page);
+  const std::string html = page.Page("");
+  EXPECT_EQ(page.figures(), 1);
+  EXPECT_THAT(html, HasSubstr("left: projection uncertainty"));
+  EXPECT_THAT(html, HasSubstr("a point at infinity"));
+  EXPECT_THAT(html, HasSubstr("capped at 1 px"));
+  EXPECT_THAT(html, Not(HasSubstr(">10<")));  // the 10.8 px cell is capped
+  // Without a grid there is no map.
+  camcal["cameras"][0]["projection_uncertainty"].erase("grid");
+  HtmlReport bare("t");
+  AddCameraSection(TwoCameras(), camcal, "c.json", &bare);
+  EXPECT_EQ(bare.figures(), 0);
+}
+
 TEST(CameraSectionsTest, WithoutCamcalJsonSaysWhereItComesFrom) {
   HtmlReport page("t");
   AddCameraSection(TwoCameras(), nlohmann::json(), "", &page);

@@ -25,6 +25,47 @@ std::string StereoDir() {
   return testing::SharedDataDir() + "/opencv-stereo-left-right";
 }
 
+// The default (least squares, board warp, 4-sigma outlier rejection: as
+// mrcal-calibrate-cameras) on the stereo pairs. mrcal's default on the same
+// corners (bench/mrcal_crossval.py, mrcal 2.2, OPENCV5, outlier rejection,
+// regularisation, calobject_warp): 36 corners rejected, warp (0.0015,
+// -0.00632) squares, halves 0.049 / 0.153 px within 160 px of the centre
+// and 2.778 / 0.411 px over the image (left / right; projection difference,
+// rays at infinity, rotation fitted within 160 px); fx 534.186 / 537.894
+// (sigma 0.313 / 0.322), cx 341.851 / 326.771 (sigma 0.402 / 0.443).
+// kincal's default applies mrcal's lens regulariser with mrcal's scales, so
+// it is mrcal's default: measured 0.00 mrcal sigma from it, halves 0.048 /
+// 0.150 px within 160 px and 2.780 / 0.419 px over the image (kincal's
+// projection difference; mrcal's code gives 2.781 / 0.411 for the same
+// halves). The halves must agree within 160 px as well as the bar
+// (0.05 / 0.16 px) and over the whole image within 5 % of mrcal's; the
+// intrinsics within 0.1 of mrcal's sigma.
+void ExpectDefaultAsConsistentAsMrcal(const nlohmann::json& j) {
+  const auto& rejection = j.at("outlier_rejection");
+  EXPECT_EQ(rejection.at("reject_sigma").get<double>(), 4.0);
+  EXPECT_GT(rejection.at("corners").get<int>(), 14);  // 1 %..7 % of 1404
+  EXPECT_LT(rejection.at("corners").get<int>(), 100);
+  ASSERT_EQ(j.at("board_warp").size(), 2u);
+  EXPECT_NEAR(j["board_warp"][0].get<double>(), 0.0015, 0.001);
+  EXPECT_NEAR(j["board_warp"][1].get<double>(), -0.0063, 0.001);
+  const double focus_bar[2] = {0.05, 0.16}, mrcal_whole[2] = {2.778, 0.411};
+  const double mrcal_fx[2] = {534.186, 537.894}, sigma_fx[2] = {0.313, 0.322};
+  const double mrcal_cx[2] = {341.851, 326.771}, sigma_cx[2] = {0.402, 0.443};
+  for (size_t c = 0; c < 2; ++c) {
+    const auto& cam = j.at("cameras")[c];
+    EXPECT_EQ(cam.at("half_diff_focus_radius_px").get<double>(), 160.0);
+    EXPECT_LE(cam.at("half_diff_focus_rms_px").get<double>(), focus_bar[c]);
+    EXPECT_LE(cam.at("half_diff_rms_px").get<double>(), 1.05 * mrcal_whole[c]);
+    EXPECT_LT(std::abs(cam.at("fx").get<double>() - mrcal_fx[c]),
+              0.1 * sigma_fx[c]);
+    EXPECT_LT(std::abs(cam.at("cx").get<double>() - mrcal_cx[c]),
+              0.1 * sigma_cx[c]);
+    // Held out on the other half's inliers: close to the inlier RMS.
+    EXPECT_LT(cam.at("holdout_rms_px").get<double>(), 0.25);
+    EXPECT_LT(cam.at("rms_px").get<double>(), 0.2);
+  }
+}
+
 TEST(CamcalCli, StereoChessboardJsonAndRig) {
   KINCAL_REQUIRE_SHARED_DATA("opencv-stereo-left-right");
   const std::string out = testing::MakeTempDir("camcal") + "/rig.yaml";
@@ -69,12 +110,16 @@ TEST(CamcalCli, StereoChessboardJsonAndRig) {
                            g["mean_dy_px"][k].get<double>()),
                 g["rms_px"][k].get<double>() + 1e-12);
     }
-    EXPECT_EQ(corners, 13 * 54);
+    // The cells hold the inliers; with the rejected corners, every corner.
+    EXPECT_EQ(corners, c.at("points").get<int>());
+    EXPECT_EQ(c.at("rejected_views").get<int>(), 0);
+    EXPECT_EQ(corners + c.at("rejected_corners").get<int>(), 13 * 54);
     EXPECT_GT(cells_seen, 20);
     EXPECT_NEAR(std::sqrt(ss / corners), c.at("rms_px").get<double>(), 1e-9);
   }
   EXPECT_NE(j.at("command").get<std::string>().find("camcal"),
             std::string::npos);
+  ExpectDefaultAsConsistentAsMrcal(j);
   // The rig file reads back and agrees with the JSON.
   const Rig rig = ReadRigYaml(out);
   ASSERT_EQ(rig.cameras.size(), 2u);
@@ -121,9 +166,10 @@ TEST(CamcalCli, StereoChessboardJsonAndRig) {
   EXPECT_NEAR(back.BaselineMm(), rig.BaselineMm(), 1e-12);
 }
 
-// The 8-coefficient model converges with the default regulariser of k4..k6
-// and reports its share of the cost; without it the solve stops at 200
-// iterations and writes nothing (exit 1); a negative weight is bad input.
+// The 8-coefficient model converges with the default regularisers (k4..k6
+// and mrcal's lens regulariser) and reports their share of the cost;
+// without both the solve stops at 200 iterations and writes nothing (exit
+// 1); a negative weight is bad input.
 TEST(CamcalCli, RationalModelConvergesWithRegularizer) {
   KINCAL_REQUIRE_SHARED_DATA("opencv-stereo-left-right");
   const std::string dir = testing::MakeTempDir("camcal_opencv8");
@@ -139,6 +185,7 @@ TEST(CamcalCli, RationalModelConvergesWithRegularizer) {
   EXPECT_LE(j.at("rms_px").get<double>(), 0.445);
   const auto& reg = j.at("regularization");
   EXPECT_DOUBLE_EQ(reg.at("weight").get<double>(), 0.005);
+  EXPECT_DOUBLE_EQ(reg.at("lens_weight").get<double>(), 1.0);
   EXPECT_GT(reg.at("share").get<double>(), 0.0);
   EXPECT_LT(reg.at("share").get<double>(), 0.001);
   for (const auto& c : j.at("cameras")) {
@@ -146,9 +193,11 @@ TEST(CamcalCli, RationalModelConvergesWithRegularizer) {
     EXPECT_LT(c.at("half_diff_rms_px").get<double>(), 10.0);
   }
   std::remove(out.c_str());
-  EXPECT_EQ(RunKincal(images + " --regularize 0").exit_code, 1);
+  EXPECT_EQ(RunKincal(images + " --regularize 0 --regularize-lens 0").exit_code,
+            1);
   EXPECT_FALSE(std::ifstream(out).good());
   EXPECT_EQ(RunKincal(images + " --regularize -1").exit_code, 2);
+  EXPECT_EQ(RunKincal(images + " --regularize-lens -1").exit_code, 2);
 }
 
 TEST(CamcalCli, BadInputExitsTwoAndWritesNothing) {

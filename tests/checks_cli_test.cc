@@ -217,7 +217,7 @@ TEST(ChecksCli, CamcalThatDoesNotConvergeFailsAndWritesNothing) {
   const RunResult r =
       RunKincal("camcal --left '" + d + "/left*.jpg' --right '" + d +
                 "/right*.jpg' --target chessboard:9x6:1 "
-                "--distortion 8 --regularize 0 --out " +
+                "--distortion 8 --regularize 0 --regularize-lens 0 --out " +
                 out + " --json");
   EXPECT_EQ(r.exit_code, 1) << r.err;
   EXPECT_NE(r.err.find("did not converge"), std::string::npos) << r.err;

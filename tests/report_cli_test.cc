@@ -286,12 +286,14 @@ TEST(ReportCliTest, CameraSectionFromRealCamcal) {
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const auto j = nlohmann::json::parse(r.out);
   EXPECT_THAT(Sections(j), Contains("camera"));
-  EXPECT_EQ(j["figures"], 3);  // per view + one image map per camera
+  // Per view + per camera the residual map and the uncertainty map.
+  EXPECT_EQ(j["figures"], 5);
   const std::string page = ReadFile(html);
   EXPECT_THAT(page, HasSubstr("left: residual over the image"));
+  EXPECT_THAT(page, HasSubstr("right: projection uncertainty"));
   EXPECT_THAT(page, HasSubstr("right: residual over the image"));
   EXPECT_THAT(page, HasSubstr("sigma fx"));
-  CheckInBrowser(html, 3, std::string(KINCAL_BUILD_DIR) + "/report_camera.png");
+  CheckInBrowser(html, 5, std::string(KINCAL_BUILD_DIR) + "/report_camera.png");
 }
 
 // The UR10 series C report (real laser-tracker data) shows the residual
