@@ -250,8 +250,8 @@ double ValidationRms(const ModelState& state,
 
 // The same with the exact-Jacobian fit (calib/free_fit.h) of the frame,
 // started from `frame` (the current model's registered frame on the
-// validation series, one per series) instead of Umeyama: same problem, calib/fit.h's
-// tolerances.
+// validation series, one per series) instead of Umeyama: same problem,
+// calib/fit.h's tolerances.
 double ValidationRmsFrom(const ModelState& state, const ModelState& frames,
                          const std::vector<Measurement>& validation) {
   if (validation.empty()) return kNaN;

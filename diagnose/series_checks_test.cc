@@ -45,7 +45,8 @@ Observations TwoSeries(double scale_ppm) {
 // within 3 sigma. One scale shared by both series is identifiable on BH-7:
 // its prismatic joint's readings carry the unit of length (an all-revolute
 // arm such as the UR10 gives a sine of 0, docs/DIAGNOSE.md).
-TEST(SeriesChecksTest, RelativeScaleFoundSharedScaleIdentifiableWithAPrismaticJoint) {
+TEST(SeriesChecksTest,
+     RelativeScaleFoundSharedScaleIdentifiableWithAPrismaticJoint) {
   const DiagnosisResult r = DiagnoseModel(Bh7(), TwoSeries(400), {});
   ASSERT_EQ(r.series.series.size(), 2u);
   EXPECT_EQ(r.series.series[0].name, "A");

@@ -13,6 +13,20 @@
 namespace kincal {
 namespace {
 
+// An empty plot over one camera's imager: pixel axes, rows downwards,
+// equal scales (the heat maps below).
+Plot ImagePlot(const std::string& title) {
+  Plot p;
+  p.title = title;
+  p.x_label = "image column (px)";
+  p.y_label = "image row (px, downwards)";
+  p.width = 500;
+  p.height = 420;
+  p.y_down = true;
+  p.equal_axes = true;
+  return p;
+}
+
 // Per camera of camcal's JSON with an image_grid: RMS per cell as coloured
 // cells and the mean residual vector as an arrow from the cell centre,
 // enlarged by *arrow_gain (one gain for all cameras: the 90th-percentile
@@ -35,14 +49,7 @@ std::vector<Plot> ImageGridPlots(const nlohmann::json& cameras,
                  : std::numeric_limits<double>::quiet_NaN();
     };
     if (cols <= 0 || rows <= 0 || !(cw > 0) || !(ch > 0)) continue;
-    Plot p;
-    p.title = c.value("name", "?") + ": residual over the image";
-    p.x_label = "image column (px)";
-    p.y_label = "image row (px, downwards)";
-    p.width = 500;
-    p.height = 420;
-    p.y_down = true;
-    p.equal_axes = true;
+    Plot p = ImagePlot(c.value("name", "?") + ": residual over the image");
     PlotSeries cells;
     cells.points = true;
     cells.color_label = "RMS (px)";
@@ -135,14 +142,7 @@ std::vector<Plot> UncertaintyPlots(const nlohmann::json& cameras,
       centre_max = std::max(centre_max, u["centre"].value("sigma_px", 0.0));
     }
     threshold = std::max(threshold, u.value("valid_threshold_px", 0.0));
-    Plot p;
-    p.title = c.value("name", "?") + ": projection uncertainty";
-    p.x_label = "image column (px)";
-    p.y_label = "image row (px, downwards)";
-    p.width = 500;
-    p.height = 420;
-    p.y_down = true;
-    p.equal_axes = true;
+    Plot p = ImagePlot(c.value("name", "?") + ": projection uncertainty");
     PlotSeries cells;
     cells.points = true;
     cells.color_label = "sigma (px)";
