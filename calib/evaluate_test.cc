@@ -13,14 +13,30 @@
 namespace kincal {
 namespace {
 
-SimulatedSession Session() {
-  const Robot bh7 =
-      ReadRobotYaml(testing::SourceDir() + "/data/robots/bh7.yaml");
+SimulateOptions SessionOptions() {
   SimulateOptions so;
   so.poses = 60;
   so.seed = 8;
   so.noise_mm = 0.02;
-  return Simulate(bh7, so);
+  return so;
+}
+
+SimulatedSession Session() {
+  const Robot bh7 =
+      ReadRobotYaml(testing::SourceDir() + "/data/robots/bh7.yaml");
+  return Simulate(bh7, SessionOptions());
+}
+
+// A second campaign of Session()'s robot with the instrument moved: its
+// frame turned by `turn_rad` about the rotation vector's z and moved 500 mm
+// along x.
+SimulatedSession MovedInstrument(const SimulatedSession& a, double turn_rad) {
+  std::array<double, 6> moved = a.meas_from_base;
+  moved[2] += turn_rad;
+  moved[3] += 500;
+  SimulateOptions so = SessionOptions();
+  so.meas_from_base = moved;
+  return Simulate(a.nominal, so);
 }
 
 // The true model with only the frame registered predicts at the noise
@@ -60,17 +76,7 @@ TEST(EvaluateTest, NoUsableRowIsInputError) {
 // both to the noise level; one frame for all rows is hundreds of mm off.
 TEST(EvaluateTest, OneFramePerSeries) {
   const SimulatedSession a = Session();
-  const Robot bh7 =
-      ReadRobotYaml(testing::SourceDir() + "/data/robots/bh7.yaml");
-  SimulateOptions so;
-  so.poses = 60;
-  so.seed = 8;
-  so.noise_mm = 0.02;
-  const double angle = 30.0 * M_PI / 180.0;
-  so.meas_from_base = {a.meas_from_base[0],         a.meas_from_base[1],
-                       a.meas_from_base[2] + angle, a.meas_from_base[3] + 500,
-                       a.meas_from_base[4],         a.meas_from_base[5]};
-  const SimulatedSession b = Simulate(bh7, so);
+  const SimulatedSession b = MovedInstrument(a, 30.0 * M_PI / 180.0);
   Observations both = a.observations;
   for (Observation& o : both.rows) o.series = "A";
   for (Observation o : b.observations.rows) {
@@ -158,14 +164,7 @@ TEST(EvaluateTest, TooSmallSeriesIsInputErrorNamingIt) {
 // campaign, or the nominal model on one, shows none.
 TEST(EvaluateTest, FindsFrameJumpOfUnlabelledCampaigns) {
   const SimulatedSession a = Session();
-  SimulateOptions so;
-  so.poses = 60;
-  so.seed = 8;
-  so.noise_mm = 0.02;
-  so.meas_from_base = {a.meas_from_base[0],       a.meas_from_base[1],
-                       a.meas_from_base[2] + 0.5, a.meas_from_base[3] + 500,
-                       a.meas_from_base[4],       a.meas_from_base[5]};
-  const SimulatedSession b = Simulate(a.nominal, so);
+  const SimulatedSession b = MovedInstrument(a, 0.5);
   Observations both = a.observations;
   for (size_t i = 0; i < 40; ++i) {
     Observation o = b.observations.rows[i];

@@ -33,6 +33,7 @@
 #include "tests/testing/loopback.h"
 #include "tests/testing/paths.h"
 #include "tests/testing/run.h"
+#include "tests/testing/tilt.h"
 
 namespace kincal {
 namespace {
@@ -379,18 +380,6 @@ void RenderGridViews(const Rig& rig, const std::string& dir) {
   }
 }
 
-Rigid3 Tilted(const Rigid3& pose, double about_x_deg, double about_y_deg,
-              const Eigen::Vector3d& fixed_in_tool) {
-  Rigid3 out;
-  out.R =
-      (Eigen::AngleAxisd(about_x_deg * M_PI / 180, Eigen::Vector3d::UnitX()) *
-       Eigen::AngleAxisd(about_y_deg * M_PI / 180, Eigen::Vector3d::UnitY()))
-          .toRotationMatrix() *
-      pose.R;
-  out.t = pose * fixed_in_tool - out.R * fixed_in_tool;
-  return out;
-}
-
 // LAB.md step 1b's sessions: the tool tilted in 24 views, and pivoting
 // +-20 deg about its tip in 16. `target` is ExampleTarget() scaled (as
 // simulate --render scales it to its rig distance): the example scene
@@ -407,15 +396,15 @@ void RenderToolSessions(const Rig& rig, const Target& target,
   o.noise_sigma = 1.5;
   RecordedSessionInput views, pivot;
   for (int i = 0; i < 24; ++i) {
-    views.rig_from_tool.push_back(
-        scaled(Tilted(ExampleToolPose(i), 20 * std::sin(0.9 * i),
-                      25 * std::cos(0.6 * i), Eigen::Vector3d::Zero())));
+    views.rig_from_tool.push_back(scaled(
+        testing::TiltedAbout(ExampleToolPose(i), 20 * std::sin(0.9 * i),
+                             25 * std::cos(0.6 * i), Eigen::Vector3d::Zero())));
   }
   for (int i = 0; i < 16; ++i) {
     const double a = 2 * M_PI * i / 16;
-    pivot.rig_from_tool.push_back(
-        scaled(Tilted(ExampleToolPose(0), 20 * std::sin(a), 20 * std::cos(a),
-                      target.tip_in_tool / scale)));
+    pivot.rig_from_tool.push_back(scaled(
+        testing::TiltedAbout(ExampleToolPose(0), 20 * std::sin(a),
+                             20 * std::cos(a), target.tip_in_tool / scale)));
   }
   RenderRecordedSession(rig, target, views, o, 11, standin + "/tool");
   RenderRecordedSession(rig, target, pivot, o, 12, standin + "/pivot");

@@ -21,6 +21,7 @@
 #include "tests/target_monte_carlo.h"
 #include "tests/testing/paths.h"
 #include "tests/testing/run.h"
+#include "tests/testing/tilt.h"
 #include "vision/target.h"
 
 namespace kincal::testing {
@@ -225,18 +226,6 @@ TEST(TargetCli, RandomHoldersMonteCarlo) {
   }
 }
 
-Rigid3 Tilted(const Rigid3& pose, double about_x_deg, double about_y_deg,
-              const Eigen::Vector3d& fixed_in_tool) {
-  Rigid3 out;
-  out.R =
-      (Eigen::AngleAxisd(about_x_deg * M_PI / 180, Eigen::Vector3d::UnitX()) *
-       Eigen::AngleAxisd(about_y_deg * M_PI / 180, Eigen::Vector3d::UnitY()))
-          .toRotationMatrix() *
-      pose.R;
-  out.t = pose * fixed_in_tool - out.R * fixed_in_tool;
-  return out;
-}
-
 // A hand-held session of the example tool (40 views) and a pivot session
 // (the tip fixed, tilted +-20 deg about two axes): the tip in the measured
 // tool frame against the truth carried into that frame.
@@ -251,14 +240,14 @@ TEST(TargetCli, PivotSessionGivesTheTip) {
   RecordedSessionInput views, pivot;
   for (int i = 0; i < 40; ++i) {
     views.rig_from_tool.push_back(
-        Tilted(ExampleToolPose(i), 20 * std::sin(0.9 * i),
-               25 * std::cos(0.6 * i), Eigen::Vector3d::Zero()));
+        testing::TiltedAbout(ExampleToolPose(i), 20 * std::sin(0.9 * i),
+                             25 * std::cos(0.6 * i), Eigen::Vector3d::Zero()));
   }
   const Rigid3 mid = ExampleToolPose(0);
   for (int i = 0; i < 16; ++i) {
     const double a = 2 * M_PI * i / 16;
-    pivot.rig_from_tool.push_back(
-        Tilted(mid, 20 * std::sin(a), 20 * std::cos(a), truth.tip_in_tool));
+    pivot.rig_from_tool.push_back(testing::TiltedAbout(
+        mid, 20 * std::sin(a), 20 * std::cos(a), truth.tip_in_tool));
   }
   RenderRecordedSession(rig, truth, views, o, 11, dir + "/views");
   RenderRecordedSession(rig, truth, pivot, o, 12, dir + "/pivot");
@@ -346,7 +335,7 @@ TEST(TargetCli, PivotSessionGivesTheTip) {
   // A pivot session tilted +-2 deg only: refused with what to record.
   RecordedSessionInput flat;
   for (int i = 0; i < 16; ++i) {
-    flat.rig_from_tool.push_back(Tilted(
+    flat.rig_from_tool.push_back(testing::TiltedAbout(
         mid, 2 * std::sin(0.4 * i), 2 * std::cos(0.4 * i), truth.tip_in_tool));
   }
   RenderRecordedSession(rig, truth, flat, o, 13, dir + "/flat");

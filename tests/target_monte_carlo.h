@@ -23,6 +23,7 @@
 #include <vector>
 
 #include "synth/render.h"
+#include "tests/testing/tilt.h"
 #include "vision/apriltag_detector.h"
 #include "vision/target_layout.h"
 
@@ -31,18 +32,6 @@ namespace kincal::testing {
 inline Eigen::Matrix3d McRot(const Eigen::Vector3d& axis, double deg) {
   return Eigen::AngleAxisd(deg * M_PI / 180, axis.normalized())
       .toRotationMatrix();
-}
-
-// `pose` turned about x then y (deg, rig axes) about the point
-// fixed_in_tool.
-inline Rigid3 McTilted(const Rigid3& pose, double about_x_deg,
-                       double about_y_deg,
-                       const Eigen::Vector3d& fixed_in_tool) {
-  Rigid3 out;
-  out.R = McRot(Eigen::Vector3d::UnitX(), about_x_deg) *
-          McRot(Eigen::Vector3d::UnitY(), about_y_deg) * pose.R;
-  out.t = pose * fixed_in_tool - out.R * fixed_in_tool;
-  return out;
 }
 
 inline Target RandomHolder(int tags, std::mt19937_64* rng) {
@@ -168,7 +157,7 @@ inline McTrial RunTargetTrial(
   const double phase_a = u(rng), phase_b = u(rng);
   std::vector<Rigid3> views, pivot;
   for (int i = 0; i < 40; ++i) {
-    views.push_back(McTilted(
+    views.push_back(TiltedAbout(
         ExampleToolPose(i + 7 * seed), 25 * std::sin(0.9 * i + phase_a),
         30 * std::cos(0.6 * i + phase_b), Eigen::Vector3d::Zero()));
   }
@@ -176,8 +165,8 @@ inline McTrial RunTargetTrial(
   for (int i = 0; i < 32; ++i) {
     // Two circles about the tip, +-25 and +-12 deg.
     const double a = 2 * M_PI * i / 16 + phase_a, tilt = i < 16 ? 25 : 12;
-    pivot.push_back(McTilted(mid, tilt * std::sin(a), tilt * std::cos(a),
-                             truth.tip_in_tool));
+    pivot.push_back(TiltedAbout(mid, tilt * std::sin(a), tilt * std::cos(a),
+                                truth.tip_in_tool));
   }
   CornerErrors corner_errors;
   const std::vector<LayoutFrame> view_frames =
