@@ -90,10 +90,19 @@ class PyLiteralReader {
     v.line = line_;
     v.column = column_;
     const char c = Peek();
-    if (c == '{') {
-      ReadDict(&v);
-    } else if (c == '[' || c == '(') {
-      ReadList(c == '[' ? ']' : ')', &v);
+    if (c == '{' || c == '[' || c == '(') {
+      // A camera model nests three levels; a deep nest is not one, and
+      // reading it recursively would exhaust the stack.
+      if (++depth_ > kMaxDepth) {
+        Fail("containers nested over " + std::to_string(kMaxDepth) +
+             " levels deep: not a camera model");
+      }
+      if (c == '{') {
+        ReadDict(&v);
+      } else {
+        ReadList(c == '[' ? ']' : ')', &v);
+      }
+      --depth_;
     } else if (c == '\'' || c == '"' ||
                ((c == 'b' || c == 'r') && pos_ + 1 < text_.size() &&
                 (text_[pos_ + 1] == '\'' || text_[pos_ + 1] == '"'))) {
@@ -207,8 +216,10 @@ class PyLiteralReader {
 
   const std::string& text_;
   const std::string& file_;
+  static constexpr int kMaxDepth = 32;
   size_t pos_ = 0;
   int line_ = 1, column_ = 1;
+  int depth_ = 0;  // open containers around the value being read
 };
 
 [[noreturn]] void FailAt(const std::string& file, const PyValue& v,

@@ -152,6 +152,13 @@ TEST(CameraModel, BadFilesFailWithPlace) {
               HasSubstr("imagersize: expected [width, height]"));
   EXPECT_THAT(ErrorOf(""), HasSubstr("empty file"));
   EXPECT_THAT(ErrorOf("{'a': 1, 'a': 2}"), HasSubstr("duplicate key 'a'"));
+  // A deep nest is refused with its place, not read until the stack ends
+  // (a fuzzing finding: 100000 nested dicts).
+  std::string deep;
+  for (int i = 0; i < 100000; ++i) deep += "{'a':";
+  EXPECT_THAT(ErrorOf(deep),
+              HasSubstr("m.cameramodel:1:161: containers nested over 32 "
+                        "levels deep"));
 }
 
 TEST(CameraModel, RigFromModelsConvertsUnitsAndReference) {
