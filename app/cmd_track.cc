@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
+#include <map>
 #include <memory>
 #include <sstream>
 
@@ -162,6 +163,7 @@ struct Tracked {
   std::vector<double> depths_mm;  // distance of the tool from the rig, found
   int frames_tags_in_both = 0;    // frames with a target tag in each camera
   int full_searches[2] = {0, 0};
+  std::map<std::string, int> left_out;  // tag observations left out, by why
 };
 
 std::string PosesHeader(const std::string& header) {
@@ -169,8 +171,25 @@ std::string PosesHeader(const std::string& header) {
          "# good = 1: the tip passes the quality gate (>= --min-tags tag "
          "observations, reprojection RMS <= --max-reproj px); a found tip "
          "with good = 0 is the tracker's best guess, not a measurement\n" +
+         "# tags_used: tag@camera of the fit; tags_left_out: "
+         "tag@camera:reason (contrast, corners or residual)\n" +
          "frame,found,r00,r01,r02,r10,r11,r12,r20,r21,r22,tx,ty,tz,"
-         "reproj_px,tags,left_image,right_image,good\n";
+         "reproj_px,tags,left_image,right_image,good,tags_used,"
+         "tags_left_out\n";
+}
+
+// The tag observations of a pose, used or left out with the reason, as
+// space-separated tag@camera[:reason] (CSV-safe).
+std::string TagList(const Rig& rig, const ToolPoseResult& r, bool used) {
+  std::string out;
+  for (const TagObservationResult& t : r.tags) {
+    if (t.used != used) continue;
+    if (!out.empty()) out += " ";
+    out += std::to_string(t.tag_id) + "@" +
+           rig.cameras[t.camera].intrinsics.name;
+    if (!used) out += ":" + t.left_out;
+  }
+  return out;
 }
 
 // The quality gate: enough tags, a tight fit, and both cameras (one camera
@@ -254,7 +273,11 @@ Tracked TrackFrames(const TrackArgs& args, const Rig& rig, const Target& target,
       poses << ",,,,,,,,,,,,,,0";
     }
     poses << "," << CsvQuote(pairs.left[f]) << "," << CsvQuote(pairs.right[f])
-          << "," << (good ? 1 : 0) << "\n";
+          << "," << (good ? 1 : 0) << "," << CsvQuote(TagList(rig, r, true))
+          << "," << CsvQuote(TagList(rig, r, false)) << "\n";
+    for (const TagObservationResult& t : r.tags) {
+      if (!t.used) ++out.left_out[t.left_out];
+    }
     progress.Update(static_cast<long>(f + 1), static_cast<long>(n),
                     "frames (" + std::to_string(out.found) + " with a tip)");
   }
@@ -296,6 +319,7 @@ void PrintTrack(const TrackArgs& args, size_t n, const Tracked& t, bool merged,
     j["found"] = t.found;
     j["good"] = t.found - static_cast<int>(t.failed_gate.size());
     j["failed_gate"] = t.failed_gate;
+    j["tags_left_out"] = t.left_out;
     j["seconds"] = seconds;
     j["out"] = args.out;
     j["poses"] = poses_path;
@@ -312,6 +336,15 @@ void PrintTrack(const TrackArgs& args, size_t n, const Tracked& t, bool merged,
               t.found, seconds);
   std::printf("  median reprojection RMS %.3f px; full-frame searches %d/%d\n",
               median_rms, full0, full1);
+  if (!t.left_out.empty()) {
+    std::printf("  tag observations left out of their frame's fit (the frame "
+                "kept its other tags; tags_left_out in %s):",
+                poses_path.c_str());
+    for (const auto& [why, count] : t.left_out) {
+      std::printf(" %s %d", why.c_str(), count);
+    }
+    std::printf("\n");
+  }
   if (!t.failed_gate.empty()) {
     std::printf(
         "  %zu found tips fail the quality gate (< %d tags, > %.2f px or "

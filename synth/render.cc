@@ -48,8 +48,30 @@ struct PlaneInCam {
   double x0, y0, texel_w, texel_h;
   int cols, rows;
   const cv::Mat* texture;
+  const PlaneLight* light;
   cv::Rect bbox;  // pixels that can see it (inclusive margin)
 };
+
+// The plane's light at its point (x, y) (mm).
+inline double LightAt(const PlaneLight& l, double x, double y) {
+  double g = l.gain;
+  if (l.shadow_gain != 1.0) {
+    const double d = l.shadow_normal.x() * x + l.shadow_normal.y() * y -
+                     l.shadow_offset_mm;
+    const double s = l.penumbra_mm > 0
+                         ? std::clamp(0.5 + d / l.penumbra_mm, 0.0, 1.0)
+                         : (d > 0 ? 1.0 : 0.0);
+    g *= 1.0 + (l.shadow_gain - 1.0) * s;
+  }
+  return g;
+}
+
+// Where the normalized ray (x, y, 1) meets the plane, in its (x, y) mm.
+inline Eigen::Vector2d HitOnPlane(const PlaneInCam& pl, double x, double y) {
+  const Eigen::Vector3d q = pl.R * Eigen::Vector3d(x, y, 1.0);
+  const double lambda = -pl.t.z() / q.z();
+  return Eigen::Vector2d(lambda * q.x() + pl.t.x(), lambda * q.y() + pl.t.y());
+}
 
 constexpr int64_t kBackground = -1;
 
@@ -91,6 +113,17 @@ inline double Radiance(const std::vector<PlaneInCam>& planes, int64_t label,
   return o.black + (o.white - o.black) * v / 255.0;
 }
 
+// Radiance of the label seen along ray (x, y), lit by its plane's light.
+inline double LitRadiance(const std::vector<PlaneInCam>& planes, int64_t label,
+                          double x, double y, const RenderOptions& o) {
+  const double r = Radiance(planes, label, o);
+  if (label == kBackground) return r;
+  const PlaneInCam& pl = planes[label >> 32];
+  if (pl.light->Uniform()) return r;
+  const Eigen::Vector2d h = HitOnPlane(pl, x, y);
+  return r * LightAt(*pl.light, h.x(), h.y());
+}
+
 // Distance from p to segment ab.
 inline double SegmentDistance(const Eigen::Vector2d& p,
                               const Eigen::Vector2d& a,
@@ -125,6 +158,7 @@ std::optional<PlaneInCam> PlaneInCamera(const TexturedPlane& p,
   pc.texel_w = p.size_mm.x() / pc.cols;
   pc.texel_h = p.size_mm.y() / pc.rows;
   pc.texture = &p.texture;
+  pc.light = &p.light;
   // Bounding box from points along the border (distortion bends edges).
   double u0 = 1e18, v0 = 1e18, u1 = -1e18, v1 = -1e18;
   bool behind = false;
@@ -230,7 +264,11 @@ cv::Mat ShadePixels(const std::vector<PlaneInCam>& in_cam,
         const int64_t l00 = labels[c00], l10 = labels[c00 + 1];
         const int64_t l01 = labels[c00 + gw], l11 = labels[c00 + gw + 1];
         if (l00 == l10 && l00 == l01 && l00 == l11) {
-          row[x] = Radiance(in_cam, l00, options);
+          // Lit as at the pixel's centre.
+          const Eigen::Vector2d c =
+              0.25 * (rays[c00] + rays[c00 + 1] + rays[c00 + gw] +
+                      rays[c00 + gw + 1]);
+          row[x] = LitRadiance(in_cam, l00, c.x(), c.y(), options);
           continue;
         }
         candidates.clear();
@@ -250,8 +288,8 @@ cv::Mat ShadePixels(const std::vector<PlaneInCam>& in_cam,
           const double sx = lat.x[k], sy = lat.y[k];
           const Eigen::Vector2d r = (1 - sy) * ((1 - sx) * r00 + sx * r10) +
                                     sy * ((1 - sx) * r01 + sx * r11);
-          sum += Radiance(in_cam, Trace(in_cam, candidates, r.x(), r.y()),
-                          options);
+          sum += LitRadiance(in_cam, Trace(in_cam, candidates, r.x(), r.y()),
+                             r.x(), r.y(), options);
         }
         row[x] = sum / kNumSamples;
       }
@@ -394,6 +432,18 @@ cv::Mat ExposeAndRecord(cv::Mat radiance, const RenderOptions& options,
     cv::GaussianBlur(radiance, radiance, cv::Size(0, 0), options.blur_sigma_px,
                      options.blur_sigma_px, cv::BORDER_REPLICATE);
   }
+  if (options.bayer) {
+    // RGGB photosites: R at (even x, even y), B at (odd x, odd y).
+    for (int y = 0; y < height; ++y) {
+      double* row = radiance.ptr<double>(y);
+      for (int x = 0; x < width; ++x) {
+        const int channel = (x % 2 == 0 && y % 2 == 0)   ? 0
+                            : (x % 2 == 1 && y % 2 == 1) ? 2
+                                                         : 1;
+        row[x] *= options.bayer_gains[channel];
+      }
+    }
+  }
   if (options.noise_sigma > 0) {
     std::normal_distribution<double> noise(0.0, options.noise_sigma);
     for (int y = 0; y < height; ++y) {
@@ -403,6 +453,12 @@ cv::Mat ExposeAndRecord(cv::Mat radiance, const RenderOptions& options,
   }
   cv::Mat out;
   radiance.convertTo(out, CV_8UC1);  // rounds and saturates
+  if (options.bayer) {
+    // OpenCV names a mosaic by its second row's pattern: RGGB is "BG".
+    cv::Mat gray;
+    cv::cvtColor(out, gray, cv::COLOR_BayerBG2GRAY);
+    out = gray;
+  }
   if (options.jpeg_quality > 0) {
     std::vector<uchar> buf;
     cv::imencode(".jpg", out, buf,
@@ -437,6 +493,14 @@ void RenderOptions::Check() const {
   in_range("vignetting", vignetting, 0, 0.9);
   in_range("light_gradient", light_gradient, -1, 1);
   in_range("jpeg_quality", jpeg_quality, 0, 100);
+  in_range("ambient", ambient, 0, 1);
+  in_range("shadow_gain", shadow_gain, 0, 1);
+  in_range("shadow_offset", shadow_offset, -1, 1);
+  for (double g : tag_gain) in_range("tag_gain", g, 0, 10);
+  for (double g : bayer_gains) in_range("bayer_gains", g, 0.05, 2);
+  if (!light_in_rig.allFinite()) {
+    throw InputError("render option light_in_rig is not finite");
+  }
 }
 
 TexturedPlane TagPlane(const std::string& family, int id, double size_mm,
@@ -530,6 +594,28 @@ std::vector<TagTruth> ProjectTargetCorners(const Camera& camera,
   return out;
 }
 
+void LightTags(const RenderOptions& o, const Target& target,
+               std::vector<TexturedPlane>* planes) {
+  const double light_norm = o.light_in_rig.norm();
+  for (size_t i = 0; i < planes->size() && i < target.tags.size(); ++i) {
+    TexturedPlane& p = (*planes)[i];
+    if (light_norm > 0) {
+      // The printed face looks along -z: lit when the light travels along
+      // +z of the tag.
+      const double cos = std::max(
+          0.0, p.rig_from_plane.R.col(2).dot(o.light_in_rig / light_norm));
+      p.light.gain = o.ambient + (1.0 - o.ambient) * cos;
+    }
+    if (i < o.tag_gain.size()) p.light.gain *= o.tag_gain[i];
+    if (static_cast<int>(i) == o.shadow_tag) {
+      const double a = o.shadow_angle_deg * M_PI / 180;
+      p.light.shadow_gain = o.shadow_gain;
+      p.light.shadow_normal = Eigen::Vector2d(std::cos(a), std::sin(a));
+      p.light.shadow_offset_mm = o.shadow_offset * target.tags[i].size_mm;
+    }
+  }
+}
+
 StereoRenderer::StereoRenderer(const Rig& rig, const Target& target,
                                const RenderOptions& options)
     : rig_(rig), target_(target), options_(options) {
@@ -542,8 +628,8 @@ StereoFrameTruth StereoRenderer::Render(const Rigid3& rig_from_tool,
   StereoFrameTruth frame;
   frame.rig_from_tool = rig_from_tool;
   frame.tip_in_rig = rig_from_tool * target_.tip_in_tool;
-  const std::vector<TexturedPlane> planes =
-      TargetPlanes(target_, rig_from_tool);
+  std::vector<TexturedPlane> planes = TargetPlanes(target_, rig_from_tool);
+  LightTags(options_, target_, &planes);
   std::vector<Needle> needles;
   if (options_.draw_needle) {
     Needle n;

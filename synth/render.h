@@ -16,6 +16,7 @@
 // (vision/apriltag_detector.h).
 
 #include <Eigen/Core>
+#include <array>
 #include <opencv2/core.hpp>
 #include <random>
 #include <sstream>
@@ -32,11 +33,26 @@ namespace kincal {
 // row 0 is at y = top_left_mm.y (y grows down the rows, x along the columns);
 // one texel is size_mm / (cols, rows). Seen from the -z side only (z points
 // into the plane, as for tags).
+// The light falling on a plane: a gain on its texture's gray levels (1 = as
+// RenderOptions::black/white say), and optionally a shadow edge across it:
+// points (x, y) of the plane (mm) with shadow_normal . (x, y) >
+// shadow_offset_mm get shadow_gain instead, through a linear penumbra of
+// penumbra_mm.
+struct PlaneLight {
+  double gain = 1.0;
+  double shadow_gain = 1.0;  // 1 = no shadow
+  Eigen::Vector2d shadow_normal = Eigen::Vector2d::UnitX();
+  double shadow_offset_mm = 0.0;
+  double penumbra_mm = 0.5;
+  bool Uniform() const { return gain == 1.0 && shadow_gain == 1.0; }
+};
+
 struct TexturedPlane {
   Rigid3 rig_from_plane;
   cv::Mat texture;  // CV_8UC1, 0 = black, 255 = white
   Eigen::Vector2d top_left_mm = Eigen::Vector2d::Zero();
   Eigen::Vector2d size_mm = Eigen::Vector2d::Zero();
+  PlaneLight light;
 };
 
 // The plane of one printed tag (black square of edge size_mm plus its white
@@ -76,6 +92,29 @@ struct RenderOptions {
   double vignetting = 0.0;
   double light_gradient = 0.0;
   int jpeg_quality = 0;
+  // Light on the tags (the "light-aware" renders; all off by default, the
+  // simple renderer is the fast one):
+  //  - light_in_rig: the direction a distant light travels (rig frame; zero
+  //    = even light). A tag's paper then has the gain ambient + (1 -
+  //    ambient) * max(0, cos) (Lambert, cos between the light and the tag's
+  //    normal), so tags turned away from it are dim;
+  //  - tag_gain[i]: a further gain on tag i of the target (missing = 1);
+  //  - a shadow edge across tag shadow_tag (index in the target, -1 = none):
+  //    the part beyond a line at shadow_angle_deg through the point
+  //    shadow_offset * size from the tag's centre gets shadow_gain;
+  //  - bayer: a colour sensor (RGGB mosaic with the channel gains
+  //    bayer_gains for gray paper, noise and 8 bits per photosite), whose
+  //    image is demosaiced to gray by OpenCV (cvtColor, Bayer to gray), as
+  //    a colour camera's driver delivers it.
+  Eigen::Vector3d light_in_rig = Eigen::Vector3d::Zero();
+  double ambient = 0.15;
+  std::vector<double> tag_gain;
+  int shadow_tag = -1;
+  double shadow_angle_deg = 0.0;
+  double shadow_offset = 0.0;
+  double shadow_gain = 0.35;
+  bool bayer = false;
+  std::array<double, 3> bayer_gains = {0.55, 1.0, 0.75};  // R, G, B
   // The needle: a cylinder from needle_base_in_tool to the target's tip.
   bool draw_needle = false;
   Eigen::Vector3d needle_base_in_tool = Eigen::Vector3d::Zero();
@@ -130,6 +169,11 @@ struct StereoFrameTruth {
 std::vector<TagTruth> ProjectTargetCorners(const Camera& camera,
                                            const Target& target,
                                            const Rigid3& rig_from_tool);
+
+// Sets the light of the target's tag planes (TargetPlanes order) from the
+// options' light, tag gains and shadow.
+void LightTags(const RenderOptions& options, const Target& target,
+               std::vector<TexturedPlane>* planes);
 
 // Renders every camera of a rig (caches their undistortion grids).
 class StereoRenderer {

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 #include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 
 #include "data/atomic_file.h"
 #include "data/error.h"
@@ -136,6 +137,88 @@ TEST(Render, NoisyRenderStillDetected) {
   }
   EXPECT_EQ(s.tags_found, s.tags_expected);
   EXPECT_LT(s.Rms(), 0.25);
+}
+
+// Mean gray level inside tag `t`'s quad shrunk towards its centre by
+// `shrink` (0..1), and whether that part is mostly white paper is not
+// asked: the ratio of two tags' means compares their light.
+double MeanInQuad(const cv::Mat& image, const TagTruth& t, double shrink) {
+  Eigen::Vector2d c = Eigen::Vector2d::Zero();
+  for (const auto& p : t.corners) c += p / 4;
+  std::vector<cv::Point> poly;
+  for (const auto& p : t.corners) {
+    const Eigen::Vector2d q = c + shrink * (p - c);
+    poly.emplace_back(static_cast<int>(q.x()), static_cast<int>(q.y()));
+  }
+  cv::Mat mask(image.size(), CV_8UC1, cv::Scalar(0));
+  cv::fillConvexPoly(mask, poly, cv::Scalar(255));
+  return cv::mean(image, mask)[0];
+}
+
+// A distant light: a tag turned away from it is dimmer by the Lambert
+// factor, and the tag gains and a shadow edge change only the lit tag.
+TEST(Render, LightOnTagsFollowsLambertAndShadow) {
+  const Target target = ExampleTarget();  // two faces folded by +-20 deg
+  RenderOptions o;
+  o.light_in_rig = Eigen::Vector3d(1, 0, 1);  // 45 deg from the view axis
+  o.ambient = 0.1;
+  std::vector<TexturedPlane> planes = TargetPlanes(target, ExampleToolPose(0));
+  LightTags(o, target, &planes);
+  const Eigen::Vector3d l = o.light_in_rig.normalized();
+  for (size_t i = 0; i < planes.size(); ++i) {
+    const double cos =
+        std::max(0.0, planes[i].rig_from_plane.R.col(2).dot(l));
+    EXPECT_NEAR(planes[i].light.gain, 0.1 + 0.9 * cos, 1e-12);
+  }
+  o.tag_gain = {2.0};
+  o.shadow_tag = 1;
+  o.shadow_gain = 0.3;
+  std::vector<TexturedPlane> lit = TargetPlanes(target, ExampleToolPose(0));
+  LightTags(o, target, &lit);
+  EXPECT_NEAR(lit[0].light.gain, 2.0 * planes[0].light.gain, 1e-12);
+  EXPECT_EQ(lit[1].light.shadow_gain, 0.3);
+  EXPECT_EQ(lit[2].light.shadow_gain, 1.0);
+
+  // In the image: the shadowed half of tag 1 is darker than its lit half.
+  const Rig rig = ExampleStereoRig(640, 512);
+  RenderOptions shadow;
+  shadow.shadow_tag = 1;
+  shadow.shadow_gain = 0.3;
+  shadow.shadow_angle_deg = 0;  // the +x half of the tag is in shadow
+  StereoRenderer renderer(rig, target, shadow);
+  std::mt19937_64 rng(1);
+  const StereoFrameTruth f = renderer.Render(ExampleToolPose(0), &rng);
+  RenderOptions even;
+  StereoRenderer plain(rig, target, even);
+  const StereoFrameTruth g = plain.Render(ExampleToolPose(0), &rng);
+  const TagTruth& t = f.views[0].tags[1];
+  EXPECT_LT(MeanInQuad(f.views[0].image, t, 0.9),
+            0.9 * MeanInQuad(g.views[0].image, t, 0.9));
+  EXPECT_NEAR(MeanInQuad(f.views[0].image, f.views[0].tags[0], 0.9),
+              MeanInQuad(g.views[0].image, g.views[0].tags[0], 0.9), 0.5);
+}
+
+// A colour sensor: the demosaiced gray of a flat gray scene is flat, at
+// OpenCV's gray weights of the channel gains; tags are still found.
+TEST(Render, BayerSensorDemosaicsToGray) {
+  const Rig rig = ExampleStereoRig(640, 512);
+  RenderOptions o;
+  o.bayer = true;
+  o.blur_sigma_px = 0.6;
+  StereoRenderer renderer(rig, ExampleTarget(), o);
+  std::mt19937_64 rng(2);
+  const StereoFrameTruth f = renderer.Render(ExampleToolPose(0), &rng);
+  const cv::Mat& im = f.views[0].image;
+  const double want =
+      o.background * (0.299 * o.bayer_gains[0] + 0.587 * o.bayer_gains[1] +
+                      0.114 * o.bayer_gains[2]);
+  EXPECT_NEAR(im.at<uint8_t>(5, 5), want, 1.5);
+  EXPECT_NEAR(im.at<uint8_t>(6, 6), want, 1.5);
+  AprilTagDetector detector;
+  CornerStats s;
+  for (const ViewTruth& v : f.views) Accumulate(detector.Detect(v.image), v.tags, &s);
+  EXPECT_EQ(s.tags_found, s.tags_expected);
+  EXPECT_LT(s.Rms(), 0.15);
 }
 
 TEST(Render, SameSeedSameImages) {

@@ -6,10 +6,12 @@ extern "C" {
 
 #include <algorithm>
 #include <cmath>
+#include <map>
 #include <opencv2/imgproc.hpp>
 #include <sstream>
 
 #include "data/error.h"
+#include "vision/edge_profile.h"
 #include "vision/tag_family.h"
 
 namespace kincal {
@@ -141,6 +143,7 @@ struct AprilTagDetector::Impl {
   ~Impl() { apriltag_detector_destroy(td); }
   TagFamilyHandle family;
   apriltag_detector_t* td = nullptr;
+  std::map<int, cv::Mat> patterns;  // TagImage by id
 };
 
 AprilTagDetector::AprilTagDetector(const Options& options) : options_(options) {
@@ -149,6 +152,43 @@ AprilTagDetector::AprilTagDetector(const Options& options) : options_(options) {
 }
 
 AprilTagDetector::~AprilTagDetector() = default;
+
+const cv::Mat& AprilTagDetector::Pattern(int id) {
+  auto it = impl_->patterns.find(id);
+  if (it == impl_->patterns.end()) {
+    it = impl_->patterns.emplace(id, TagImage(options_.family, id)).first;
+  }
+  return it->second;
+}
+
+// Each detection refined with the others' quads known (its sampling skips
+// them), then checked corner by corner against libapriltag's.
+void AprilTagDetector::RefineByEdges(const cv::Mat& gray,
+                                     std::vector<TagDetection>* dets) {
+  const int cells = static_cast<int>(impl_->family.family->width_at_border);
+  for (size_t i = 0; i < dets->size(); ++i) {
+    TagDetection& t = (*dets)[i];
+    std::vector<NeighbourTag> others;
+    for (size_t j = 0; j < dets->size(); ++j) {
+      if (j != i) {
+        others.push_back({(*dets)[j].detector_corners});
+      }
+    }
+    if (!RefineCornersByEdges(gray, Pattern(t.id), cells, &t, others)) {
+      continue;
+    }
+    for (int k = 0; k < 4; ++k) {
+      // Corner k joins side k-1 and side k.
+      const bool sides_ok =
+          t.sides[k].line_rms_px <= options_.max_edge_rms_px &&
+          t.sides[(k + 3) % 4].line_rms_px <= options_.max_edge_rms_px;
+      const bool near = (t.corners[k] - t.detector_corners[k]).norm() <=
+                        options_.max_refine_shift_px;
+      t.refined[k] = sides_ok && near;
+      if (!t.refined[k]) t.corners[k] = t.detector_corners[k];
+    }
+  }
+}
 
 std::vector<TagDetection> AprilTagDetector::Detect(const cv::Mat& gray) {
   return DetectInRegion(gray, cv::Rect(0, 0, gray.cols, gray.rows));
@@ -182,35 +222,20 @@ std::vector<TagDetection> AprilTagDetector::DetectInRegion(const cv::Mat& gray,
     }
     t.center = Eigen::Vector2d(d->c[0], d->c[1]) + offset;
     t.detector_corners = t.corners;
-    switch (options_.refinement) {
-      case CornerRefinement::kNone:
-        break;
-      case CornerRefinement::kCornerSubPix:
-        if (RefineCornersBySubPix(gray, &t))
-          t.refined = {true, true, true, true};
-        break;
-      case CornerRefinement::kEdges: {
-        std::array<double, 4> side_rms{};
-        if (RefineCornersByEdges(gray, &t, &side_rms)) {
-          for (int k = 0; k < 4; ++k) {
-            // Corner k joins side k-1 and side k.
-            const bool sides_ok =
-                side_rms[k] <= options_.max_edge_rms_px &&
-                side_rms[(k + 3) % 4] <= options_.max_edge_rms_px;
-            const bool near = (t.corners[k] - t.detector_corners[k]).norm() <=
-                              options_.max_refine_shift_px;
-            t.refined[k] = sides_ok && near;
-            if (!t.refined[k]) t.corners[k] = t.detector_corners[k];
-          }
-        }
-        break;
-      }
-    }
     out.push_back(t);
   }
   apriltag_detections_destroy(dets);
-  if (options_.refinement == CornerRefinement::kEdges) {
-    RevertCornersNearOtherTags(&out);
+  switch (options_.refinement) {
+    case CornerRefinement::kNone:
+      break;
+    case CornerRefinement::kCornerSubPix:
+      for (TagDetection& t : out) {
+        if (RefineCornersBySubPix(gray, &t)) t.refined = {true, true, true, true};
+      }
+      break;
+    case CornerRefinement::kEdges:
+      RefineByEdges(gray, &out);
+      break;
   }
   std::sort(out.begin(), out.end(),
             [](const TagDetection& a, const TagDetection& b) {
@@ -241,164 +266,312 @@ double SegmentsDistance(const Eigen::Vector2d& a, const Eigen::Vector2d& b,
 }
 }  // namespace
 
-// A side whose sampling reaches another tag's quad (its black square within
-// one cell plus the window of the side) is measured on that tag's edges too:
-// its corners fall back to libapriltag's.
-void RevertCornersNearOtherTags(std::vector<TagDetection>* dets) {
-  std::vector<std::array<bool, 4>> revert(dets->size(),
-                                          {false, false, false, false});
-  for (size_t i = 0; i < dets->size(); ++i) {
-    const auto& c = (*dets)[i].detector_corners;
-    for (int k = 0; k < 4; ++k) {
-      const Eigen::Vector2d& a = c[k];
-      const Eigen::Vector2d& b = c[(k + 1) % 4];
-      const double cell = (b - a).norm() / 8.0;
-      const double reach = 1.5 * cell + 1.0;
-      for (size_t j = 0; j < dets->size(); ++j) {
-        if (j == i) continue;
-        const auto& o = (*dets)[j].detector_corners;
-        for (int m = 0; m < 4 && !revert[i][k]; ++m) {
-          if (SegmentsDistance(a, b, o[m], o[(m + 1) % 4]) < reach) {
-            revert[i][k] = true;
-          }
-        }
-      }
-    }
+namespace {
+
+// image_from_template homography (h33 = 1) from the four corners: template
+// coordinates in texels of TagImage, the detected square spanning
+// [start, start + cells] (corner order of the header: 0 bottom-left).
+Eigen::Matrix3d ImageFromTemplate(const std::array<Eigen::Vector2d, 4>& c,
+                                  double start, double cells) {
+  const double lo = start, hi = start + cells;
+  const std::array<Eigen::Vector2d, 4> t = {Eigen::Vector2d(lo, hi),
+                                            Eigen::Vector2d(hi, hi),
+                                            Eigen::Vector2d(hi, lo),
+                                            Eigen::Vector2d(lo, lo)};
+  Eigen::Matrix<double, 8, 8> A;
+  Eigen::Matrix<double, 8, 1> b;
+  for (int i = 0; i < 4; ++i) {
+    const double x = t[i].x(), y = t[i].y(), u = c[i].x(), v = c[i].y();
+    A.row(2 * i) << x, y, 1, 0, 0, 0, -u * x, -u * y;
+    A.row(2 * i + 1) << 0, 0, 0, x, y, 1, -v * x, -v * y;
+    b(2 * i) = u;
+    b(2 * i + 1) = v;
   }
-  for (size_t i = 0; i < dets->size(); ++i) {
-    TagDetection& t = (*dets)[i];
-    for (int k = 0; k < 4; ++k) {
-      // Side k runs from corner k to corner k + 1.
-      if (revert[i][k]) {
-        for (int e : {k, (k + 1) % 4}) {
-          t.corners[e] = t.detector_corners[e];
-          t.refined[e] = false;
-        }
+  const Eigen::Matrix<double, 8, 1> h = A.fullPivLu().solve(b);
+  Eigen::Matrix3d H;
+  H << h(0), h(1), h(2), h(3), h(4), h(5), h(6), h(7), 1.0;
+  return H;
+}
+
+// The printed pattern seen through a homography: class 0 black, 1 white,
+// 2 outside the tag, at an image point.
+struct PatternView {
+  const cv::Mat* image;  // TagImage
+  Eigen::Matrix3d template_from_image;
+  int ClassAt(const Eigen::Vector2d& q) const {
+    const Eigen::Vector3d t = template_from_image * q.homogeneous();
+    if (!(t.z() > 0)) return 2;
+    const double x = t.x() / t.z(), y = t.y() / t.z();
+    if (!(x >= 0 && y >= 0 && x < image->cols && y < image->rows)) return 2;
+    return image->at<uint8_t>(static_cast<int>(y), static_cast<int>(x)) > 127
+               ? 1
+               : 0;
+  }
+};
+
+// The pattern along q(o) = p + o n for o in [lo, hi]: breaks found on a
+// 0.1 px scan, each refined by bisection to 1e-3 px.
+void PatternAlong(const PatternView& view, const Eigen::Vector2d& p,
+                  const Eigen::Vector2d& n, double lo, double hi,
+                  EdgeProfile* profile) {
+  profile->breaks.clear();
+  profile->classes.clear();
+  const double step = 0.1;
+  int prev = view.ClassAt(p + lo * n);
+  profile->classes.push_back(prev);
+  for (double o = lo + step; o <= hi; o += step) {
+    const int c = view.ClassAt(p + o * n);
+    if (c == prev) continue;
+    double a = o - step, b = o;
+    while (b - a > 1e-3) {
+      const double m = 0.5 * (a + b);
+      if (view.ClassAt(p + m * n) == prev) {
+        a = m;
+      } else {
+        b = m;
       }
     }
+    profile->breaks.push_back(0.5 * (a + b));
+    profile->classes.push_back(c);
+    prev = c;
   }
 }
 
-// Edge refinement. For each side (corner k to corner k+1) the outward normal
-// n points from the black square into the white border. At sample points p
-// along the middle 80 % of the side, the edge offset along n is found by the
-// area rule on the intensity profile I(o) = I(p + o n), o in [-w, w]:
-//   edge = w - integral_{-w}^{w} (I(o) - I_black) / (I_white - I_black) do,
-// which is exact for any symmetric blur of a step (and for pixel
-// integration), with I_black, I_white the side's median intensities half a
-// cell inside and outside the edge. The window is re-centred once. A total
-// least-squares line is fitted to the edge points (3 MAD outliers dropped),
-// and adjacent lines intersect in the new corners.
-bool RefineCornersByEdges(const cv::Mat& gray, TagDetection* det,
-                          std::array<double, 4>* side_rms) {
-  const auto& c = det->corners;
-  std::array<double, 4> rms_of_side{};
-  Eigen::Vector2d centroid = (c[0] + c[1] + c[2] + c[3]) / 4.0;
-  std::array<Line2, 4> lines;
-  for (int k = 0; k < 4; ++k) {
-    const Eigen::Vector2d a = c[k];
-    const Eigen::Vector2d b = c[(k + 1) % 4];
-    const double len = (b - a).norm();
-    if (len < 8.0) return false;
-    const Eigen::Vector2d dir = (b - a) / len;
-    Eigen::Vector2d n(-dir.y(), dir.x());
-    if (n.dot((a + b) / 2 - centroid) < 0) n = -n;
-    // Cells across the black square: 8 for tag36h11; the white border is one
-    // cell wide. A conservative 8 keeps windows inside one cell for smaller
-    // families too. The cell across this side is set by the sides that run
-    // across it, which are shorter than this one when the tag is seen
-    // obliquely: the shortest side bounds it.
-    double shortest = len;
+// Whether the segment ab comes within one cell (+ 1 px) of another tag's
+// quad: its white border and black square would enter the profile.
+bool NearOtherTag(const Eigen::Vector2d& a, const Eigen::Vector2d& b,
+                  const std::vector<NeighbourTag>& others, double cells) {
+  for (const NeighbourTag& t : others) {
+    const auto& o = t.corners;
+    double side = 0;
+    for (int m = 0; m < 4; ++m) side += (o[(m + 1) % 4] - o[m]).norm() / 4;
+    const double reach = side / cells + 1.0;
+    for (int m = 0; m < 4; ++m) {
+      if (SegmentsDistance(a, b, o[m], o[(m + 1) % 4]) < reach) return true;
+    }
+  }
+  return false;
+}
+
+// Profiles across one side (corner a to b, outward normal n) at sample
+// points along its middle 80 %, each with its pattern; samples near the
+// image border are skipped, and those reaching another tag unless too few
+// would remain.
+struct SideProfiles {
+  std::vector<Eigen::Vector2d> base;
+  std::vector<EdgeProfile> profiles;
+  int near_other_tag = 0;
+  double cell = 0;
+};
+
+SideProfiles ProfilesOfSide(
+    const cv::Mat& gray, const PatternView& view, const Eigen::Vector2d& a,
+    const Eigen::Vector2d& b, const Eigen::Vector2d& n, double cell,
+    double cells, const std::vector<NeighbourTag>& others) {
+  SideProfiles out;
+  out.cell = cell;
+  const double len = (b - a).norm();
+  const Eigen::Vector2d dir = (b - a) / len;
+  // The window reaches one cell past the edge on both sides (the black
+  // ring and the white border) plus 2 px for the blur, at most 1.5 cells.
+  const double reach = std::max(2.0, std::min(1.5 * cell, cell + 2.0));
+  const double step = std::clamp(cell / 8.0, 0.25, 1.0);
+  const int samples = std::clamp(static_cast<int>(len * 0.8), 6, 32);
+  std::vector<bool> near;
+  for (int s = 0; s < samples; ++s) {
+    const double t = 0.1 + 0.8 * (s + 0.5) / samples;
+    const Eigen::Vector2d p = a + t * len * dir;
+    const Eigen::Vector2d lo = p - reach * n, hi = p + reach * n;
+    if (!Inside(gray, lo, 1.0) || !Inside(gray, hi, 1.0)) continue;
+    EdgeProfile prof;
+    for (double o = -reach; o <= reach + 1e-9; o += step) {
+      const Eigen::Vector2d q = p + o * n;
+      prof.offsets.push_back(o);
+      prof.values.push_back(Bilinear(gray, q.x(), q.y()));
+    }
+    // Pattern beyond the window as far as a wide blur reaches into it.
+    PatternAlong(view, p, n, -reach - 6.0, reach + 6.0, &prof);
+    near.push_back(NearOtherTag(lo, hi, others, cells));
+    out.near_other_tag += near.back() ? 1 : 0;
+    out.base.push_back(p);
+    out.profiles.push_back(std::move(prof));
+  }
+  const int clear = static_cast<int>(out.base.size()) - out.near_other_tag;
+  if (out.near_other_tag > 0 && clear >= std::max(4, samples / 3)) {
+    SideProfiles kept = out;
+    kept.base.clear();
+    kept.profiles.clear();
+    for (size_t i = 0; i < near.size(); ++i) {
+      if (near[i]) continue;
+      kept.base.push_back(out.base[i]);
+      kept.profiles.push_back(std::move(out.profiles[i]));
+    }
+    return kept;
+  }
+  return out;
+}
+
+// The side's blur: the sigma that fits eight of its profiles best
+// (golden section on log sigma in [0.3, 3] px, 8 steps: to 2 %).
+double SideBlur(const std::vector<EdgeProfile>& profiles) {
+  if (profiles.empty()) return 1.0;
+  const size_t stride = std::max<size_t>(1, profiles.size() / 8);
+  const auto cost = [&](double log_sigma) {
+    double sum = 0;
+    for (size_t i = 0; i < profiles.size(); i += stride) {
+      const EdgeProfileFit f =
+          FitEdgeProfile(profiles[i], std::exp(log_sigma), 3);
+      sum += f.ok ? f.rms * f.rms : 1e6;
+    }
+    return sum;
+  };
+  double a = std::log(0.3), b = std::log(3.0);
+  const double g = 0.5 * (std::sqrt(5.0) - 1);
+  double x1 = b - g * (b - a), x2 = a + g * (b - a);
+  double f1 = cost(x1), f2 = cost(x2);
+  for (int it = 0; it < 8; ++it) {
+    if (f1 < f2) {
+      b = x2;
+      x2 = x1;
+      f2 = f1;
+      x1 = b - g * (b - a);
+      f1 = cost(x1);
+    } else {
+      a = x1;
+      x1 = x2;
+      f1 = f2;
+      x2 = a + g * (b - a);
+      f2 = cost(x2);
+    }
+  }
+  return std::exp(0.5 * (a + b));
+}
+
+// Edge points of one side: the profiles' shifts along the normal.
+bool FitSide(const cv::Mat& gray, const SideProfiles& side,
+             const Eigen::Vector2d& n, double sigma, Line2* line,
+             TagSideQuality* quality) {
+  std::vector<Eigen::Vector2d> pts;
+  std::vector<double> contrast, fit_rms;
+  const double w = std::min(0.45 * side.cell, 3.0);
+  for (size_t i = 0; i < side.profiles.size(); ++i) {
+    const EdgeProfile& prof = side.profiles[i];
+    const EdgeProfileFit f = FitEdgeProfile(prof, sigma);
+    if (!f.ok) continue;
+    double shift = f.shift_px;
+    // A sharp side whose neighbouring edges (one cell away) stay out of
+    // the area rule's window even blurred: the rule is exact there.
+    if (sigma < 0.8 && w >= 0.8 && 0.55 * side.cell >= 2.5 * sigma) {
+      // A sharp edge: the area rule, its levels the plateaus at the
+      // window's ends (sampled at 0.25 px: the trapezoid rule is then
+      // exact on the bilinear interpolant of a pixel-integrated step).
+      EdgeProfile fine;
+      for (double o = shift - w - 0.25; o <= shift + w + 0.25; o += 0.25) {
+        const Eigen::Vector2d q = side.base[i] + o * n;
+        if (!Inside(gray, q, 1.0)) break;
+        fine.offsets.push_back(o);
+        fine.values.push_back(Bilinear(gray, q.x(), q.y()));
+      }
+      if (fine.offsets.size() < 8 || fine.offsets.back() < shift + w) {
+        continue;
+      }
+      const size_t m = fine.values.size();
+      const double inside = 0.5 * (fine.values[0] + fine.values[1]);
+      const double outside = 0.5 * (fine.values[m - 1] + fine.values[m - 2]);
+      if (std::abs(outside - inside) < 5.0) continue;
+      shift = AreaRuleShift(fine, inside, outside, shift, w);
+      if (std::abs(shift - f.shift_px) > 0.5) continue;
+    }
+    pts.push_back(side.base[i] + shift * n);
+    contrast.push_back(std::abs(f.levels[1] - f.levels[0]));
+    fit_rms.push_back(f.rms);
+  }
+  if (pts.size() < 4) return false;
+  *line = FitLine(pts);
+  // Drop points far from the line (another edge, a glint) and refit.
+  std::vector<double> res;
+  for (const auto& q : pts) res.push_back(std::abs(line->n.dot(q) - line->c));
+  const double limit = std::max(3.0 * 1.4826 * Median(res), 0.05);
+  std::vector<Eigen::Vector2d> kept;
+  for (size_t i = 0; i < pts.size(); ++i) {
+    if (res[i] <= limit) kept.push_back(pts[i]);
+  }
+  if (kept.size() < 4) return false;
+  if (kept.size() < pts.size()) *line = FitLine(kept);
+  double ss = 0;
+  for (const auto& q : kept) {
+    const double r = line->n.dot(q) - line->c;
+    ss += r * r;
+  }
+  quality->line_rms_px = std::sqrt(ss / kept.size());
+  quality->blur_px = sigma;
+  quality->contrast = Median(contrast);
+  quality->fit_rms = Median(fit_rms);
+  quality->points = static_cast<int>(kept.size());
+  quality->near_other_tag = side.near_other_tag;
+  return true;
+}
+
+}  // namespace
+
+// Edge refinement by the pattern model (vision/edge_profile.h): for each
+// side, profiles across it at sample points along its middle 80 % are
+// fitted with the tag's own printed pattern along that line (its data bits,
+// black ring, white border and the outside), blurred by a Gaussian whose
+// width the side's profiles choose, with black, white and outside levels
+// per profile; the shifts give edge points, a total least-squares line per
+// side (3 MAD outliers dropped) and the corners as intersections. Two
+// passes: the second places the pattern by the first's corners. Samples
+// whose window reaches another detected tag are left out (while enough
+// remain), not the whole side. A sharp side (sigma < 0.8 px, its
+// neighbouring edges 2.5 sigma clear of the window) takes the area rule
+// with the plateaus at the window's ends instead (edge_profile.h).
+bool RefineCornersByEdges(const cv::Mat& gray, const cv::Mat& tag_image,
+                          int cells, TagDetection* det,
+                          const std::vector<NeighbourTag>& others) {
+  const double start = 0.5 * (tag_image.cols - cells);
+  std::array<Eigen::Vector2d, 4> c = det->corners;
+  std::array<TagSideQuality, 4> quality{};
+  std::array<double, 4> sigma = {0, 0, 0, 0};
+  for (int pass = 0; pass < 2; ++pass) {
+    PatternView view{&tag_image,
+                     ImageFromTemplate(c, start, cells).inverse()};
+    const Eigen::Vector2d centroid = (c[0] + c[1] + c[2] + c[3]) / 4.0;
+    double shortest = 1e9;
     for (int j = 0; j < 4; ++j) {
       shortest = std::min(shortest, (c[(j + 1) % 4] - c[j]).norm());
     }
-    const double cell = shortest / 8.0;
-    const double w = std::min(0.45 * cell, 3.0);
-    if (w < 0.8) return false;
-    const int samples = std::max(6, static_cast<int>(len * 0.8));
-    const double margin = cell + 2.0;
-    std::vector<double> dark, bright;
-    std::vector<Eigen::Vector2d> base;
-    for (int s = 0; s < samples; ++s) {
-      const double t = 0.1 + 0.8 * (s + 0.5) / samples;
-      const Eigen::Vector2d p = a + t * len * dir;
-      if (!Inside(gray, p, margin)) continue;
-      base.push_back(p);
-      const Eigen::Vector2d p_dark = p - 0.5 * cell * n;
-      const Eigen::Vector2d p_bright = p + 0.5 * cell * n;
-      dark.push_back(Bilinear(gray, p_dark.x(), p_dark.y()));
-      bright.push_back(Bilinear(gray, p_bright.x(), p_bright.y()));
-    }
-    if (base.size() < 4) return false;
-    const double i_dark = Median(dark);
-    const double i_bright = Median(bright);
-    // Reversed-border families (tagStandard41h12) have the bright side
-    // inside: the area rule only needs the two levels apart.
-    if (std::abs(i_bright - i_dark) < 5.0) return false;
-    const double inv = 1.0 / (i_bright - i_dark);
-    const double h = 0.25;  // px between profile samples
-    const int m = static_cast<int>(std::ceil(w / h));
-    std::vector<Eigen::Vector2d> pts;
-    std::vector<double> offsets;
-    for (const Eigen::Vector2d& p : base) {
-      double o0 = 0;
-      bool ok = true;
-      for (int iter = 0; iter < 2 && ok; ++iter) {
-        // Trapezoid rule over o in [o0 - m h, o0 + m h].
-        double area = 0;
-        for (int j = -m; j <= m; ++j) {
-          const Eigen::Vector2d q = p + (o0 + j * h) * n;
-          const double v = (Bilinear(gray, q.x(), q.y()) - i_dark) * inv;
-          area += (j == -m || j == m) ? 0.5 * v : v;
-        }
-        area *= h;
-        const double o = o0 + m * h - area;
-        if (std::abs(o) > w) ok = false;
-        o0 = o;
+    const double cell = shortest / cells;
+    if (shortest < 8.0 || cell < 1.5) return false;
+    std::array<Line2, 4> lines;
+    for (int k = 0; k < 4; ++k) {
+      const Eigen::Vector2d a = c[k], b = c[(k + 1) % 4];
+      const Eigen::Vector2d dir = (b - a).normalized();
+      Eigen::Vector2d n(-dir.y(), dir.x());
+      if (n.dot((a + b) / 2 - centroid) < 0) n = -n;
+      const SideProfiles side =
+          ProfilesOfSide(gray, view, a, b, n, cell, cells, others);
+      if (pass == 0) sigma[k] = SideBlur(side.profiles);
+      if (!FitSide(gray, side, n, sigma[k], &lines[k], &quality[k])) {
+        return false;
       }
-      if (!ok) continue;
-      pts.push_back(p + o0 * n);
-      offsets.push_back(o0);
     }
-    if (pts.size() < 4) return false;
-    Line2 line = FitLine(pts);
-    // Drop points far from the line (another edge, a glint) and refit.
-    std::vector<double> res;
-    for (const auto& q : pts) res.push_back(std::abs(line.n.dot(q) - line.c));
-    const double mad = Median(res);
-    const double limit = std::max(3.0 * 1.4826 * mad, 0.05);
-    std::vector<Eigen::Vector2d> kept;
-    for (size_t i = 0; i < pts.size(); ++i) {
-      if (res[i] <= limit) kept.push_back(pts[i]);
+    std::array<Eigen::Vector2d, 4> refined;
+    for (int k = 0; k < 4; ++k) {
+      // Corner k joins side k-1 (from corner k-1 to k) and side k.
+      if (!Intersect(lines[(k + 3) % 4], lines[k], &refined[k])) return false;
+      if ((refined[k] - det->corners[k]).norm() > 3.0) return false;
     }
-    if (kept.size() < 4) return false;
-    if (kept.size() < pts.size()) line = FitLine(kept);
-    double ss = 0;
-    for (const auto& q : kept) {
-      const double r = line.n.dot(q) - line.c;
-      ss += r * r;
-    }
-    rms_of_side[k] = std::sqrt(ss / kept.size());
-    lines[k] = line;
+    c = refined;
   }
-  std::array<Eigen::Vector2d, 4> refined;
-  for (int k = 0; k < 4; ++k) {
-    // Corner k joins side k-1 (from corner k-1 to k) and side k.
-    if (!Intersect(lines[(k + 3) % 4], lines[k], &refined[k])) return false;
-    if ((refined[k] - c[k]).norm() > 3.0) return false;
-  }
-  det->corners = refined;
-  if (side_rms != nullptr) *side_rms = rms_of_side;
+  det->corners = c;
+  det->sides = quality;
   // Centre: intersection of the diagonals.
   Line2 d0, d1;
-  d0.n = Eigen::Vector2d(-(refined[2] - refined[0]).y(),
-                         (refined[2] - refined[0]).x())
-             .normalized();
-  d0.c = d0.n.dot(refined[0]);
-  d1.n = Eigen::Vector2d(-(refined[3] - refined[1]).y(),
-                         (refined[3] - refined[1]).x())
-             .normalized();
-  d1.c = d1.n.dot(refined[1]);
+  d0.n = Eigen::Vector2d(-(c[2] - c[0]).y(), (c[2] - c[0]).x()).normalized();
+  d0.c = d0.n.dot(c[0]);
+  d1.n = Eigen::Vector2d(-(c[3] - c[1]).y(), (c[3] - c[1]).x()).normalized();
+  d1.c = d1.n.dot(c[1]);
   Eigen::Vector2d center;
   if (Intersect(d0, d1, &center)) det->center = center;
   return true;

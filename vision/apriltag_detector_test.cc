@@ -204,8 +204,11 @@ TEST(AprilTagDetector, DetectInRegionReportsFullImageCoordinates) {
       detector.DetectInRegion(image, cv::Rect(230, 130, 120, 120));
   ASSERT_EQ(full.size(), 1u);
   ASSERT_EQ(crop.size(), 1u);
+  // The same up to the refinement's dependence on libapriltag's start
+  // corners (its sample points move with them; < 0.001 px here): an offset
+  // error would be 0.5 px or more.
   for (int k = 0; k < 4; ++k) {
-    EXPECT_NEAR((full[0].corners[k] - crop[0].corners[k]).norm(), 0.0, 1e-6);
+    EXPECT_NEAR((full[0].corners[k] - crop[0].corners[k]).norm(), 0.0, 0.005);
   }
   // A region without the tag finds nothing.
   EXPECT_TRUE(detector.DetectInRegion(image, cv::Rect(0, 0, 150, 150)).empty());

@@ -21,14 +21,50 @@ namespace {
 
 // One tag seen by one camera, with its target placement.
 struct TagObs {
-  int camera;
-  const TagDetection* det;
-  const TargetTag* tag;
+  int camera = 0;
+  const TagDetection* det = nullptr;
+  const TargetTag* tag = nullptr;
   // The corners the fit uses (the detection's, or libapriltag's where the
   // per-corner check swapped them back) and which of them take part.
   std::array<Eigen::Vector2d, 4> px;
   std::array<bool, 4> use = {true, true, true, true};
+  std::string left_out;  // reason code when not used
 };
+
+// The weakest side's contrast (0 when the edge refinement did not run).
+double Contrast(const TagDetection& d) {
+  double c = 1e9;
+  for (const TagSideQuality& s : d.sides) c = std::min(c, s.contrast);
+  return d.sides[0].points > 0 ? c : 0.0;
+}
+
+// Angle between the tag's normal and the ray from the camera to its centre.
+double ObliquityDeg(const Camera& cam, const Rigid3& rig_from_tool,
+                    const TargetTag& tag) {
+  const Rigid3 cam_from_tag = cam.cam_from_rig * rig_from_tool *
+                              tag.tool_from_tag;
+  const Eigen::Vector3d ray = cam_from_tag.t.normalized();
+  const double c = std::abs(ray.dot(cam_from_tag.R.col(2)));
+  return std::acos(std::min(1.0, c)) * 180 / M_PI;
+}
+
+// Whether the used tag observations without `drop` still determine the
+// pose: two or more, in every camera that has one now.
+bool DeterminedWithout(const std::vector<TagObs>& obs,
+                       const std::vector<bool>& used, size_t drop) {
+  std::map<int, int> now, after;
+  for (size_t i = 0; i < obs.size(); ++i) {
+    if (!used[i]) continue;
+    ++now[obs[i].camera];
+    if (i != drop) ++after[obs[i].camera];
+  }
+  int left = 0;
+  for (const auto& [camera, count] : now) {
+    if (after[camera] == 0) return false;
+    left += after[camera];
+  }
+  return left >= 2;
+}
 
 std::vector<TagObs> CollectObservations(
     const Rig& rig, const Target& target,
@@ -41,7 +77,12 @@ std::vector<TagObs> CollectObservations(
     for (const auto& d : detections[c]) {
       const TargetTag* tag = target.FindTag(d.id);
       if (tag == nullptr || count[d.id] != 1) continue;
-      obs.push_back({static_cast<int>(c), &d, tag, d.corners});
+      TagObs o;
+      o.camera = static_cast<int>(c);
+      o.det = &d;
+      o.tag = tag;
+      o.px = d.corners;
+      obs.push_back(o);
     }
   }
   return obs;
@@ -267,7 +308,10 @@ int CheckCornersAgainstPose(const Rig& rig, const Rigid3& pose,
         ++kept;
       }
     }
-    if (kept < 3) (*used)[i] = false;
+    if (kept < 3) {
+      (*used)[i] = false;
+      o.left_out = "corners";
+    }
   }
   return changed;
 }
@@ -281,6 +325,10 @@ void ToolPoseOptions::Check() const {
     throw InputError(os.str());
   };
   if (!(outlier_px > 0)) fail("outlier_px (expected > 0)", outlier_px);
+  if (!(hard_outlier_px >= outlier_px)) {
+    fail("hard_outlier_px (expected >= outlier_px)", hard_outlier_px);
+  }
+  if (!(min_contrast >= 0)) fail("min_contrast (expected >= 0)", min_contrast);
   if (!(outlier_ratio >= 1))
     fail("outlier_ratio (expected >= 1)", outlier_ratio);
   if (!(huber_px >= 0)) fail("huber_px (expected >= 0)", huber_px);
@@ -304,10 +352,23 @@ ToolPoseResult EstimateToolPose(
     const ToolPoseOptions& options) {
   options.Check();
   ToolPoseResult result;
-  std::vector<TagObs> obs = CollectObservations(rig, target, detections);
+  std::vector<TagObs> all = CollectObservations(rig, target, detections);
+  // Tags too faint to measure are left out before the fit.
+  std::vector<TagObs> obs, faint;
+  for (TagObs& o : all) {
+    const double c = Contrast(*o.det);
+    if (c > 0 && c < options.min_contrast) {
+      o.left_out = "contrast";
+      faint.push_back(o);
+    } else {
+      obs.push_back(o);
+    }
+  }
   if (static_cast<int>(obs.size()) < options.min_tag_observations ||
       obs.empty()) {
-    result.why_not = "no tag of the target seen";
+    result.why_not = faint.empty() ? "no tag of the target seen"
+                                   : "every tag seen is too faint (contrast "
+                                     "under --min-contrast gray levels)";
     return result;
   }
   Rigid3 pose;
@@ -360,7 +421,12 @@ ToolPoseResult EstimateToolPose(
       }
     }
     if (worst < 0 || n_used - 1 < options.min_tag_observations) break;
+    if (rms[worst] <= std::max(options.hard_outlier_px, limit) &&
+        !DeterminedWithout(obs, used, worst)) {
+      break;
+    }
     used[worst] = false;
+    obs[worst].left_out = "residual";
     if (!FitPose(rig, obs, used, options.huber_px, options.max_iterations,
                  &pose)) {
       result.why_not = "pose fit failed after outlier rejection";
@@ -374,10 +440,22 @@ ToolPoseResult EstimateToolPose(
   }
   double sum = 0;
   int corners = 0;
+  for (const TagObs& o : faint) obs.push_back(o);
+  used.resize(obs.size(), false);
   for (size_t i = 0; i < obs.size(); ++i) {
-    const double r = TagRms(rig.cameras[obs[i].camera], pose, obs[i]);
-    result.tags.push_back(
-        {obs[i].camera, obs[i].tag->id, r, used[i], obs[i].use, obs[i].px});
+    const Camera& cam = rig.cameras[obs[i].camera];
+    const double r = TagRms(cam, pose, obs[i]);
+    TagObservationResult t;
+    t.camera = obs[i].camera;
+    t.tag_id = obs[i].tag->id;
+    t.rms_px = r;
+    t.used = used[i];
+    t.left_out = used[i] ? "" : obs[i].left_out;
+    t.contrast = Contrast(*obs[i].det);
+    t.obliquity_deg = ObliquityDeg(cam, pose, *obs[i].tag);
+    t.corner_used = obs[i].use;
+    t.corners_px = obs[i].px;
+    result.tags.push_back(t);
     if (!used[i]) continue;
     int n = 0;
     for (bool u : obs[i].use) n += u ? 1 : 0;

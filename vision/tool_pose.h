@@ -19,11 +19,21 @@
 namespace kincal {
 
 struct ToolPoseOptions {
-  // A tag observation (one tag in one camera) is rejected when its corner RMS
-  // exceeds max(outlier_px, outlier_ratio * median tag RMS); the worst goes
-  // first, then the fit is redone.
-  double outlier_px = 1.5;
+  // Each tag observation (one tag in one camera) is judged on its own, so a
+  // badly lit or oblique tag costs that tag, not the frame:
+  //  - before the fit, one whose edges have a contrast under min_contrast
+  //    gray levels (TagSideQuality::contrast, the weakest side) is left out
+  //    ("contrast");
+  //  - after the fit, the worst is left out while its corner RMS exceeds
+  //    max(outlier_px, outlier_ratio * median tag RMS) ("residual"), the
+  //    fit redone each time; between outlier_px and hard_outlier_px only
+  //    while the remaining tags still determine the pose: two tag
+  //    observations or more, in every camera that had one. A tag over
+  //    hard_outlier_px goes whatever remains.
+  double outlier_px = 0.5;
+  double hard_outlier_px = 1.5;
   double outlier_ratio = 5.0;
+  double min_contrast = 12.0;
   // Per corner, after the robust first fit: a corner whose residual exceeds
   // max(corner_outlier_px, outlier_ratio * median corner residual) goes back
   // to libapriltag's corner (TagDetection::detector_corners) if that fits
@@ -43,6 +53,12 @@ struct TagObservationResult {
   int tag_id = 0;
   double rms_px = 0;  // corner RMS against the final pose
   bool used = false;
+  // Why it was left out (empty when used): "contrast" (its edges too faint
+  // to measure), "corners" (fewer than 3 corners fit the pose), "residual"
+  // (its corners disagree with the other tags' pose).
+  std::string left_out;
+  double contrast = 0;       // weakest side's white - black, gray levels
+  double obliquity_deg = 0;  // angle between its normal and the view ray
   // Corners that took part (the per-corner check may leave some out) and
   // the pixels used for them (refined, or libapriltag's).
   std::array<bool, 4> corner_used = {true, true, true, true};

@@ -1,0 +1,162 @@
+#include "vision/edge_profile.h"
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cmath>
+
+namespace kincal {
+
+namespace {
+
+constexpr double kPhiRange = 6.0;
+constexpr int kPhiTable = 4096;
+
+struct PhiTable {
+  std::array<double, kPhiTable + 1> v;
+  PhiTable() {
+    for (int i = 0; i <= kPhiTable; ++i) {
+      const double x = -kPhiRange + 2 * kPhiRange * i / kPhiTable;
+      v[i] = 0.5 * std::erfc(-x / std::sqrt(2.0));
+    }
+  }
+};
+
+struct GaussTable {
+  std::array<double, kPhiTable + 1> v;
+  GaussTable() {
+    for (int i = 0; i <= kPhiTable; ++i) {
+      const double x = -kPhiRange + 2 * kPhiRange * i / kPhiTable;
+      v[i] = 0.3989422804014327 * std::exp(-0.5 * x * x);
+    }
+  }
+};
+
+// Standard normal density from a table, for |x| < kPhiRange.
+inline double Gauss(double x) {
+  static const GaussTable table;
+  const double f = (x + kPhiRange) * (kPhiTable / (2 * kPhiRange));
+  const int i = static_cast<int>(f);
+  const double t = f - i;
+  return (1 - t) * table.v[i] + t * table.v[i + 1];
+}
+
+// Basis of the three classes at offset o, and its derivative with respect
+// to e, for shift e and blur sigma.
+void Basis(const EdgeProfile& p, double o, double e, double sigma,
+           Eigen::Vector3d* b, Eigen::Vector3d* db_de) {
+  b->setZero();
+  db_de->setZero();
+  const double inv = 1.0 / sigma;
+  // Phi((o - e - break) / sigma) at each break: the class left of a break
+  // contributes 1 - Phi there, the right one Phi, so each class sums
+  // (Phi(lower break) - Phi(upper break)).
+  double prev_phi = 1.0, prev_g = 0.0;  // at -inf: Phi = 1, density 0
+  for (size_t i = 0; i <= p.breaks.size(); ++i) {
+    double phi = 0.0, g = 0.0;  // at +inf
+    if (i < p.breaks.size()) {
+      const double x = (o - e - p.breaks[i]) * inv;
+      phi = FastPhi(x);
+      g = x > -kPhiRange && x < kPhiRange ? Gauss(x) : 0.0;
+    }
+    const int c = p.classes[i];
+    (*b)(c) += prev_phi - phi;
+    // d/de Phi((o - e - s) / sigma) = -g / sigma.
+    (*db_de)(c) += (-prev_g + g) * inv;
+    prev_phi = phi;
+    prev_g = g;
+  }
+}
+
+// The profile's sums for shift e in one pass: with B = sum b b^T,
+// D = sum db b^T, DD = sum db db^T, bv = sum b v, dv = sum db v, vv =
+// sum v^2, the levels L solve B L = bv, and with r = v - b.L, j = -db.L:
+// SSE = vv - 2 L.bv + L^T B L, sum j j = L^T DD L,
+// sum j r = -L.dv + L^T D L.
+struct ProfileSums {
+  Eigen::Matrix3d B = Eigen::Matrix3d::Zero(), D = Eigen::Matrix3d::Zero(),
+                  DD = Eigen::Matrix3d::Zero();
+  Eigen::Vector3d bv = Eigen::Vector3d::Zero(), dv = Eigen::Vector3d::Zero();
+  double vv = 0;
+};
+
+ProfileSums Sums(const EdgeProfile& p, double e, double sigma) {
+  ProfileSums s;
+  Eigen::Vector3d b, db;
+  for (size_t i = 0; i < p.offsets.size(); ++i) {
+    Basis(p, p.offsets[i], e, sigma, &b, &db);
+    const double v = p.values[i];
+    s.B.noalias() += b * b.transpose();
+    s.D.noalias() += db * b.transpose();
+    s.DD.noalias() += db * db.transpose();
+    s.bv += b * v;
+    s.dv += db * v;
+    s.vv += v * v;
+  }
+  // A tiny ridge for classes the profile does not reach.
+  s.B += Eigen::Matrix3d::Identity() * 1e-6;
+  return s;
+}
+
+}  // namespace
+
+double AreaRuleShift(const EdgeProfile& p, double inside, double outside,
+                     double centre, double w) {
+  const double a = centre - w, b = centre + w;
+  double area = 0;
+  for (size_t i = 0; i + 1 < p.offsets.size(); ++i) {
+    const double o0 = p.offsets[i], o1 = p.offsets[i + 1];
+    const double lo = std::max(a, o0), hi = std::min(b, o1);
+    if (!(hi > lo)) continue;
+    // The linear interpolant's integral over [lo, hi].
+    const double slope = (p.values[i + 1] - p.values[i]) / (o1 - o0);
+    const double v_lo = p.values[i] + slope * (lo - o0);
+    const double v_hi = p.values[i] + slope * (hi - o0);
+    area += 0.5 * (v_lo + v_hi) * (hi - lo);
+  }
+  const double normalised = (area - inside * (b - a)) / (outside - inside);
+  return b - normalised;
+}
+
+double FastPhi(double x) {
+  static const PhiTable table;
+  if (x <= -kPhiRange) return 0.0;
+  if (x >= kPhiRange) return 1.0;
+  const double f = (x + kPhiRange) * (kPhiTable / (2 * kPhiRange));
+  const int i = static_cast<int>(f);
+  const double t = f - i;
+  return (1 - t) * table.v[i] + t * table.v[i + 1];
+}
+
+EdgeProfileFit FitEdgeProfile(const EdgeProfile& profile, double sigma_px,
+                              int iterations, double max_shift_px) {
+  EdgeProfileFit fit;
+  if (profile.offsets.size() < 6 ||
+      profile.classes.size() != profile.breaks.size() + 1 ||
+      !(sigma_px > 0)) {
+    return fit;
+  }
+  double e = 0;
+  Eigen::Vector3d levels = Eigen::Vector3d::Zero();
+  double sse = 0;
+  for (int it = 0;; ++it) {
+    const ProfileSums s = Sums(profile, e, sigma_px);
+    levels = s.B.ldlt().solve(s.bv);
+    sse = s.vv - 2 * levels.dot(s.bv) + levels.dot(s.B * levels);
+    if (it == iterations) break;
+    // Gauss-Newton on e with the levels held.
+    const double jtj = levels.dot(s.DD * levels);
+    const double jtr = -levels.dot(s.dv) + levels.dot(s.D * levels);
+    if (!(jtj > 0)) return fit;
+    const double step = std::clamp(-jtr / jtj, -0.5, 0.5);
+    e += step;
+    if (std::abs(e) > max_shift_px) return fit;
+    if (std::abs(step) < 1e-4) iterations = it + 1;
+  }
+  fit.shift_px = e;
+  fit.levels = {levels(0), levels(1), levels(2)};
+  fit.rms = std::sqrt(std::max(0.0, sse) / profile.offsets.size());
+  fit.ok = std::isfinite(e) && std::abs(levels(1) - levels(0)) >= 5.0;
+  return fit;
+}
+
+}  // namespace kincal

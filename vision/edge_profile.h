@@ -1,0 +1,67 @@
+#ifndef KINCAL_VISION_EDGE_PROFILE_H_
+#define KINCAL_VISION_EDGE_PROFILE_H_
+
+// The intensity profile across one side of a tag, fitted with a model of
+// the tag's own pattern along that line (vision/apriltag_detector.cc's edge
+// refinement). The model is the printed pattern, blurred:
+//
+//   m(o) = sum_segments level[class] * (Phi((o - e - lo) / sigma)
+//                                       - Phi((o - e - hi) / sigma))
+//
+// o: offset along the side's outward normal (px, 0 = the side as
+// currently placed); the segments [lo, hi) are the pattern along that line
+// (black square, its data bits, the white border, the outside) with class
+// 0 = black, 1 = white, 2 = outside the tag; e: the shift of the pattern
+// (the edge correction sought); sigma: a Gaussian blur shared by the side.
+// The three levels are solved per profile (linear least squares for a given
+// e), so uneven light across and between tags, a shadow, vignetting or a
+// dim tag change the levels, not the edge; the neighbouring data bits and
+// the white border's outer edge are in the model instead of biasing the
+// edge, as they do in an area rule or a gradient centroid under wide blur.
+// e is found by Gauss-Newton with the levels projected out.
+
+#include <array>
+#include <vector>
+
+namespace kincal {
+
+struct EdgeProfile {
+  std::vector<double> offsets;  // px along the outward normal
+  std::vector<double> values;   // gray levels at those offsets
+  // Pattern: classes[i] holds between breaks[i - 1] and breaks[i]
+  // (classes.size() == breaks.size() + 1; the first and last extend to
+  // -inf and +inf).
+  std::vector<double> breaks;
+  std::vector<int> classes;  // 0 black, 1 white, 2 outside
+};
+
+struct EdgeProfileFit {
+  bool ok = false;
+  double shift_px = 0;                 // e
+  std::array<double, 3> levels = {};   // black, white, outside
+  double rms = 0;                      // residual RMS, gray levels
+};
+
+// Fits e (starting at 0, each step clamped to +-0.5 px, at most
+// `iterations` steps) for a given sigma. Not ok when the profile is too
+// short, the black and white levels are not apart, or e leaves +-max_shift.
+EdgeProfileFit FitEdgeProfile(const EdgeProfile& profile, double sigma_px,
+                              int iterations = 6, double max_shift_px = 2.0);
+
+// The area rule on the profile's samples (linearly interpolated) over
+// [centre - w, centre + w]: edge = centre + w - integral (v - inside) /
+// (outside - inside) do, with `inside` and `outside` the levels either side
+// of the edge (from a fit). Exact for any symmetric blur of an isolated
+// step and for pixel integration, which the Gaussian model is not when an
+// edge is sharp (sigma < 0.8 px: the sampled profile's shape then depends on
+// the edge's phase within a pixel); used there, where the neighbours' edges
+// stay outside the window.
+double AreaRuleShift(const EdgeProfile& profile, double inside, double outside,
+                     double centre, double w);
+
+// Standard normal CDF from a table (|error| < 2e-5), for the model's speed.
+double FastPhi(double x);
+
+}  // namespace kincal
+
+#endif  // KINCAL_VISION_EDGE_PROFILE_H_

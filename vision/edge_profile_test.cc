@@ -1,0 +1,104 @@
+#include "vision/edge_profile.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <random>
+
+namespace kincal {
+namespace {
+
+// A blurred pattern sampled at 0.25 px: data bit (white) | black ring |
+// white border | outside, with the edge at `edge` and a cell of `cell` px.
+EdgeProfile Synthetic(double edge, double cell, double sigma, double black,
+                      double white, double outside, double noise,
+                      std::mt19937_64* rng) {
+  EdgeProfile p;
+  // The pattern as the caller believes it placed (edge at 0).
+  p.breaks = {-cell, 0.0, cell};
+  p.classes = {1, 0, 1, 2};
+  std::normal_distribution<double> n(0, noise);
+  const double levels[3] = {black, white, outside};
+  for (double o = -1.5 * cell; o <= 1.5 * cell; o += 0.25) {
+    double v = 0, prev = 1.0;
+    for (size_t i = 0; i <= p.breaks.size(); ++i) {
+      const double phi =
+          i < p.breaks.size()
+              ? 0.5 * std::erfc(-(o - edge - p.breaks[i]) / (sigma * M_SQRT2))
+              : 0.0;
+      v += levels[p.classes[i]] * (prev - phi);
+      prev = phi;
+    }
+    p.offsets.push_back(o);
+    p.values.push_back(v + (noise > 0 ? n(*rng) : 0.0));
+  }
+  return p;
+}
+
+TEST(EdgeProfile, FastPhiMatchesErfc) {
+  for (double x = -7; x <= 7; x += 0.013) {
+    EXPECT_NEAR(FastPhi(x), 0.5 * std::erfc(-x / M_SQRT2), 2e-5) << x;
+  }
+}
+
+TEST(EdgeProfile, RecoversTheShiftUnderWideBlurWithNeighbours) {
+  std::mt19937_64 rng(3);
+  // A cell of 3 px under sigma 1.4 px: the white data bit and the dark
+  // outside both reach the edge; the model holds them.
+  for (double edge : {-0.7, -0.2, 0.0, 0.35, 0.9}) {
+    const EdgeProfile p = Synthetic(edge, 3.0, 1.4, 30, 220, 60, 0, &rng);
+    const EdgeProfileFit f = FitEdgeProfile(p, 1.4);
+    ASSERT_TRUE(f.ok);
+    EXPECT_NEAR(f.shift_px, edge, 1e-3);
+    EXPECT_NEAR(f.levels[0], 30, 0.05);
+    EXPECT_NEAR(f.levels[1], 220, 0.05);
+    EXPECT_NEAR(f.levels[2], 60, 0.05);
+  }
+}
+
+TEST(EdgeProfile, LevelsDoNotMoveTheEdge) {
+  std::mt19937_64 rng(4);
+  // A dim, low-contrast tag (paper at 60, black at 20) in a bright
+  // surround, and noise: the shift stays unbiased.
+  double sum = 0, sum_sq = 0;
+  const int n = 200;
+  for (int i = 0; i < n; ++i) {
+    const EdgeProfile p = Synthetic(0.3, 4.0, 1.0, 20, 60, 150, 1.5, &rng);
+    const EdgeProfileFit f = FitEdgeProfile(p, 1.0);
+    ASSERT_TRUE(f.ok);
+    sum += f.shift_px - 0.3;
+    sum_sq += (f.shift_px - 0.3) * (f.shift_px - 0.3);
+  }
+  EXPECT_LT(std::abs(sum / n), 0.01);
+  EXPECT_LT(std::sqrt(sum_sq / n), 0.1);
+}
+
+// A sharp edge as a pixel-integrated step sampled between pixel centres
+// looks: a ramp one pixel wide, not centred on a sample. The area rule
+// puts it exactly.
+TEST(EdgeProfile, AreaRuleIsExactForASharpRamp) {
+  for (double edge : {-0.37, 0.0, 0.21, 0.5}) {
+    EdgeProfile p;
+    for (double o = -4; o <= 4; o += 0.25) {
+      p.offsets.push_back(o);
+      p.values.push_back(
+          30 + 190 * std::clamp(o - (edge - 0.5), 0.0, 1.0));
+    }
+    EXPECT_NEAR(AreaRuleShift(p, 30, 220, 0.1, 2.5), edge, 1e-9) << edge;
+  }
+}
+
+TEST(EdgeProfile, RefusesAFlatProfile) {
+  EdgeProfile p;
+  p.breaks = {0.0};
+  p.classes = {0, 1};
+  for (double o = -3; o <= 3; o += 0.25) {
+    p.offsets.push_back(o);
+    p.values.push_back(100);
+  }
+  EXPECT_FALSE(FitEdgeProfile(p, 1.0).ok);
+}
+
+}  // namespace
+}  // namespace kincal
