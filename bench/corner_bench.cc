@@ -152,8 +152,9 @@ void RunScene(const Scene& scene, int holders) {
             Stat& s = stats[d.refined[k] ? "e final, refined corners"
                                          : "f final, fallen back"];
             s.AddCorner(d.corners[k] - t->corners[k]);
-            const double excess = (d.corners[k] - t->corners[k]).norm() -
-                                  (d.detector_corners[k] - t->corners[k]).norm();
+            const double excess =
+                (d.corners[k] - t->corners[k]).norm() -
+                (d.detector_corners[k] - t->corners[k]).norm();
             excess_sq += excess > 0 ? excess * excess : 0;
             worse += excess > 0.1 ? 1 : 0;
           }
@@ -197,7 +198,8 @@ int main(int argc, char** argv) {
     } else if (!std::strcmp(argv[i], "--scene") && i + 1 < argc) {
       only = argv[++i];
     } else {
-      std::fprintf(stderr, "usage: corner_bench [--holders N] [--scene NAME]\n");
+      std::fprintf(stderr,
+                   "usage: corner_bench [--holders N] [--scene NAME]\n");
       return 2;
     }
   }

@@ -252,7 +252,6 @@ bool AreaRuleRefinement(const cv::Mat& gray, TagDetection* det,
   return true;
 }
 
-
 // As the detector's checks did: refined corners beyond 0.3 px of
 // libapriltag's, or next to a side scattering over 0.15 px, fall back.
 std::vector<TagDetection> Refine(const cv::Mat& gray,

@@ -56,8 +56,8 @@ struct PlaneInCam {
 inline double LightAt(const PlaneLight& l, double x, double y) {
   double g = l.gain;
   if (l.shadow_gain != 1.0) {
-    const double d = l.shadow_normal.x() * x + l.shadow_normal.y() * y -
-                     l.shadow_offset_mm;
+    const double d =
+        l.shadow_normal.x() * x + l.shadow_normal.y() * y - l.shadow_offset_mm;
     const double s = l.penumbra_mm > 0
                          ? std::clamp(0.5 + d / l.penumbra_mm, 0.0, 1.0)
                          : (d > 0 ? 1.0 : 0.0);
@@ -266,8 +266,8 @@ cv::Mat ShadePixels(const std::vector<PlaneInCam>& in_cam,
         if (l00 == l10 && l00 == l01 && l00 == l11) {
           // Lit as at the pixel's centre.
           const Eigen::Vector2d c =
-              0.25 * (rays[c00] + rays[c00 + 1] + rays[c00 + gw] +
-                      rays[c00 + gw + 1]);
+              0.25 *
+              (rays[c00] + rays[c00 + 1] + rays[c00 + gw] + rays[c00 + gw + 1]);
           row[x] = LitRadiance(in_cam, l00, c.x(), c.y(), options);
           continue;
         }

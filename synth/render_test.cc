@@ -166,8 +166,7 @@ TEST(Render, LightOnTagsFollowsLambertAndShadow) {
   LightTags(o, target, &planes);
   const Eigen::Vector3d l = o.light_in_rig.normalized();
   for (size_t i = 0; i < planes.size(); ++i) {
-    const double cos =
-        std::max(0.0, planes[i].rig_from_plane.R.col(2).dot(l));
+    const double cos = std::max(0.0, planes[i].rig_from_plane.R.col(2).dot(l));
     EXPECT_NEAR(planes[i].light.gain, 0.1 + 0.9 * cos, 1e-12);
   }
   o.tag_gain = {2.0};
@@ -216,7 +215,8 @@ TEST(Render, BayerSensorDemosaicsToGray) {
   EXPECT_NEAR(im.at<uint8_t>(6, 6), want, 1.5);
   AprilTagDetector detector;
   CornerStats s;
-  for (const ViewTruth& v : f.views) Accumulate(detector.Detect(v.image), v.tags, &s);
+  for (const ViewTruth& v : f.views)
+    Accumulate(detector.Detect(v.image), v.tags, &s);
   EXPECT_EQ(s.tags_found, s.tags_expected);
   EXPECT_LT(s.Rms(), 0.15);
 }

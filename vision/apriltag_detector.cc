@@ -230,7 +230,8 @@ std::vector<TagDetection> AprilTagDetector::DetectInRegion(const cv::Mat& gray,
       break;
     case CornerRefinement::kCornerSubPix:
       for (TagDetection& t : out) {
-        if (RefineCornersBySubPix(gray, &t)) t.refined = {true, true, true, true};
+        if (RefineCornersBySubPix(gray, &t))
+          t.refined = {true, true, true, true};
       }
       break;
     case CornerRefinement::kEdges:
@@ -274,10 +275,9 @@ namespace {
 Eigen::Matrix3d ImageFromTemplate(const std::array<Eigen::Vector2d, 4>& c,
                                   double start, double cells) {
   const double lo = start, hi = start + cells;
-  const std::array<Eigen::Vector2d, 4> t = {Eigen::Vector2d(lo, hi),
-                                            Eigen::Vector2d(hi, hi),
-                                            Eigen::Vector2d(hi, lo),
-                                            Eigen::Vector2d(lo, lo)};
+  const std::array<Eigen::Vector2d, 4> t = {
+      Eigen::Vector2d(lo, hi), Eigen::Vector2d(hi, hi), Eigen::Vector2d(hi, lo),
+      Eigen::Vector2d(lo, lo)};
   Eigen::Matrix<double, 8, 8> A;
   Eigen::Matrix<double, 8, 1> b;
   for (int i = 0; i < 4; ++i) {
@@ -364,10 +364,10 @@ struct SideProfiles {
   double cell = 0;
 };
 
-SideProfiles ProfilesOfSide(
-    const cv::Mat& gray, const PatternView& view, const Eigen::Vector2d& a,
-    const Eigen::Vector2d& b, const Eigen::Vector2d& n, double cell,
-    double cells, const std::vector<NeighbourTag>& others) {
+SideProfiles ProfilesOfSide(const cv::Mat& gray, const PatternView& view,
+                            const Eigen::Vector2d& a, const Eigen::Vector2d& b,
+                            const Eigen::Vector2d& n, double cell, double cells,
+                            const std::vector<NeighbourTag>& others) {
   SideProfiles out;
   out.cell = cell;
   const double len = (b - a).norm();
@@ -534,8 +534,7 @@ bool RefineCornersByEdges(const cv::Mat& gray, const cv::Mat& tag_image,
   std::array<TagSideQuality, 4> quality{};
   std::array<double, 4> sigma = {0, 0, 0, 0};
   for (int pass = 0; pass < 2; ++pass) {
-    PatternView view{&tag_image,
-                     ImageFromTemplate(c, start, cells).inverse()};
+    PatternView view{&tag_image, ImageFromTemplate(c, start, cells).inverse()};
     const Eigen::Vector2d centroid = (c[0] + c[1] + c[2] + c[3]) / 4.0;
     double shortest = 1e9;
     for (int j = 0; j < 4; ++j) {

@@ -131,8 +131,7 @@ EdgeProfileFit FitEdgeProfile(const EdgeProfile& profile, double sigma_px,
                               int iterations, double max_shift_px) {
   EdgeProfileFit fit;
   if (profile.offsets.size() < 6 ||
-      profile.classes.size() != profile.breaks.size() + 1 ||
-      !(sigma_px > 0)) {
+      profile.classes.size() != profile.breaks.size() + 1 || !(sigma_px > 0)) {
     return fit;
   }
   double e = 0;

@@ -37,9 +37,9 @@ struct EdgeProfile {
 
 struct EdgeProfileFit {
   bool ok = false;
-  double shift_px = 0;                 // e
-  std::array<double, 3> levels = {};   // black, white, outside
-  double rms = 0;                      // residual RMS, gray levels
+  double shift_px = 0;                // e
+  std::array<double, 3> levels = {};  // black, white, outside
+  double rms = 0;                     // residual RMS, gray levels
 };
 
 // Fits e (starting at 0, each step clamped to +-0.5 px, at most

@@ -82,8 +82,7 @@ TEST(EdgeProfile, AreaRuleIsExactForASharpRamp) {
     EdgeProfile p;
     for (double o = -4; o <= 4; o += 0.25) {
       p.offsets.push_back(o);
-      p.values.push_back(
-          30 + 190 * std::clamp(o - (edge - 0.5), 0.0, 1.0));
+      p.values.push_back(30 + 190 * std::clamp(o - (edge - 0.5), 0.0, 1.0));
     }
     EXPECT_NEAR(AreaRuleShift(p, 30, 220, 0.1, 2.5), edge, 1e-9) << edge;
   }

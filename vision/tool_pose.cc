@@ -41,8 +41,8 @@ double Contrast(const TagDetection& d) {
 // Angle between the tag's normal and the ray from the camera to its centre.
 double ObliquityDeg(const Camera& cam, const Rigid3& rig_from_tool,
                     const TargetTag& tag) {
-  const Rigid3 cam_from_tag = cam.cam_from_rig * rig_from_tool *
-                              tag.tool_from_tag;
+  const Rigid3 cam_from_tag =
+      cam.cam_from_rig * rig_from_tool * tag.tool_from_tag;
   const Eigen::Vector3d ray = cam_from_tag.t.normalized();
   const double c = std::abs(ray.dot(cam_from_tag.R.col(2)));
   return std::acos(std::min(1.0, c)) * 180 / M_PI;
