@@ -116,7 +116,11 @@ void SetTransmissionTravel(const std::vector<Measurement>& ms, Chain* chain,
     if (!(hi > lo)) continue;
     row.transmission_lo = lo;
     row.transmission_hi = hi;
-    if (row.type == JointType::kRevolute && !row.periodic())
+    // Readings over more than one turn test whether the error repeats
+    // every turn (a gear train whose ratio is not whole does not): there
+    // the series along the travel is fitted, which can take either.
+    if (row.type == JointType::kRevolute && !row.periodic() &&
+        hi - lo < 2 * M_PI)
       row.periodic_basis = MakePeriodicBasis(q, periodic).basis;
   }
 }

@@ -52,9 +52,10 @@ std::string SpecCauseName(const std::string& cause);
 // Sets the travel of every moving joint whose chain row has none
 // (ChainRow::transmission_lo/hi) to the range of its readings in
 // `measurements`: the interval the transmission family's series lives on.
-// Revolute joints also get their periodic basis from the readings
-// (diagnose/periodic_basis.h): their transmission is a function of the angle
-// over the whole revolution; prismatic joints keep the sine series.
+// Revolute joints whose readings span less than one turn also get their
+// periodic basis from the readings (diagnose/periodic_basis.h): their
+// transmission is a function of the angle over the whole revolution;
+// prismatic joints and readings over more than a turn keep the sine series.
 void SetTransmissionTravel(const std::vector<Measurement>& measurements,
                            Chain* chain,
                            const PeriodicBasisOptions& periodic = {});
