@@ -2,6 +2,7 @@
 
 #include <sys/stat.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
@@ -28,6 +29,94 @@ std::string HelpFooter(const std::string& example,
                        const std::string& units_note) {
   return example + "\nUnits: lengths mm, angles deg, time s (pixels px)" +
          units_note + ". Defaults are shown beside each option.";
+}
+
+CLI::Option* AddCameraOption(CLI::App* sub, std::vector<std::string>* cameras,
+                             const std::string& help) {
+  return sub->add_option("--camera", *cameras, help)
+      ->type_name("NAME=GLOB")
+      ->allow_extra_args(false)
+      ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
+}
+
+std::vector<CameraGlob> CameraGlobs(const std::vector<std::string>& cameras,
+                                    const std::string& left,
+                                    const std::string& right) {
+  std::vector<CameraGlob> out;
+  if (!cameras.empty()) {
+    if (!left.empty() || !right.empty()) {
+      throw InputError(
+          "--camera NAME=GLOB replaces --left/--right (their two-camera "
+          "spelling); give one or the other");
+    }
+    for (const std::string& c : cameras) {
+      const size_t eq = c.find('=');
+      if (eq == std::string::npos || eq == 0 || eq + 1 == c.size()) {
+        throw InputError("--camera '" + c +
+                         "': expected NAME=GLOB, the camera's name in "
+                         "rig.yaml and its images (quote the glob), e.g. "
+                         "--camera top='session/top/*.png'");
+      }
+      const std::string name = c.substr(0, eq);
+      for (const CameraGlob& g : out) {
+        if (g.name == name) {
+          throw InputError("--camera " + name + " is given twice");
+        }
+      }
+      out.push_back({name, c.substr(eq + 1), "--camera " + name});
+    }
+    return out;
+  }
+  if (!right.empty() && left.empty()) {
+    throw InputError("--right needs --left (the rig's first camera)");
+  }
+  if (!left.empty()) out.push_back({"left", left, "--left"});
+  if (!right.empty()) out.push_back({"right", right, "--right"});
+  return out;
+}
+
+std::vector<CameraGlob> InRigOrder(const std::vector<CameraGlob>& globs,
+                                   const std::vector<std::string>& rig_names,
+                                   const std::string& rig_file) {
+  const bool spelled_left_right = !globs.empty() && globs[0].option == "--left";
+  std::vector<CameraGlob> out;
+  if (spelled_left_right) {
+    if (globs.size() != rig_names.size()) {
+      throw InputError(
+          rig_file + " has " + std::to_string(rig_names.size()) +
+          " cameras but --left/--right give " + std::to_string(globs.size()) +
+          (rig_names.size() > 2 ? "; name every camera with --camera NAME=GLOB"
+                                : ""));
+    }
+    for (size_t c = 0; c < globs.size(); ++c) {
+      out.push_back(globs[c]);
+      out.back().name = rig_names[c];
+    }
+    return out;
+  }
+  for (const std::string& name : rig_names) {
+    const CameraGlob* found = nullptr;
+    for (const CameraGlob& g : globs) {
+      if (g.name == name) found = &g;
+    }
+    if (found == nullptr) {
+      throw InputError("camera '" + name + "' of " + rig_file +
+                       " has no images: give --camera " + name +
+                       "='GLOB' for every camera of the rig");
+    }
+    out.push_back(*found);
+  }
+  for (const CameraGlob& g : globs) {
+    if (std::find(rig_names.begin(), rig_names.end(), g.name) ==
+        rig_names.end()) {
+      std::string names;
+      for (const std::string& n : rig_names)
+        names += (names.empty() ? "" : ", ") + n;
+      throw InputError(g.option + ": no camera '" + g.name + "' in " +
+                       rig_file + " (its cameras: " + names + ")");
+    }
+  }
+  return out;
 }
 
 void MakeDirs(const std::string& dir) {

@@ -32,6 +32,30 @@ CLI::Option* AddRobotOptions(CLI::App* sub, std::string* robot,
 std::string HelpFooter(const std::string& example,
                        const std::string& units_note = "");
 
+// The image globs of a command's cameras (format v3): `--camera NAME=GLOB`,
+// repeatable, in rig order; or the two-camera spelling `--left GLOB
+// [--right GLOB]` (cameras named left and right). `option` is how the user
+// wrote it, for messages.
+struct CameraGlob {
+  std::string name, glob, option;
+};
+// Adds --camera (repeatable) to `sub`, with `help`.
+CLI::Option* AddCameraOption(CLI::App* sub, std::vector<std::string>* cameras,
+                             const std::string& help);
+// InputError for a --camera without NAME= or GLOB, a name given twice, a
+// --right without --left, or --camera mixed with --left/--right. Empty when
+// none is given.
+std::vector<CameraGlob> CameraGlobs(const std::vector<std::string>& cameras,
+                                    const std::string& left,
+                                    const std::string& right);
+// `globs` in the order of the rig's cameras: --camera names must be the
+// rig's (each once, every one given); --left/--right stand for the rig's
+// first and second camera (and --left alone for a one-camera rig).
+// InputError naming the camera otherwise. `rig_file` for messages.
+std::vector<CameraGlob> InRigOrder(const std::vector<CameraGlob>& globs,
+                                   const std::vector<std::string>& rig_names,
+                                   const std::string& rig_file);
+
 // Creates `dir` (and parents) if needed; InputError when it cannot.
 void MakeDirs(const std::string& dir);
 

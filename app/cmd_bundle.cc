@@ -132,7 +132,8 @@ std::string TrackedTipsCsv(const BundleArgs& args, const Robot& robot,
       p.tags_used = f.tracked_tags;
     }
     if (p.found && p.tags_used >= args.min_tags &&
-        p.rms_px <= args.max_reproj_px && SeenByTwoCameras(f)) {
+        p.rms_px <= args.max_reproj_px &&
+        SeenByEnoughCameras(f, static_cast<int>(r.rig.cameras.size()))) {
       o.has_point = true;
       o.p_in_meas = p.rig_from_tool * target.tip_in_tool;
       ++*points;
@@ -235,6 +236,32 @@ struct BundleRun {
   double seconds = 0.0;
 };
 
+// What the camera configuration itself cannot determine, beside the
+// parameters the data leave unidentifiable (`unidentifiable`): {what, why}.
+nlohmann::json NotDeterminedJson(const Rig& rig) {
+  nlohmann::json out = nlohmann::json::array();
+  if (rig.cameras.size() == 1) {
+    out.push_back(
+        {{"what", "scale"},
+         {"why",
+          "one camera sees directions only: every length (the robot's, "
+          "rig_from_base's translation) rests on target.yaml's tag sizes; a "
+          "wrong tag size scales them all and no image can show it"}});
+  } else {
+    out.push_back(
+        {{"what", "scale"},
+         {"why",
+          "lengths rest on the rig's baseline and target.yaml's tag sizes "
+          "together; a disagreement between them shows as reprojection "
+          "error, not as a scale"}});
+  }
+  out.push_back({{"what", "tool beyond the target"},
+                 {"why",
+                  "the images see the tags, not the tip: the tool row ends at "
+                  "target.yaml's tip_in_tool as measured by `kincal target`"}});
+  return out;
+}
+
 nlohmann::json SummaryJson(const BundleArgs& args, const Target& target,
                            const BundleRun& run) {
   const BundleResult& r = run.result;
@@ -265,6 +292,9 @@ nlohmann::json SummaryJson(const BundleArgs& args, const Target& target,
   j["identifiable"] = r.identifiable;
   j["unidentifiable"] = r.unidentifiable;
   j["params"] = params;
+  j["cameras"] = r.rig.cameras.size();
+  j["mount"] = RigMountName(r.rig.mount);
+  j["not_determined"] = NotDeterminedJson(r.rig);
   if (!args.options.extensions.empty()) {
     const nlohmann::json extensions = ExtensionsJson(args.options, r);
     j["extensions"] = extensions;
@@ -315,6 +345,29 @@ void PrintSummary(const BundleArgs& args, const BundleRun& run) {
               args.out.c_str(), run.seconds, run.obs.seconds, r.seconds);
 }
 
+// A camera whose images never show a tag of the target (spec v3): bad
+// input naming the camera, before any solve.
+void RefuseBlindCameras(const BundleArgs& args, const Rig& rig,
+                        const SessionObservations& obs) {
+  std::vector<int> corners(rig.cameras.size(), 0);
+  for (const BundleFrame& f : obs.frames) {
+    for (const auto& c : f.corners) {
+      if (c.camera >= 0 && c.camera < static_cast<int>(corners.size())) {
+        ++corners[c.camera];
+      }
+    }
+  }
+  for (size_t c = 0; c < corners.size(); ++c) {
+    if (corners[c] > 0) continue;
+    throw InputError("camera '" + rig.cameras[c].intrinsics.name + "' of " +
+                     args.rig + " never shows a tag of the target in the " +
+                     std::to_string(obs.frames.size()) +
+                     " frames with joint readings of " + args.session +
+                     ": check its image folder and that it looks at the "
+                     "target, or leave the camera out of the rig");
+  }
+}
+
 int RunBundleCommand(BundleArgs args) {
   const auto start = std::chrono::steady_clock::now();
   Progress progress("kincal bundle", args.json || args.quiet);
@@ -322,13 +375,17 @@ int RunBundleCommand(BundleArgs args) {
   const Robot robot = ReadRobot(args.robot);
   const Rig rig = ReadRigYaml(args.rig);
   const Target target = ReadTargetYaml(args.target);
-  if (rig.cameras.size() != 2) {
-    throw InputError(args.rig +
-                     ": a recorded session has two cameras; the "
-                     "rig has " +
-                     std::to_string(rig.cameras.size()));
+  if (rig.mount == RigMount::kFlange) {
+    // Not a silent solve of the wrong model: the stand's unknowns
+    // (rig_from_base, flange_from_target) do not describe this set-up.
+    throw std::runtime_error(
+        args.rig +
+        ": mount: flange (cameras on the flange, target fixed) is read but "
+        "the bundle solves only cameras on a stand (mount: world) so far; "
+        "nothing written");
   }
   SessionReadOptions so;
+  so.camera_names = rig.CameraNames();
   so.joint_names = robot.JointNames();
   so.require_joint_readings = true;
   const Session session = ReadSession(args.session, so);
@@ -342,6 +399,7 @@ int RunBundleCommand(BundleArgs args) {
     progress.Update(done, total, "frames (detecting tags)");
   };
   run.obs = ObserveSession(session, rig, target, oo);
+  RefuseBlindCameras(args, rig, run.obs);
   progress.Stage("solving the bundle (" +
                  std::to_string(run.obs.frames.size()) + " frames)");
   run.result = RunBundle(robot, rig, target, run.obs.frames, args.options);

@@ -21,6 +21,7 @@
 #include "data/error.h"
 #include "data/glob.h"
 #include "data/progress.h"
+#include "data/session.h"
 #include "vision/calib_target.h"
 
 namespace kincal::app {
@@ -28,6 +29,7 @@ namespace {
 
 struct CamcalArgs {
   std::string left, right, target, out;
+  std::vector<std::string> cameras;  // --camera NAME=GLOB, in rig order
   int distortion = 5;
   std::string loss = "none";
   double loss_scale_px = 3.0;
@@ -114,18 +116,36 @@ CalibrationOptions ResolveOptions(const CamcalArgs& args) {
   return options;
 }
 
-// Image files per camera (left, then right when given), paired by name
-// order.
-std::vector<std::vector<std::string>> ImageFiles(const CamcalArgs& args) {
+// The cameras' names and image globs (--camera NAME=GLOB in rig order, or
+// --left [--right]).
+std::vector<CameraGlob> Globs(const CamcalArgs& args) {
+  const std::vector<CameraGlob> globs =
+      CameraGlobs(args.cameras, args.left, args.right);
+  if (globs.empty()) {
+    throw InputError(
+        "give --camera NAME='GLOB' for every camera (the first is the "
+        "reference), or --left 'GLOB' [--right 'GLOB']");
+  }
+  if (static_cast<int>(globs.size()) > kMaxCameras) {
+    throw InputError("camcal takes at most " + std::to_string(kMaxCameras) +
+                     " cameras, got " + std::to_string(globs.size()));
+  }
+  for (const CameraGlob& g : globs) CheckSessionCameraName(g.name, g.option);
+  return globs;
+}
+
+// Image files per camera, paired by name order.
+std::vector<std::vector<std::string>> ImageFiles(
+    const std::vector<CameraGlob>& globs) {
   std::vector<std::vector<std::string>> files;
-  files.push_back(GlobSortedOrThrow(args.left, "--left"));
-  if (!args.right.empty()) {
-    files.push_back(GlobSortedOrThrow(args.right, "--right"));
-    if (files[1].size() != files[0].size()) {
-      throw InputError("--left matches " + std::to_string(files[0].size()) +
-                       " images but --right matches " +
-                       std::to_string(files[1].size()) +
-                       "; stereo images are paired in name order");
+  for (const CameraGlob& g : globs) {
+    files.push_back(GlobSortedOrThrow(g.glob, g.option));
+    if (files.back().size() != files[0].size()) {
+      throw InputError(globs[0].option + " matches " +
+                       std::to_string(files[0].size()) + " images but " +
+                       g.option + " matches " +
+                       std::to_string(files.back().size()) +
+                       "; the cameras' images are paired in name order");
     }
   }
   return files;
@@ -135,15 +155,14 @@ std::vector<std::vector<std::string>> ImageFiles(const CamcalArgs& args) {
 // its first image. InputError when sizes differ or a camera sees the target
 // in fewer than options.min_views images.
 CalibrationProblem DetectTargets(
-    const CamcalArgs& args, const CalibTargetSpec& spec,
+    const std::vector<CameraGlob>& globs, const CalibTargetSpec& spec,
     const CalibrationOptions& options,
     const std::vector<std::vector<std::string>>& files, Progress* progress) {
   const size_t nc = files.size();
   const size_t nv = files[0].size();
   CalibrationProblem problem;
   for (size_t c = 0; c < nc; ++c) {
-    problem.cameras.push_back(
-        {c == 0 ? "left" : "right", 0, 0, 0, 0, 0, 0, {}});
+    problem.cameras.push_back({globs[c].name, 0, 0, 0, 0, 0, 0, {}});
   }
   CalibTargetDetector detector(spec);
   std::vector<int> found(nc, 0);
@@ -174,8 +193,7 @@ CalibrationProblem DetectTargets(
   }
   for (size_t c = 0; c < nc; ++c) {
     if (found[c] < options.min_views) {
-      throw InputError(std::string(c == 0 ? "--left" : "--right") + " '" +
-                       (c == 0 ? args.left : args.right) + "': target " +
+      throw InputError(globs[c].option + " '" + globs[c].glob + "': target " +
                        spec.text + " found in " + std::to_string(found[c]) +
                        " of " + std::to_string(nv) + " images; need at least " +
                        std::to_string(options.min_views));
@@ -319,6 +337,7 @@ nlohmann::json SummaryJson(const CamcalArgs& args, const CalibTargetSpec& spec,
   j["baseline_sigma"] = Nullable(sum.baseline_sigma);
   j["target"] = spec.text;
   j["out"] = args.out;
+  j["unconnected"] = nlohmann::json::array();  // all connected, or exit 2
   if (!args.out_cameramodel.empty()) {
     nlohmann::json files = nlohmann::json::array();
     for (const std::string& f : CameraModelPaths(args, sum)) files.push_back(f);
@@ -438,6 +457,28 @@ void PrintSummary(const CamcalArgs& args, const CalibTargetSpec& spec,
               args.out.c_str());
 }
 
+// A camera that shares no board view with the reference (directly or
+// through other cameras) has no pose in the rig: bad input, nothing
+// written. With --json the object names them in `unconnected` (spec v3)
+// beside the error.
+void RefuseUnconnected(const CamcalArgs& args,
+                       const CalibrationProblem& problem,
+                       const CalibrationOptions& options) {
+  const std::vector<int> unconnected = UnconnectedCameras(problem, options);
+  if (unconnected.empty()) return;
+  const std::string message = UnconnectedMessage(problem, unconnected);
+  if (args.json) {
+    nlohmann::json j;
+    nlohmann::json names = nlohmann::json::array();
+    for (int c : unconnected) names.push_back(problem.cameras[c].name);
+    j["unconnected"] = names;
+    j["error"] = message;
+    j["out"] = nullptr;
+    PrintJson(j);
+  }
+  throw InputError(message + "; nothing written");
+}
+
 int RunCamcal(const CamcalArgs& args) {
   // Everything that can be checked before reading images comes first.
   const CalibTargetSpec spec = ParseCalibTargetSpec(args.target);
@@ -446,10 +487,12 @@ int RunCamcal(const CamcalArgs& args) {
     if (!why.empty()) throw InputError(why);
   }
   const CalibrationOptions options = ResolveOptions(args);
-  const std::vector<std::vector<std::string>> files = ImageFiles(args);
+  const std::vector<CameraGlob> globs = Globs(args);
+  const std::vector<std::vector<std::string>> files = ImageFiles(globs);
   Progress progress("kincal camcal", args.json);
   const CalibrationProblem problem =
-      DetectTargets(args, spec, options, files, &progress);
+      DetectTargets(globs, spec, options, files, &progress);
+  RefuseUnconnected(args, problem, options);
   progress.Stage("calibrating (OpenCV start, Ceres refinement, covariance)");
   const CalibrationSummary sum = CalibrateCameras(problem, options);
   progress.Done();
@@ -477,9 +520,13 @@ int RunCamcal(const CamcalArgs& args) {
 void AddCamcalCommand(CLI::App& app, Runner* run) {
   auto args = std::make_shared<CamcalArgs>();
   CLI::App* sub = app.add_subcommand("camcal", kCamcalDescription);
+  AddCameraOption(sub, &args->cameras,
+                  "NAME='GLOB': one camera's images (repeat for every camera, "
+                  "in rig order: the first is the reference; images pair in "
+                  "name order)");
   sub->add_option("--left", args->left,
-                  "images of the first (reference) camera, a quoted glob")
-      ->required();
+                  "images of the first (reference) camera, a quoted glob "
+                  "(the two-camera spelling of --camera left=GLOB)");
   sub->add_option("--right", args->right,
                   "images of the second camera (paired with --left in name "
                   "order); omit for one camera");

@@ -16,6 +16,7 @@
 #include "capture/capture_session.h"
 #include "capture/frame_source.h"
 #include "data/error.h"
+#include "data/session.h"
 
 namespace kincal::app {
 namespace {
@@ -24,6 +25,7 @@ using capture::Status;
 
 struct CaptureArgs {
   capture::CaptureOptions options;
+  std::vector<std::string> cameras;  // --camera NAME=URI
   bool list = false;
   bool json = false;
 };
@@ -230,6 +232,27 @@ void PrintRecording(const CaptureArgs& args, const capture::CaptureResult& r) {
 int RunCapture(const CaptureArgs& args) {
   if (args.list) return RunList(args);
   capture::CaptureOptions options = args.options;
+  if (!args.cameras.empty()) {
+    // --camera NAME=URI: the cameras named as in rig.yaml; capture records
+    // a camera pair (the version-2 spelling is --left/--right).
+    const std::vector<CameraGlob> cams =
+        CameraGlobs(args.cameras, options.left, options.right);
+    if (cams.size() != 2) {
+      throw InputError(
+          "capture records a pair of cameras: give --camera NAME=URI twice "
+          "(got " +
+          std::to_string(cams.size()) +
+          "); for one camera or more than two, record each camera's images "
+          "and give them to track / bundle as --camera NAME='GLOB' or as a "
+          "session with one folder per camera");
+    }
+    options.camera_names = {cams[0].name, cams[1].name};
+    options.left = cams[0].glob;
+    options.right = cams[1].glob;
+  }
+  for (const std::string& name : options.camera_names) {
+    CheckSessionCameraName(name, "--camera");
+  }
   options.announce = !args.json;
   options.interrupted = &g_interrupted;
   std::optional<InterruptGuard> guard;
@@ -258,6 +281,10 @@ void AddCaptureCommand(CLI::App& app, Runner* run) {
   CLI::App* sub = app.add_subcommand("capture", kCaptureDescription);
   auto* list = sub->add_flag("--list", args->list,
                              "list V4L2 devices and Aravis cameras");
+  AddCameraOption(sub, &args->cameras,
+                  "NAME=URI: a camera of the pair, named as in rig.yaml (its "
+                  "image folder and frames.csv columns); twice, in rig order")
+      ->excludes(list);
   sub->add_option("--left", o.left, "left source URI")->excludes(list);
   sub->add_option("--right", o.right, "right source URI")->excludes(list);
   sub->add_option("--out", o.out,

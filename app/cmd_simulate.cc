@@ -30,6 +30,7 @@ struct SimulateArgs {
   // --render: stereo images of the tool target at every pose.
   bool render = false;
   int render_width = 1280, render_height = 1024;
+  int render_cameras = 2;  // 1, 2 or 3 (synth/rig_placement.h)
   RenderOptions render_options;
 };
 
@@ -205,6 +206,9 @@ int RunSimulate(SimulateArgs args) {
 #endif
     rig_distance = PlaceRigAndScaleTool(nominal, rig, &opt, &target);
   }
+  const Rig rendered_rig =
+      args.render ? RigWithCameras(rig, args.render_cameras, rig_distance)
+                  : rig;
   const SimulatedSession s = Simulate(nominal, opt);
   const nlohmann::json truth = TruthJson(s, opt, args.mode);
 
@@ -218,7 +222,8 @@ int RunSimulate(SimulateArgs args) {
   const std::string obs_text = FormatObservationsCsv(s.observations, comment);
   MakeDirs(args.out);
   const int rendered =
-      args.render ? WriteRenderedSession(args, nominal, s, rig, target) : 0;
+      args.render ? WriteRenderedSession(args, nominal, s, rendered_rig, target)
+                  : 0;
   WriteFileAtomic(args.out + "/robot.yaml", robot_text);
   WriteFileAtomic(args.out + "/truth_robot.yaml", truth_robot_text);
   WriteFileAtomic(args.out + "/observations.csv", obs_text);
@@ -279,6 +284,12 @@ void AddSimulateCommand(CLI::App& app, Runner* run) {
                 "right/, frames.csv with joint columns, session.yaml) and "
                 "OUT/rig.yaml, OUT/target.yaml");
   sub->add_option("--render-width", args->render_width, "image width, px")
+      ->capture_default_str();
+  sub->add_option("--render-cameras", args->render_cameras,
+                  "cameras of the rendered rig: 1 (the left camera alone), 2 "
+                  "(left, right) or 3 (and 'top', 120 mm above left, turned "
+                  "down to the workspace)")
+      ->check(CLI::Range(1, 3))
       ->capture_default_str();
   sub->add_option("--render-height", args->render_height, "image height, px")
       ->capture_default_str();

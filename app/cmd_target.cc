@@ -38,7 +38,9 @@ struct TargetArgs {
 
 std::vector<LayoutFrame> Detect(const std::string& dir, const Rig& rig,
                                 const TargetArgs& args, Progress* progress) {
-  const Session session = ReadSession(dir, SessionReadOptions());
+  SessionReadOptions so;
+  so.camera_names = rig.CameraNames();
+  const Session session = ReadSession(dir, so);
   if (session.frames.empty()) {
     throw InputError(dir + ": the session has no complete frame");
   }

@@ -1,8 +1,9 @@
-// kincal track: the needle tip in the rig frame for every stereo frame pair,
-// from the AprilTags of the tool target (../shared/spec/formats.md).
+// kincal track: the needle tip in the rig frame for every frame of 1..N
+// cameras, from the AprilTags of the tool target (../shared/spec/formats.md).
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <memory>
 #include <sstream>
@@ -22,6 +23,7 @@
 #include "data/urdf.h"
 #include "data/yaml_util.h"
 #include "vision/camera_order.h"
+#include "vision/pose_uncertainty.h"
 #include "vision/stereo_images.h"
 #include "vision/target.h"
 #include "vision/tool_pose.h"
@@ -32,6 +34,7 @@ namespace {
 
 struct TrackArgs {
   std::string rig, target, left, right, out;
+  std::vector<std::string> cameras;  // --camera NAME=GLOB
   // A recorded session folder instead of --left/--right (data/session.h).
   std::string session;
   // Optional: joint readings of the same frames (one row per frame pair, in
@@ -40,6 +43,7 @@ struct TrackArgs {
   // Quality gate for the merge: a tip is merged only when the tool pose used
   // at least min_tags tags and fits them within max_reproj_px (one small tag
   // leaves the rotation, and so the tip at the end of its lever, ambiguous).
+  // With two or more cameras the tags must also be seen by two of them.
   int min_tags = 2;
   double max_reproj_px = 0.5;
   bool json = false;
@@ -57,47 +61,63 @@ std::string PosesPath(const std::string& out) {
   return out + ".poses.csv";
 }
 
-// The image pairs to track, from a session folder or two globs.
-struct FramePairs {
-  std::vector<std::string> left, right;
-  Session session;  // when --session
+// The frames to track, from a session folder or one glob per camera.
+struct FrameSets {
+  std::vector<std::string> option;               // per camera, for messages
+  std::vector<std::vector<std::string>> images;  // [camera][frame]
+  Session session;                               // when --session
+  size_t size() const { return images.empty() ? 0 : images[0].size(); }
 };
 
-FramePairs ListFramePairs(const TrackArgs& args) {
-  FramePairs pairs;
+FrameSets ListFrameSets(const TrackArgs& args, const Rig& rig) {
+  FrameSets sets;
+  const std::vector<CameraGlob> globs =
+      CameraGlobs(args.cameras, args.left, args.right);
   if (!args.session.empty()) {
-    if (!args.left.empty() || !args.right.empty()) {
+    if (!globs.empty()) {
       throw InputError(
-          "--session replaces --left/--right; give one or the "
+          "--session replaces --camera and --left/--right; give one or the "
           "other");
     }
     SessionReadOptions so;
+    so.camera_names = rig.CameraNames();
     if (!args.robot.empty() && args.obs.empty()) {
       so.joint_names = ReadRobot(args.robot).JointNames();
       so.require_joint_readings = !args.out_obs.empty();
     }
-    pairs.session = ReadSession(args.session, so);
-    for (const SessionFrame& f : pairs.session.frames) {
-      pairs.left.push_back(f.left_image);
-      pairs.right.push_back(f.right_image);
+    sets.session = ReadSession(args.session, so);
+    sets.images.resize(rig.cameras.size());
+    for (size_t c = 0; c < rig.cameras.size(); ++c) {
+      sets.option.push_back(args.session + "/" + sets.session.folders[c]);
     }
-    if (pairs.left.empty()) {
+    for (const SessionFrame& f : sets.session.frames) {
+      for (size_t c = 0; c < f.images.size(); ++c) {
+        sets.images[c].push_back(f.images[c]);
+      }
+    }
+    if (sets.size() == 0) {
       throw InputError(args.session + ": the session has no complete frame");
     }
-  } else {
-    if (args.left.empty() || args.right.empty()) {
-      throw InputError("give --left and --right (image globs) or --session");
+    return sets;
+  }
+  if (globs.empty()) {
+    throw InputError(
+        "give --camera NAME='GLOB' for every camera of the rig (or --left and "
+        "--right for a stereo rig), or --session");
+  }
+  for (const CameraGlob& g : InRigOrder(globs, rig.CameraNames(), args.rig)) {
+    sets.option.push_back(g.option);
+    sets.images.push_back(GlobSortedOrThrow(g.glob, g.option));
+  }
+  for (size_t c = 1; c < sets.images.size(); ++c) {
+    if (sets.images[c].size() != sets.images[0].size()) {
+      throw InputError(
+          sets.option[0] + " matches " + std::to_string(sets.images[0].size()) +
+          " images but " + sets.option[c] + " matches " +
+          std::to_string(sets.images[c].size()) + "; frames pair in order");
     }
-    pairs.left = GlobSortedOrThrow(args.left, "--left");
-    pairs.right = GlobSortedOrThrow(args.right, "--right");
   }
-  if (pairs.left.size() != pairs.right.size()) {
-    throw InputError("--left matches " + std::to_string(pairs.left.size()) +
-                     " images but --right matches " +
-                     std::to_string(pairs.right.size()) +
-                     "; frames pair in order");
-  }
-  return pairs;
+  return sets;
 }
 
 // The joint readings the tracked tips are merged into (--out-obs).
@@ -109,10 +129,10 @@ struct Merge {
 };
 
 // Validates the merge inputs before any work, so bad input writes nothing.
-Merge PrepareMerge(const TrackArgs& args, const FramePairs& pairs) {
+Merge PrepareMerge(const TrackArgs& args, const FrameSets& pairs) {
   Merge merge;
   Observations& merged = merge.merged;
-  merge.merged_row.assign(pairs.left.size(), -1);
+  merge.merged_row.assign(pairs.size(), -1);
   if (!args.session.empty() && args.obs.empty() &&
       (!args.robot.empty() || !args.out_obs.empty())) {
     if (args.robot.empty() || args.out_obs.empty()) {
@@ -128,7 +148,7 @@ Merge PrepareMerge(const TrackArgs& args, const FramePairs& pairs) {
       Observation o;
       o.pose = std::to_string(sf.frame);
       o.q = sf.q;
-      o.t_s = sf.t_left;
+      o.t_s = sf.t[0];
       o.line = sf.line;
       merge.merged_row[f] = static_cast<int>(merged.rows.size());
       merged.rows.push_back(o);
@@ -140,48 +160,63 @@ Merge PrepareMerge(const TrackArgs& args, const FramePairs& pairs) {
           "into the joint readings of the same frames)");
     }
     merged = ReadObservationsCsv(args.obs, ReadRobot(args.robot).JointNames());
-    if (merged.rows.size() != pairs.left.size()) {
+    if (merged.rows.size() != pairs.size()) {
       throw InputError(args.obs + ": " + std::to_string(merged.rows.size()) +
-                       " observation rows but " +
-                       std::to_string(pairs.left.size()) +
-                       " frame pairs; rows must match frames in order");
+                       " observation rows but " + std::to_string(pairs.size()) +
+                       " frames; rows must match frames in order");
     }
-    for (size_t f = 0; f < pairs.left.size(); ++f) {
+    for (size_t f = 0; f < pairs.size(); ++f) {
       merge.merged_row[f] = static_cast<int>(f);
     }
   }
   return merge;
 }
 
-// What tracking every pair produced: the two CSV texts and the counts.
+// What tracking every frame produced: the two CSV texts and the counts.
 struct Tracked {
   std::string points, poses;
   int found = 0, merged_count = 0;
   std::vector<int> failed_gate;  // found, but not good
   std::vector<double> rms_values;
   std::vector<double> depths_mm;  // distance of the tool from the rig, found
-  int frames_tags_in_both = 0;    // frames with a target tag in each camera
-  int full_searches[2] = {0, 0};
+  // 1-sigma of the tip along the reference camera's line of sight, found
+  // frames (vision/pose_uncertainty.h).
+  std::vector<double> depth_sigmas_mm;
+  int frames_tags_in_all = 0;      // frames with a target tag in every camera
+  std::vector<int> tag_frames;     // per camera: frames with a target tag
+  std::vector<int> full_searches;  // per camera
 };
 
-std::string PosesHeader(const std::string& header) {
+std::string PosesHeader(const std::string& header,
+                        const std::string& image_columns) {
   return header + "# rig_from_tool: R row-major, t in mm; tip in rig, mm\n" +
          "# good = 1: the tip passes the quality gate (>= --min-tags tag "
-         "observations, reprojection RMS <= --max-reproj px); a found tip "
-         "with good = 0 is the tracker's best guess, not a measurement\n" +
+         "observations, reprojection RMS <= --max-reproj px, and with two "
+         "or more cameras tags seen by two); a found tip with good = 0 is "
+         "the tracker's best guess, not a measurement. depth_sigma_mm: "
+         "1-sigma of the tip along the first camera's line of sight\n" +
          "frame,found,r00,r01,r02,r10,r11,r12,r20,r21,r22,tx,ty,tz,"
-         "reproj_px,tags,left_image,right_image,good\n";
+         "reproj_px,tags,depth_sigma_mm,good," +
+         image_columns + "\n";
 }
 
-// The quality gate: enough tags, a tight fit, and both cameras (one camera
-// leaves the depth weak: tens of mm at 2 m).
-bool PassesGate(const TrackArgs& args, const ToolPoseResult& r) {
-  bool cameras[2] = {false, false};
+// The quality gate: enough tags, a tight fit, and with a rig of two or more
+// cameras the tags seen by at least two of them (a frame seen by one camera
+// of a stereo rig has a weak depth, tens of mm at 2 m, where the rig's
+// other frames have a fraction of a mm). A one-camera rig has nothing
+// better: its tips are valid with their depth sigma.
+bool PassesGate(const TrackArgs& args, size_t num_cameras,
+                const ToolPoseResult& r) {
+  std::vector<bool> cameras(num_cameras, false);
   for (const TagObservationResult& t : r.tags) {
-    if (t.used && t.camera >= 0 && t.camera < 2) cameras[t.camera] = true;
+    if (t.used && t.camera >= 0 && t.camera < static_cast<int>(num_cameras)) {
+      cameras[t.camera] = true;
+    }
   }
+  const size_t seen = std::count(cameras.begin(), cameras.end(), true);
   return r.found && r.tags_used >= args.min_tags &&
-         r.rms_px <= args.max_reproj_px && cameras[0] && cameras[1];
+         r.rms_px <= args.max_reproj_px &&
+         seen >= std::min<size_t>(2, num_cameras);
 }
 
 bool SeesTargetTag(const Target& target,
@@ -194,74 +229,106 @@ bool SeesTargetTag(const Target& target,
   return false;
 }
 
+// Per-camera image columns of poses.csv: image_<camera name>.
+std::string ImageColumns(const Rig& rig) {
+  std::string h;
+  for (const std::string& n : rig.CameraNames()) {
+    h += (h.empty() ? "" : ",") + CsvQuote("image_" + n);
+  }
+  return h;
+}
+
+// One pose row's values after `frame,found` (empty cells when not found).
+void AppendPoseCells(const ToolPoseResult& r, const TipUncertainty& u,
+                     std::ostringstream* poses) {
+  if (!r.found) {
+    *poses << ",,,,,,,,,,,,,,0,";
+    return;
+  }
+  for (int i = 0; i < 9; ++i) {
+    *poses << "," << FormatDouble(r.rig_from_tool.R(i / 3, i % 3));
+  }
+  for (int i = 0; i < 3; ++i) {
+    *poses << "," << FormatDouble(r.rig_from_tool.t(i));
+  }
+  *poses << "," << FormatDouble(r.rms_px) << "," << r.tags_used << ",";
+  if (u.ok) *poses << FormatDouble(u.depth_sigma_mm);
+}
+
 Tracked TrackFrames(const TrackArgs& args, const Rig& rig, const Target& target,
-                    const FramePairs& pairs, Merge* merge) {
+                    const FrameSets& pairs, Merge* merge) {
   TrackerOptions topt;
   topt.detector.family = target.family;
   topt.detector.quad_decimate = args.decimate;
   topt.enabled = !args.no_tracking;
   topt.Check();
+  const int nc = static_cast<int>(rig.cameras.size());
   std::vector<std::unique_ptr<TagTracker>> trackers;
-  for (int c = 0; c < 2; ++c)
+  for (int c = 0; c < nc; ++c) {
     trackers.push_back(std::make_unique<TagTracker>(topt));
+  }
 
-  const size_t n = pairs.left.size();
+  const size_t n = pairs.size();
   Tracked out;
+  out.tag_frames.assign(nc, 0);
   std::ostringstream points, poses;
   const std::string header =
       "# written by " + ToolVersion() + ": " + CommandLine() + "\n";
   points << header << "frame,x,y,z,reproj_px,tags\n";
-  poses << PosesHeader(header);
+  poses << PosesHeader(header, ImageColumns(rig));
   // On a terminal only; silent with --json, --quiet or when piped.
   Progress progress("kincal track", args.json || args.quiet);
   for (size_t f = 0; f < n; ++f) {
-    std::vector<std::vector<TagDetection>> dets(2);
-    const std::string* files[2] = {&pairs.left[f], &pairs.right[f]};
-    ForBothCameras([&](int c) {
+    std::vector<std::vector<TagDetection>> dets(nc);
+    ForEachCamera(nc, [&](int c) {
       dets[c] = trackers[c]->Track(
-          ReadCameraImage(*files[c], rig.cameras[c].intrinsics));
+          ReadCameraImage(pairs.images[c][f], rig.cameras[c].intrinsics));
     });
     const ToolPoseResult r = EstimateToolPose(rig, target, dets);
-    if (SeesTargetTag(target, dets[0]) && SeesTargetTag(target, dets[1])) {
-      ++out.frames_tags_in_both;
+    int cameras_with_tags = 0;
+    for (int c = 0; c < nc; ++c) {
+      const bool seen = SeesTargetTag(target, dets[c]);
+      out.tag_frames[c] += seen ? 1 : 0;
+      cameras_with_tags += seen ? 1 : 0;
     }
+    if (cameras_with_tags == nc) ++out.frames_tags_in_all;
     points << f;
     poses << f << "," << (r.found ? 1 : 0);
-    const bool good = PassesGate(args, r);
+    const bool good = PassesGate(args, rig.cameras.size(), r);
     if (merge->merged_row[f] >= 0) {
       Observation& row = merge->merged.rows[merge->merged_row[f]];
       row.has_point = good;
       if (good) row.p_in_meas = r.tip_in_rig;
       out.merged_count += good ? 1 : 0;
     }
+    // The corner sigma per coordinate: the fit's RMS (a norm over x and y)
+    // over sqrt(2), at least 0.05 px (a perfect fit still has noise).
+    const TipUncertainty u = TipUncertaintyOf(
+        rig, target, r, std::max(0.05, r.rms_px / std::sqrt(2.0)));
     if (r.found) {
       ++out.found;
       out.rms_values.push_back(r.rms_px);
       out.depths_mm.push_back(r.rig_from_tool.t.norm());
+      if (u.ok) out.depth_sigmas_mm.push_back(u.depth_sigma_mm);
       for (int i = 0; i < 3; ++i)
         points << "," << FormatDouble(r.tip_in_rig(i));
       if (!good) out.failed_gate.push_back(static_cast<int>(f));
       points << "," << FormatDouble(r.rms_px) << "," << r.tags_used << "\n";
-      for (int i = 0; i < 9; ++i) {
-        poses << "," << FormatDouble(r.rig_from_tool.R(i / 3, i % 3));
-      }
-      for (int i = 0; i < 3; ++i) {
-        poses << "," << FormatDouble(r.rig_from_tool.t(i));
-      }
-      poses << "," << FormatDouble(r.rms_px) << "," << r.tags_used;
     } else {
       points << ",,,,,0\n";
-      poses << ",,,,,,,,,,,,,,0";
     }
-    poses << "," << CsvQuote(pairs.left[f]) << "," << CsvQuote(pairs.right[f])
-          << "," << (good ? 1 : 0) << "\n";
+    AppendPoseCells(r, u, &poses);
+    poses << "," << (good ? 1 : 0);
+    for (int c = 0; c < nc; ++c) poses << "," << CsvQuote(pairs.images[c][f]);
+    poses << "\n";
     progress.Update(static_cast<long>(f + 1), static_cast<long>(n),
                     "frames (" + std::to_string(out.found) + " with a tip)");
   }
   out.points = points.str();
   out.poses = poses.str();
-  out.full_searches[0] = trackers[0]->full_searches();
-  out.full_searches[1] = trackers[1]->full_searches();
+  for (int c = 0; c < nc; ++c) {
+    out.full_searches.push_back(trackers[c]->full_searches());
+  }
   return out;
 }
 
@@ -272,8 +339,8 @@ void WriteMergedObservations(const TrackArgs& args,
                       merged, {"joint readings from " + merged.source +
                                "; x,y,z = needle tip tracked in the rig "
                                "frame (empty where the tool was not found, "
-                               "seen by one camera only, or with fewer "
-                               "than " +
+                               "seen by one camera of a multi-camera rig, "
+                               "or with fewer than " +
                                std::to_string(args.min_tags) +
                                " tags or a reprojection RMS over " +
                                FormatDouble(args.max_reproj_px) + " px)"}));
@@ -286,10 +353,16 @@ double MedianOf(std::vector<double> values) {
   return values[values.size() / 2];
 }
 
+std::string JoinInts(const std::vector<int>& v) {
+  std::string s;
+  for (int x : v) s += (s.empty() ? "" : "/") + std::to_string(x);
+  return s;
+}
+
 void PrintTrack(const TrackArgs& args, size_t n, const Tracked& t, bool merged,
                 const std::string& poses_path, double seconds) {
   const double median_rms = MedianOf(t.rms_values);
-  const int full0 = t.full_searches[0], full1 = t.full_searches[1];
+  const double depth_sigma = MedianOf(t.depth_sigmas_mm);
   if (args.json) {
     nlohmann::json j;
     j["frames"] = n;
@@ -300,7 +373,10 @@ void PrintTrack(const TrackArgs& args, size_t n, const Tracked& t, bool merged,
     j["out"] = args.out;
     j["poses"] = poses_path;
     j["median_reproj_px"] = median_rms;
-    j["full_searches"] = {full0, full1};
+    j["cameras"] = t.tag_frames.size();
+    j["median_depth_sigma_mm"] =
+        Number(t.depth_sigmas_mm.empty() ? NAN : depth_sigma);
+    j["full_searches"] = t.full_searches;
     if (merged) {
       j["out_obs"] = args.out_obs;
       j["merged"] = t.merged_count;
@@ -308,14 +384,22 @@ void PrintTrack(const TrackArgs& args, size_t n, const Tracked& t, bool merged,
     PrintJson(j);
     return;
   }
-  std::printf("kincal track: %zu frame pairs, tip found in %d (%.1f s)\n", n,
-              t.found, seconds);
-  std::printf("  median reprojection RMS %.3f px; full-frame searches %d/%d\n",
-              median_rms, full0, full1);
+  std::printf(
+      "kincal track: %zu frames of %zu camera(s), tip found in %d "
+      "(%.1f s)\n",
+      n, t.tag_frames.size(), t.found, seconds);
+  std::printf("  median reprojection RMS %.3f px; full-frame searches %s\n",
+              median_rms, JoinInts(t.full_searches).c_str());
+  if (!t.depth_sigmas_mm.empty()) {
+    std::printf(
+        "  median depth sigma %.3f mm (along the first camera's line "
+        "of sight)\n",
+        depth_sigma);
+  }
   if (!t.failed_gate.empty()) {
     std::printf(
         "  %zu found tips fail the quality gate (< %d tags, > %.2f px or "
-        "one camera; "
+        "one camera of several; "
         "good = 0 in %s): frames",
         t.failed_gate.size(), args.min_tags, args.max_reproj_px,
         poses_path.c_str());
@@ -332,29 +416,31 @@ void PrintTrack(const TrackArgs& args, size_t n, const Tracked& t, bool merged,
 // (vision/camera_order.h); if that explains the data, the images were given
 // in the wrong order: bad input, nothing written.
 void RefuseSwappedCameras(const TrackArgs& args, const Rig& rig,
-                          const Target& target, const FramePairs& pairs,
+                          const Target& target, const FrameSets& pairs,
                           const Tracked& tracked) {
   const int good = tracked.found - static_cast<int>(tracked.failed_gate.size());
-  if (pairs.left.empty() || 2 * good >= static_cast<int>(pairs.left.size())) {
+  if (pairs.images.size() != 2 || pairs.size() == 0 ||
+      2 * good >= static_cast<int>(pairs.size())) {
     return;
   }
   AprilTagOptions detector;
   detector.family = target.family;
   detector.quad_decimate = args.decimate;
   const CameraOrderCheck check = CheckCameraOrder(
-      rig, target, pairs.left, pairs.right,
-      [&](const ToolPoseResult& r) { return PassesGate(args, r); }, detector);
+      rig, target, pairs.images[0], pairs.images[1],
+      [&](const ToolPoseResult& r) { return PassesGate(args, 2, r); },
+      detector);
   if (!check.LooksSwapped()) return;
   throw InputError(
-      "the --left and --right images look swapped: of " +
-      std::to_string(check.sampled) + " sampled frame pairs, " +
-      std::to_string(check.pass_as_given) +
+      "the images of " + pairs.option[0] + " and " + pairs.option[1] +
+      " look swapped: of " + std::to_string(check.sampled) +
+      " sampled frame pairs, " + std::to_string(check.pass_as_given) +
       " give a tool pose passing the quality gate as given and " +
       std::to_string(check.pass_swapped) +
       " with the two images exchanged. --left takes the images of the rig's "
       "first camera (" +
       args.rig +
-      "): exchange --left and --right, or "
+      "): exchange --left and --right (or the --camera globs), or "
       "check which camera recorded which folder");
 }
 
@@ -373,10 +459,11 @@ void RefuseImpossibleDepth(const TrackArgs& args, const Rig& rig,
       rig.cameras.size() > 1 ? rig.cameras[1].cam_from_rig.t.norm() : 0.0;
   const std::string pair = args.rig + " (baseline " + FormatDouble(baseline) +
                            " mm) and " + args.target;
-  // Tags in both cameras, yet no tool pose fits any frame.
-  if (tracked.found == 0 && tracked.frames_tags_in_both >= 3) {
-    throw InputError("tags of the target are seen by both cameras in " +
-                     std::to_string(tracked.frames_tags_in_both) +
+  // Tags in every camera, yet no tool pose fits any frame.
+  if (tracked.found == 0 && rig.cameras.size() > 1 &&
+      tracked.frames_tags_in_all >= 3) {
+    throw InputError("tags of the target are seen by every camera in " +
+                     std::to_string(tracked.frames_tags_in_all) +
                      " frames, but no tool pose fits them in any: " + pair +
                      " do not describe the same set-up; most likely they" +
                      units);
@@ -390,17 +477,28 @@ void RefuseImpossibleDepth(const TrackArgs& args, const Rig& rig,
                    " frames), closer than any lens focuses: " + pair + units);
 }
 
+// A camera whose images never show a tag of the target is bad input
+// (spec v3): wrong folder, wrong camera, or a camera looking elsewhere.
+void RefuseBlindCameras(const Rig& rig, const FrameSets& sets,
+                        const Tracked& tracked) {
+  for (size_t c = 0; c < tracked.tag_frames.size(); ++c) {
+    if (tracked.tag_frames[c] > 0) continue;
+    throw InputError(
+        "camera '" + rig.cameras[c].intrinsics.name + "' (" + sets.option[c] +
+        ") never shows a tag of the target in " + std::to_string(sets.size()) +
+        " frames: check that these are its images and that it looks at the "
+        "target, or leave the camera out of the rig");
+  }
+}
+
 int RunTrack(const TrackArgs& args) {
   const auto start = std::chrono::steady_clock::now();
   const Rig rig = ReadRigYaml(args.rig);
   const Target target = ReadTargetYaml(args.target);
-  if (rig.cameras.size() < 2) {
-    throw InputError(args.rig + ": track needs a stereo rig (2 cameras), got " +
-                     std::to_string(rig.cameras.size()));
-  }
-  const FramePairs pairs = ListFramePairs(args);
+  const FrameSets pairs = ListFrameSets(args, rig);
   Merge merge = PrepareMerge(args, pairs);
   const Tracked tracked = TrackFrames(args, rig, target, pairs, &merge);
+  RefuseBlindCameras(rig, pairs, tracked);
   RefuseSwappedCameras(args, rig, target, pairs, tracked);
   RefuseImpossibleDepth(args, rig, tracked);
   WriteFileAtomic(args.out, tracked.points);
@@ -411,7 +509,7 @@ int RunTrack(const TrackArgs& args) {
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start)
           .count();
-  PrintTrack(args, pairs.left.size(), tracked, merged, poses_path, seconds);
+  PrintTrack(args, pairs.size(), tracked, merged, poses_path, seconds);
   return 0;
 }
 
@@ -420,14 +518,21 @@ int RunTrack(const TrackArgs& args) {
 void AddTrackCommand(CLI::App& app, Runner* run) {
   auto args = std::make_shared<TrackArgs>();
   CLI::App* sub = app.add_subcommand("track", kTrackDescription);
-  sub->add_option("--rig", args->rig, "rig.yaml (2 cameras)")->required();
+  sub->add_option("--rig", args->rig, "rig.yaml (1..N cameras)")->required();
   sub->add_option("--target", args->target, "target.yaml")->required();
-  sub->add_option("--left", args->left, "left images, a glob (quote it)");
-  sub->add_option("--right", args->right, "right images, a glob (quote it)");
+  AddCameraOption(sub, &args->cameras,
+                  "NAME='GLOB': the images of the rig's camera NAME (repeat "
+                  "for every camera; frames pair in sorted order)");
+  sub->add_option("--left", args->left,
+                  "images of the rig's first camera, a glob (quote it); the "
+                  "two-camera spelling of --camera");
+  sub->add_option("--right", args->right,
+                  "images of the rig's second camera, a glob (quote it)");
   sub->add_option("--session", args->session,
-                  "a recorded session folder (left/, right/, frames.csv, "
-                  "session.yaml) instead of --left/--right; with --robot and "
-                  "--out-obs its joint columns are merged with the tips");
+                  "a recorded session folder (one image folder per camera, "
+                  "frames.csv, session.yaml) instead of --camera; with "
+                  "--robot and --out-obs its joint columns are merged with "
+                  "the tips");
   sub->add_option("--out", args->out, "points.csv to write")->required();
   sub->add_option("--decimate", args->decimate,
                   "libapriltag quad_decimate (default 2)")

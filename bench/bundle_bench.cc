@@ -10,6 +10,7 @@
 
 #include <cstdio>
 #include <map>
+#include <utility>
 
 #include "bundle/bundle.h"
 #include "bundle/testing/synthetic.h"
@@ -18,16 +19,17 @@
 namespace kincal {
 namespace {
 
-const SyntheticBundle& Data(int frames) {
-  static std::map<int, SyntheticBundle> cache;
-  auto it = cache.find(frames);
+const SyntheticBundle& Data(int frames, int cameras = 2) {
+  static std::map<std::pair<int, int>, SyntheticBundle> cache;
+  auto it = cache.find({frames, cameras});
   if (it == cache.end()) {
     SyntheticBundleOptions o;
     o.frames = frames;
+    o.cameras = cameras;
     o.noise_px = 0.1;
     o.seed = 42;
     it = cache
-             .emplace(frames, MakeSyntheticBundle(
+             .emplace(std::make_pair(frames, cameras), MakeSyntheticBundle(
                                   ReadRobotYaml(std::string(KINCAL_SOURCE_DIR) +
                                                 "/data/robots/bh7.yaml"),
                                   o))
@@ -65,5 +67,35 @@ BENCHMARK(BM_Bundle)
 
 }  // namespace
 }  // namespace kincal
+
+// The same with one and three cameras on the stand (format v3; three:
+// the stereo pair and "top", synth/rig_placement.h). Target: 500 frames x 3
+// cameras <= 3 s, linear in frames.
+void BM_BundleCameras(benchmark::State& state) {
+  const SyntheticBundle& s = Data(static_cast<int>(state.range(0)),
+                                  static_cast<int>(state.range(1)));
+  BundleOptions o;
+  BundleResult r;
+  for (auto _ : state) {
+    r = RunBundle(s.nominal, s.rig, s.target, s.frames, o);
+    benchmark::DoNotOptimize(r);
+  }
+  int corners = 0;
+  for (const BundleFrame& f : s.frames) {
+    corners += static_cast<int>(f.corners.size());
+  }
+  state.counters["frames"] = static_cast<double>(s.frames.size());
+  state.counters["cameras"] = static_cast<double>(s.rig.cameras.size());
+  state.counters["corners"] = corners;
+  state.counters["reproj_px"] = r.reproj_rms_px;
+}
+BENCHMARK(BM_BundleCameras)
+    ->Args({250, 1})
+    ->Args({500, 1})
+    ->Args({250, 3})
+    ->Args({500, 3})
+    ->Args({1000, 3})
+    ->Unit(benchmark::kMillisecond)
+    ->Iterations(2);
 
 BENCHMARK_MAIN();

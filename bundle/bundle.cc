@@ -419,6 +419,10 @@ bool SeenByTwoCameras(const BundleFrame& f) {
   return false;
 }
 
+bool SeenByEnoughCameras(const BundleFrame& f, int num_cameras) {
+  return num_cameras < 2 ? !f.corners.empty() : SeenByTwoCameras(f);
+}
+
 bool HandEyeStart(const std::vector<Rigid3>& base_from_flange,
                   const std::vector<Rigid3>& rig_from_tool, Rigid3* x,
                   Rigid3* y) {
@@ -563,11 +567,14 @@ std::vector<Obs> MakeObs(const std::vector<BundleFrame>& frames,
 }
 
 // A tracked tool pose good enough to start from or to compare tips with:
-// enough tags, a small RMS, both cameras (one camera leaves its depth weak:
-// tens of mm at 2 m).
-bool WellTracked(const BundleFrame& f, const BundleOptions& opt) {
+// enough tags, a small RMS, and on a rig of two or more cameras two of them
+// (one camera of a stereo rig leaves the depth weak: tens of mm at 2 m; a
+// one-camera rig has nothing better, SeenByEnoughCameras).
+bool WellTracked(const BundleFrame& f, const BundleOptions& opt,
+                 int num_cameras) {
   return !(!f.tracked || f.tracked_tags < opt.start_min_tags ||
-           f.tracked_rms_px > opt.start_max_rms_px || !SeenByTwoCameras(f));
+           f.tracked_rms_px > opt.start_max_rms_px ||
+           !SeenByEnoughCameras(f, num_cameras));
 }
 
 // Start values of rig_from_base and flange_from_tool: hand-eye from the
@@ -577,7 +584,9 @@ void StartFrames(const std::vector<BundleFrame>& frames,
   std::vector<Rigid3> bf, rt;
   for (int i : res.train) {
     const BundleFrame& f = frames[i];
-    if (!WellTracked(f, opt)) continue;
+    if (!WellTracked(f, opt, static_cast<int>(res.rig.cameras.size()))) {
+      continue;
+    }
     bf.push_back(BaseFromFlange(st->chain, res.inputs[i], false));
     rt.push_back(f.rig_from_tool);
   }
@@ -876,7 +885,9 @@ void HeldOutTips(const std::vector<BundleFrame>& frames, const Target& target,
   std::vector<double> tip_err;
   for (int i : res->heldout) {
     const BundleFrame& f = frames[i];
-    if (!WellTracked(f, opt)) continue;
+    if (!WellTracked(f, opt, static_cast<int>(res->rig.cameras.size()))) {
+      continue;
+    }
     const Eigen::Vector3d model =
         ModelRigFromTool(*res, i) * target.tip_in_tool;
     const Eigen::Vector3d seen = f.rig_from_tool * target.tip_in_tool;

@@ -144,6 +144,9 @@ Rigid3 ModelRigFromTool(const BundleResult& result, int index);
 // Whether the frame's corners come from at least two cameras (a tool pose
 // from one camera is weak in depth: such tips are not used as measurements).
 bool SeenByTwoCameras(const BundleFrame& f);
+// The configuration-aware form: on a rig of `num_cameras` >= 2, two cameras;
+// on a one-camera rig, any corner (its tips carry their depth sigma).
+bool SeenByEnoughCameras(const BundleFrame& f, int num_cameras);
 
 // Closed-form hand-eye start: X = rig_from_base, Y = flange_from_tool with
 // rig_from_tool_i = X * base_from_flange_i * Y (linear in the rotations,

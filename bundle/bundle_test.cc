@@ -119,6 +119,54 @@ TEST(Bundle, ReportedSigmaMatchesTheSpreadOverSeeds) {
               rms_z);
 }
 
+// One, two and three cameras on the stand (format v3) on the same poses
+// and truths: the reported sigma is honest in each configuration (RMS of
+// (estimate - truth) / sigma within 0.7..1.4), and the tips at fresh poses
+// are within 2x of the stereo rig's.
+TEST(Bundle, OneTwoAndThreeCamerasHonestSigmaAndTipsWithinTwiceStereo) {
+  double tip_rms[4] = {0, 0, 0, 0};
+  for (int cameras : {2, 1, 3}) {
+    double sum_z2 = 0, sum_tip2 = 0;
+    int n = 0;
+    const int seeds = 6;
+    for (int seed = 1; seed <= seeds; ++seed) {
+      SyntheticBundleOptions so;
+      so.frames = 80;
+      so.noise_px = 0.1;
+      so.seed = 300 + seed;
+      so.cameras = cameras;
+      so.only_identifiable = true;
+      const SyntheticBundle s = MakeSyntheticBundle(Bh7(), so);
+      ASSERT_EQ(s.rig.cameras.size(), static_cast<size_t>(cameras));
+      BundleOptions o;
+      o.holdout_fraction = 0.0;
+      const BundleResult r = RunBundle(s.nominal, s.rig, s.target, s.frames, o);
+      ModelState truth;
+      truth.chain = Chain::FromRobot(s.truth);
+      for (const BundleParam& p : r.params) {
+        const ParamInfo info = FindParam(truth, p.name);
+        const double t = info.ToInterface(ParamValue(truth, info));
+        ASSERT_TRUE(std::isfinite(p.sigma)) << p.name;
+        const double z = (p.value - t) / p.sigma;
+        sum_z2 += z * z;
+        ++n;
+      }
+      const double tip = TipRmsAgainstTruth(s, r.calibrated, 100, 9);
+      sum_tip2 += tip * tip;
+    }
+    const double rms_z = std::sqrt(sum_z2 / n);
+    tip_rms[cameras] = std::sqrt(sum_tip2 / seeds);
+    std::printf("%d camera(s): RMS z %.3f over %d parameters, tips at fresh "
+                "poses %.4f mm\n",
+                cameras, rms_z, n, tip_rms[cameras]);
+    EXPECT_GT(rms_z, 0.7) << cameras << " camera(s)";
+    EXPECT_LT(rms_z, 1.4) << cameras << " camera(s)";
+    EXPECT_LT(tip_rms[cameras], 0.10) << cameras << " camera(s)";
+  }
+  EXPECT_LE(tip_rms[1], 2 * tip_rms[2]);
+  EXPECT_LE(tip_rms[3], 2 * tip_rms[2]);
+}
+
 TEST(Bundle, TooFewTrackedFramesIsBadInput) {
   SyntheticBundleOptions so;
   so.frames = 2;

@@ -1,6 +1,7 @@
 #include "bundle/observe.h"
 
 #include <chrono>
+#include <memory>
 
 #include "data/error.h"
 #include "vision/stereo_images.h"
@@ -11,17 +12,22 @@ SessionObservations ObserveSession(const Session& session, const Rig& rig,
                                    const Target& target,
                                    const ObserveOptions& options) {
   const auto start = std::chrono::steady_clock::now();
-  if (rig.cameras.size() != 2) {
-    throw InputError("a recorded session has two cameras; the rig has " +
-                     std::to_string(rig.cameras.size()));
+  const int nc = static_cast<int>(rig.cameras.size());
+  if (session.cameras.size() != rig.cameras.size()) {
+    throw InputError(session.dir + ": the session has " +
+                     std::to_string(session.cameras.size()) +
+                     " cameras, the rig " + std::to_string(nc) +
+                     " (read the session with the rig's camera names)");
   }
   SessionObservations out;
   out.session_frames = static_cast<int>(session.frames.size());
   AprilTagOptions dopt = options.detector;
   dopt.family = target.family;
   dopt.Check();
-  AprilTagDetector detectors[2] = {AprilTagDetector(dopt),
-                                   AprilTagDetector(dopt)};
+  std::vector<std::unique_ptr<AprilTagDetector>> detectors;
+  for (int c = 0; c < nc; ++c) {
+    detectors.push_back(std::make_unique<AprilTagDetector>(dopt));
+  }
   int done = 0;
   const int total = session.CountWithJoints();
   for (const SessionFrame& sf : session.frames) {
@@ -29,16 +35,15 @@ SessionObservations ObserveSession(const Session& session, const Rig& rig,
       ++out.without_joints;
       continue;
     }
-    std::vector<std::vector<TagDetection>> dets(2);
-    const std::string* files[2] = {&sf.left_image, &sf.right_image};
-    ForBothCameras([&](int c) {
-      dets[c] = detectors[c].Detect(
-          ReadCameraImage(*files[c], rig.cameras[c].intrinsics));
+    std::vector<std::vector<TagDetection>> dets(nc);
+    ForEachCamera(nc, [&](int c) {
+      dets[c] = detectors[c]->Detect(
+          ReadCameraImage(sf.images[c], rig.cameras[c].intrinsics));
     });
     BundleFrame f;
     f.frame = sf.frame;
     f.q_reading = sf.q;
-    f.t_s = sf.t_left;
+    f.t_s = sf.t[0];
     const ToolPoseResult r = EstimateToolPose(rig, target, dets, options.pose);
     if (r.found) {
       f.tracked = true;

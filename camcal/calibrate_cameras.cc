@@ -96,9 +96,9 @@ void ValidateProblem(const CalibrationProblem& problem,
                      const CalibrationOptions& options) {
   options.Check();
   const size_t nc = problem.cameras.size();
-  Require(
-      nc == 1 || nc == 2,
-      "camera calibration: expected 1 or 2 cameras, got " + std::to_string(nc));
+  Require(nc >= 1 && nc <= kMaxCameras,
+          "camera calibration: expected 1 to " + std::to_string(kMaxCameras) +
+              " cameras, got " + std::to_string(nc));
   for (const CameraIntrinsics& cam : problem.cameras) {
     Require(cam.width > 0 && cam.height > 0,
             "camera calibration: camera '" + cam.name +
@@ -115,6 +115,63 @@ void ValidateProblem(const CalibrationProblem& problem,
                            << " pixels for " << obs.p_in_target.size()
                            << " target points");
     }
+  }
+}
+
+// Start values of every camera's cam_from_rig: breadth first from the
+// reference camera, each new camera d from an already placed camera c with
+// which it shares the most views, cam_d_from_cam_c averaged over those views
+// (quaternion mean, mean translation). Every camera is connected
+// (UnconnectedCameras is checked before).
+void ConnectCameras(const CalibrationProblem& problem,
+                    const std::vector<std::vector<Rigid3>>& cam_from_target,
+                    const std::vector<std::vector<bool>>& seen, State* s) {
+  const size_t nc = problem.cameras.size();
+  const size_t nv = problem.views.size();
+  std::vector<bool> placed(nc, false);
+  placed[0] = true;
+  std::vector<Rigid3> cam_from_rig(nc);
+  for (size_t round = 1; round < nc; ++round) {
+    int best_c = -1, best_d = -1, best_n = 0;
+    for (size_t d = 0; d < nc; ++d) {
+      if (placed[d]) continue;
+      for (size_t c = 0; c < nc; ++c) {
+        if (!placed[c]) continue;
+        int n = 0;
+        for (size_t v = 0; v < nv; ++v) n += seen[c][v] && seen[d][v];
+        if (n > best_n) best_c = c, best_d = d, best_n = n;
+      }
+    }
+    if (best_d < 0) {
+      throw InputError(
+          "camera calibration: camera '" +
+          problem
+              .cameras[std::find(placed.begin(), placed.end(), false) -
+                       placed.begin()]
+              .name +
+          "' shares no view of the target with the others");
+    }
+    Eigen::Vector4d q_sum = Eigen::Vector4d::Zero();
+    Eigen::Vector3d t_sum = Eigen::Vector3d::Zero();
+    Eigen::Quaterniond q_ref = Eigen::Quaterniond::Identity();
+    int n = 0;
+    for (size_t v = 0; v < nv; ++v) {
+      if (!seen[best_c][v] || !seen[best_d][v]) continue;
+      const Rigid3 d_from_c =
+          cam_from_target[best_d][v] * cam_from_target[best_c][v].Inverse();
+      Eigen::Quaterniond q(d_from_c.R);
+      if (n == 0) q_ref = q;
+      if (q.coeffs().dot(q_ref.coeffs()) < 0) q.coeffs() *= -1;
+      q_sum += q.coeffs();
+      t_sum += d_from_c.t;
+      ++n;
+    }
+    Rigid3 d_from_c;
+    d_from_c.R = Eigen::Quaterniond(q_sum / n).normalized().toRotationMatrix();
+    d_from_c.t = t_sum / n;
+    cam_from_rig[best_d] = d_from_c * cam_from_rig[best_c];
+    s->cam_from_rig[best_d] = PoseBlock::From(cam_from_rig[best_d]);
+    placed[best_d] = true;
   }
 }
 
@@ -215,42 +272,15 @@ State Initialize(const CalibrationProblem& problem,
     }
   }
 
-  if (nc == 2) {
-    // cam1_from_rig = cam1_from_target * (cam0_from_target)^-1, averaged.
-    Eigen::Vector4d q_sum = Eigen::Vector4d::Zero();
-    Eigen::Vector3d t_sum = Eigen::Vector3d::Zero();
-    Eigen::Quaterniond q_ref = Eigen::Quaterniond::Identity();
-    int n = 0;
-    for (size_t v = 0; v < nv; ++v) {
-      if (!seen[0][v] || !seen[1][v]) continue;
-      const Rigid3 cam1_from_cam0 =
-          cam_from_target[1][v] * cam_from_target[0][v].Inverse();
-      Eigen::Quaterniond q(cam1_from_cam0.R);
-      if (n == 0) q_ref = q;
-      if (q.coeffs().dot(q_ref.coeffs()) < 0) q.coeffs() *= -1;
-      q_sum += q.coeffs();
-      t_sum += cam1_from_cam0.t;
-      ++n;
-    }
-    if (n == 0) {
-      throw InputError("cameras '" + problem.cameras[0].name + "' and '" +
-                       problem.cameras[1].name +
-                       "' never saw the target in the same view; stereo "
-                       "calibration needs views seen by both");
-    }
-    Rigid3 cam1_from_rig;
-    cam1_from_rig.R =
-        Eigen::Quaterniond(q_sum / n).normalized().toRotationMatrix();
-    cam1_from_rig.t = t_sum / n;
-    s.cam_from_rig[1] = PoseBlock::From(cam1_from_rig);
-  }
+  ConnectCameras(problem, cam_from_target, seen, &s);
+  // Each view's pose from the first camera that saw it.
   for (size_t v = 0; v < nv; ++v) {
-    if (seen[0][v]) {
-      s.rig_from_target[v] = PoseBlock::From(cam_from_target[0][v]);
-      s.view_used[v] = true;
-    } else if (nc == 2 && seen[1][v]) {
-      s.rig_from_target[v] = PoseBlock::From(
-          s.cam_from_rig[1].ToRigid3().Inverse() * cam_from_target[1][v]);
+    for (size_t c = 0; c < nc && !s.view_used[v]; ++c) {
+      if (!seen[c][v]) continue;
+      const Rigid3 cam_from_rig =
+          c == 0 ? Rigid3() : s.cam_from_rig[c].ToRigid3();
+      s.rig_from_target[v] =
+          PoseBlock::From(cam_from_rig.Inverse() * cam_from_target[c][v]);
       s.view_used[v] = true;
     }
   }
@@ -772,7 +802,7 @@ void AddSigmas(const CalibrationCovariance& cal, CalibrationSummary* out) {
       out->cameras[c].sigma.push_back(index < 0 ? 0.0 : sigma(index));
     }
   }
-  if (cal.intrinsics.size() == 2) {
+  if (cal.intrinsics.size() >= 2) {
     const int e = cal.cam_from_rig_index[1];
     for (int i = 0; i < 3; ++i) {
       out->extrinsic_rotation_sigma_deg.push_back(sigma(e + i) * 180.0 / M_PI);
@@ -1053,10 +1083,64 @@ void SummarizeCameras(const CalibrationProblem& input,
 
 }  // namespace
 
+std::vector<int> UnconnectedCameras(const CalibrationProblem& problem,
+                                    const CalibrationOptions& options) {
+  const size_t nc = problem.cameras.size();
+  std::vector<bool> connected(nc, false);
+  if (nc == 0) return {};
+  connected[0] = true;
+  // Grow the set through views in which a connected and an unconnected
+  // camera both see the target, until nothing changes.
+  for (bool grew = true; grew;) {
+    grew = false;
+    for (const CalibrationView& view : problem.views) {
+      bool any = false;
+      for (size_t c = 0; c < nc; ++c) {
+        any = any || (connected[c] &&
+                      UsableObservation(view.observations[c], options));
+      }
+      if (!any) continue;
+      for (size_t c = 0; c < nc; ++c) {
+        if (!connected[c] && UsableObservation(view.observations[c], options)) {
+          connected[c] = true;
+          grew = true;
+        }
+      }
+    }
+  }
+  std::vector<int> out;
+  for (size_t c = 0; c < nc; ++c) {
+    if (!connected[c]) out.push_back(static_cast<int>(c));
+  }
+  return out;
+}
+
+std::string UnconnectedMessage(const CalibrationProblem& problem,
+                               const std::vector<int>& unconnected) {
+  std::string names;
+  for (int c : unconnected) {
+    names += (names.empty() ? "'" : ", '") + problem.cameras[c].name + "'";
+  }
+  return "camera" + std::string(unconnected.size() > 1 ? "s " : " ") + names +
+         " never see" + (unconnected.size() > 1 ? "" : "s") +
+         " the target in the same view as the reference camera '" +
+         problem.cameras[0].name + "' or a camera connected to it, so " +
+         (unconnected.size() > 1 ? "their" : "its") +
+         " pose in the rig is not determined: record views in which the "
+         "board is seen by " +
+         (unconnected.size() > 1 ? "each of them" : "it") +
+         " and by an already connected camera at once (a chain of shared "
+         "views is enough)";
+}
+
 CalibrationSummary CalibrateCameras(const CalibrationProblem& input,
                                     const CalibrationOptions& options) {
   const auto start = std::chrono::steady_clock::now();
   ValidateProblem(input, options);
+  const std::vector<int> unconnected = UnconnectedCameras(input, options);
+  if (!unconnected.empty()) {
+    throw InputError(UnconnectedMessage(input, unconnected));
+  }
   const size_t nc = input.cameras.size();
   const size_t nv = input.views.size();
 

@@ -1,8 +1,12 @@
 #ifndef KINCAL_CAMCAL_CALIBRATE_CAMERAS_H_
 #define KINCAL_CAMCAL_CALIBRATE_CAMERAS_H_
 
-// Intrinsic and stereo calibration of one or two cameras from 2D-3D
-// correspondences of a planar target (chessboard, AprilGrid).
+// Intrinsic and extrinsic calibration of 1..kMaxCameras cameras from 2D-3D
+// correspondences of a planar target (chessboard, AprilGrid). Cameras are
+// connected through shared views: a camera's pose in the rig starts from
+// the views it shares with an already placed camera (breadth first from the
+// reference camera, most shared views first), and a camera that no chain of
+// shared views connects to the reference is bad input (UnconnectedCameras).
 //
 // Model: for camera c, view v and target point p_in_target (target units,
 // z = 0 plane),
@@ -32,6 +36,9 @@
 #include "camcal/rig.h"
 
 namespace kincal {
+
+// Most cameras one calibration takes.
+constexpr int kMaxCameras = 16;
 
 // Target points seen by one camera in one view (index-aligned).
 struct TargetObservation {
@@ -219,10 +226,20 @@ struct CalibrationSummary {
 };
 
 // Calibrates the cameras. Throws InputError when the data cannot determine
-// the cameras (no or too few views with the target, one or three+ cameras,
-// no view seen by both cameras of a stereo pair).
+// the cameras (no or too few views with the target, no or more than
+// kMaxCameras cameras, a camera that shares no view with the others:
+// UnconnectedMessage).
 CalibrationSummary CalibrateCameras(const CalibrationProblem& problem,
                                     const CalibrationOptions& options = {});
+
+// Indexes of the cameras that no chain of shared views (views in which two
+// cameras both see the target with at least min_points_per_view points)
+// connects to the reference camera 0; empty when all are connected.
+std::vector<int> UnconnectedCameras(const CalibrationProblem& problem,
+                                    const CalibrationOptions& options = {});
+// The message naming them, with the cause and the fix.
+std::string UnconnectedMessage(const CalibrationProblem& problem,
+                               const std::vector<int>& unconnected);
 
 // Why the solve in `summary` is no calibration, with the likely cause and
 // the fix; empty when it is one. Not converged within max_iterations: too

@@ -39,7 +39,9 @@ Synthetic MakeSynthetic(int num_cameras, int num_views, double noise_px,
   Synthetic s;
   for (int c = 0; c < num_cameras; ++c) {
     Camera cam;
-    cam.intrinsics = {c == 0 ? "left" : "right",
+    cam.intrinsics = {c == 0   ? "left"
+                      : c == 1 ? "right"
+                               : "c" + std::to_string(c),
                       1280,
                       1024,
                       1800.0 + 10 * c,
@@ -51,6 +53,11 @@ Synthetic MakeSynthetic(int num_cameras, int num_views, double noise_px,
       cam.cam_from_rig.R =
           Eigen::AngleAxisd(-0.08, Eigen::Vector3d::UnitY()).toRotationMatrix();
       cam.cam_from_rig.t = Eigen::Vector3d(-120, 0.8, 1.5);
+    }
+    if (c == 2) {
+      cam.cam_from_rig.R =
+          Eigen::AngleAxisd(-0.16, Eigen::Vector3d::UnitY()).toRotationMatrix();
+      cam.cam_from_rig.t = Eigen::Vector3d(-240, -1.2, 6.0);
     }
     s.truth.cameras.push_back(cam);
     s.problem.cameras.push_back(cam.intrinsics);
@@ -166,6 +173,50 @@ Eigen::Vector2d ProjectThroughSolvedTargets(
 // Monte Carlo: the spread of that projection over noise draws matches the
 // predicted worst-direction sigma (which fails if the covariance's layout,
 // the rotation scaling or the view-pose terms are wrong).
+// Three cameras, the third sharing views only with the second: it is
+// connected through the chain and its pose recovered; with no view shared
+// with any other camera it is unconnected, named, and nothing is solved.
+TEST(CalibrateCameras, ThreeCamerasConnectThroughAChainOfSharedViews) {
+  Synthetic syn = MakeSynthetic(3, 18, 0.3, 11);
+  for (size_t v = 0; v < syn.problem.views.size(); ++v) {
+    std::vector<TargetObservation>& obs = syn.problem.views[v].observations;
+    if (v < 9) {
+      obs[2] = TargetObservation();  // camera 2 not in the first half
+    } else {
+      obs[0] = TargetObservation();  // camera 0 not in the second half
+    }
+  }
+  EXPECT_TRUE(UnconnectedCameras(syn.problem).empty());
+  CalibrationOptions options;
+  options.cross_validate = false;
+  const CalibrationSummary sum = CalibrateCameras(syn.problem, options);
+  EXPECT_TRUE(sum.converged) << sum.termination;
+  ASSERT_EQ(sum.rig.cameras.size(), 3u);
+  EXPECT_EQ(sum.rig.cameras[2].intrinsics.name, "c2");
+  for (int c = 1; c < 3; ++c) {
+    const Rigid3& est = sum.rig.cameras[c].cam_from_rig;
+    const Rigid3& truth = syn.truth.cameras[c].cam_from_rig;
+    EXPECT_LT((est.t - truth.t).norm(), 1.0) << "camera " << c;
+    EXPECT_LT(
+        Eigen::AngleAxisd(est.R * truth.R.transpose()).angle() * 180 / M_PI,
+        0.05)
+        << "camera " << c;
+  }
+
+  for (size_t v = 9; v < syn.problem.views.size(); ++v) {
+    syn.problem.views[v].observations[1] = TargetObservation();
+  }
+  EXPECT_EQ(UnconnectedCameras(syn.problem), (std::vector<int>{2}));
+  try {
+    CalibrateCameras(syn.problem, options);
+    FAIL() << "an unconnected camera was solved";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("camera 'c2' never sees"),
+              std::string::npos)
+        << e.what();
+  }
+}
+
 TEST(CalibrateCameras, ProjectionUncertaintyMatchesMonteCarlo) {
   const double noise_px = 0.5;
   const int views = 8, trials = 30;

@@ -21,6 +21,23 @@ double Rig::BaselineMm() const {
   return (c1 - c0).norm();
 }
 
+const char* RigMountName(RigMount mount) {
+  return mount == RigMount::kFlange ? "flange" : "world";
+}
+
+std::vector<std::string> Rig::CameraNames() const {
+  std::vector<std::string> names;
+  for (const Camera& c : cameras) names.push_back(c.intrinsics.name);
+  return names;
+}
+
+int Rig::FindCamera(const std::string& name) const {
+  for (size_t c = 0; c < cameras.size(); ++c) {
+    if (cameras[c].intrinsics.name == name) return static_cast<int>(c);
+  }
+  return -1;
+}
+
 namespace {
 
 Rigid3 ParsePose(const YamlReader& y, const YAML::Node& node,
@@ -103,7 +120,7 @@ Rig ParseRigYaml(const std::string& text, const std::string& file) {
     throw InputError(file, 0, 0, "empty file: expected a kincal_rig document");
   }
   y.ExpectMap(root, "rig file");
-  y.CheckKeys(root, {"kincal_rig", "cameras"}, "rig file");
+  y.CheckKeys(root, {"kincal_rig", "mount", "cameras"}, "rig file");
   const YAML::Node version = y.Required(root, "kincal_rig", "rig file");
   if (y.Integer(version, "kincal_rig") != 1) {
     y.Fail(version,
@@ -114,6 +131,17 @@ Rig ParseRigYaml(const std::string& text, const std::string& file) {
   if (cams.size() == 0) y.Fail(cams, "cameras: expected at least one camera");
 
   Rig rig;
+  if (root["mount"]) {
+    const std::string mount = y.String(root["mount"], "mount");
+    if (mount == "flange") {
+      rig.mount = RigMount::kFlange;
+    } else if (mount != "world") {
+      y.Fail(root["mount"],
+             "mount: expected world (cameras on a stand, target on the "
+             "flange) or flange (cameras on the flange, target fixed), got '" +
+                 mount + "'");
+    }
+  }
   std::set<std::string> names;
   for (size_t i = 0; i < cams.size(); ++i) {
     const YAML::Node c = cams[i];
@@ -199,6 +227,9 @@ std::string RigToYaml(const Rig& rig) {
   std::ostringstream os;
   os << "# written by " << ToolVersion() << ": " << CommandLine() << "\n";
   os << "kincal_rig: 1\n";
+  if (rig.mount == RigMount::kFlange) {
+    os << "mount: flange  # cameras on the robot's flange, target fixed\n";
+  }
   os << "cameras:  # the first camera is the reference; rig frame = its "
         "frame\n";
   for (const Camera& cam : rig.cameras) {

@@ -191,8 +191,42 @@ INSTANTIATE_TEST_SUITE_P(
                 "480, fx: 800, fy: 800, cx: 320, cy: 240, distortion: [], "
                 "cam_from_rig: {R: [1,0,0,0,1,0,0,0], t: [0,0,0]}}\n",
                 3, "expected 9 numbers"},
+        BadCase{"mount", "kincal_rig: 1\nmount: wrist\ncameras:\n" CAM0, 2,
+                "mount: expected world"},
         BadCase{"yaml syntax", "kincal_rig: 1\ncameras: [\n", 3,
                 "invalid YAML"}));
+
+// Format v3: 1..N cameras and `mount`; world is the default and is not
+// written, flange round-trips.
+TEST(RigYaml, MountAndThreeCameras) {
+  const std::string cams = std::string(CAM0) +
+                           "  - {name: mid, width: 640, height: 480, fx: 800, "
+                           "fy: 800, cx: 320, cy: 240, distortion: [], "
+                           "cam_from_rig: {R: [1,0,0,0,1,0,0,0,1], t: "
+                           "[-100,0,0]}}\n"
+                           "  - {name: far, width: 640, height: 480, fx: 800, "
+                           "fy: 800, cx: 320, cy: 240, distortion: [], "
+                           "cam_from_rig: {R: [1,0,0,0,1,0,0,0,1], t: "
+                           "[-200,0,0]}}\n";
+  const Rig world = ParseRigYaml("kincal_rig: 1\ncameras:\n" + cams, "a");
+  EXPECT_EQ(world.mount, RigMount::kWorld);
+  ASSERT_EQ(world.cameras.size(), 3u);
+  EXPECT_EQ(world.FindCamera("far"), 2);
+  EXPECT_EQ(world.FindCamera("nope"), -1);
+  EXPECT_EQ(world.CameraNames(),
+            (std::vector<std::string>{"left", "mid", "far"}));
+  EXPECT_THAT(RigToYaml(world), Not(HasSubstr("mount")));
+  EXPECT_EQ(
+      ParseRigYaml("kincal_rig: 1\nmount: world\ncameras:\n" + cams, "b").mount,
+      RigMount::kWorld);
+  const Rig flange =
+      ParseRigYaml("kincal_rig: 1\nmount: flange\ncameras:\n" + cams, "c");
+  EXPECT_EQ(flange.mount, RigMount::kFlange);
+  EXPECT_STREQ(RigMountName(flange.mount), "flange");
+  const Rig back = ParseRigYaml(RigToYaml(flange), "d");
+  EXPECT_EQ(back.mount, RigMount::kFlange);
+  EXPECT_EQ(back.cameras.size(), 3u);
+}
 
 TEST(RigYaml, EmptyFileIsInputError) {
   EXPECT_THROW(ParseRigYaml("", "empty.yaml"), InputError);

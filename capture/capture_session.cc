@@ -139,6 +139,7 @@ SessionInfo DescribeCameras(const CaptureOptions& options,
                             const StereoGrabber& grabber, double tolerance_s,
                             bool live) {
   SessionInfo info;
+  info.camera_names = options.camera_names;
   info.left_uri = options.left;
   info.right_uri = options.right;
   info.left_description = left.Describe();

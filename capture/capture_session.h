@@ -28,7 +28,10 @@
 namespace kincal::capture {
 
 struct CaptureOptions {
-  std::string left, right;       // source URIs (capture/frame_source.h)
+  std::string left, right;  // source URIs (capture/frame_source.h)
+  // The two cameras' names as in rig.yaml: the session's image folders and
+  // frames.csv columns (default the version-2 left/right layout).
+  std::vector<std::string> camera_names = {"left", "right"};
   std::string out;               // session folder: must not exist or be empty
   int64_t frames = 0;            // stop after N pairs (0: no limit)
   double seconds = 0;            // stop after S seconds (0: no limit)

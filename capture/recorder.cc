@@ -19,6 +19,7 @@
 #include "data/csv.h"
 #include "data/error.h"
 #include "data/provenance.h"
+#include "data/session.h"
 #include "data/yaml_util.h"
 
 namespace kincal::capture {
@@ -142,7 +143,7 @@ std::string SessionRecorder::FrameFileName(int64_t frame) {
 }
 
 std::string SessionRecorder::CsvHeader() const {
-  std::string h = "frame,t_left,t_right,seq_left,seq_right";
+  std::string h = SessionFramesHeader(info_.camera_names, {});
   for (const std::string& j : info_.joint_names) h += "," + CsvQuote(j);
   return h + "\n";
 }
@@ -152,8 +153,21 @@ Status SessionRecorder::Open(const std::string& dir, const SessionInfo& info) {
     return Status::Error(Status::Kind::kIoError,
                          "recorder already open on " + dir_);
   }
-  std::set<std::string> names = {"frame", "t_left", "t_right", "seq_left",
-                                 "seq_right"};
+  if (info.camera_names.size() != 2 ||
+      info.camera_names[0] == info.camera_names[1]) {
+    return Status::Error(Status::Kind::kUnsupported,
+                         "a stereo recording needs two different camera names");
+  }
+  std::set<std::string> names = {"frame"};
+  for (const std::string& c : info.camera_names) {
+    try {
+      CheckSessionCameraName(c, "capture");
+    } catch (const InputError& e) {
+      return Status::Error(Status::Kind::kUnsupported, e.what());
+    }
+    names.insert("t_" + c);
+    names.insert("seq_" + c);
+  }
   for (const std::string& j : info.joint_names) {
     if (j.empty() || !names.insert(j).second) {
       return Status::Error(
@@ -167,7 +181,8 @@ Status SessionRecorder::Open(const std::string& dir, const SessionInfo& info) {
                              ": exists and is not empty (kincal never "
                              "overwrites a session; choose a new folder)");
   }
-  for (const std::string& d : {dir, dir + "/left", dir + "/right"}) {
+  for (const std::string& d : {dir, dir + "/" + info.camera_names[0],
+                               dir + "/" + info.camera_names[1]}) {
     Status s = MakeDirs(d);
     if (!s.ok()) return s;
   }
@@ -227,8 +242,8 @@ Status SessionRecorder::WritePairImages(int64_t frame, const StereoFrame& pair,
                                         int compression) const {
   const int level = compression >= 0 ? compression : options_.png_compression;
   const std::string name = FrameFileName(frame);
-  const std::string left = dir_ + "/left/" + name;
-  const std::string right = dir_ + "/right/" + name;
+  const std::string left = dir_ + "/" + info_.camera_names[0] + "/" + name;
+  const std::string right = dir_ + "/" + info_.camera_names[1] + "/" + name;
   size_t left_bytes = 0, right_bytes = 0;
   Status left_status =
       WritePngAtomic(left, pair.left.image, level, &left_bytes);
@@ -246,8 +261,8 @@ Status SessionRecorder::WritePairImages(int64_t frame, const StereoFrame& pair,
 
 void SessionRecorder::RemovePairImages(int64_t frame) const {
   const std::string name = FrameFileName(frame);
-  ::unlink((dir_ + "/left/" + name).c_str());
-  ::unlink((dir_ + "/right/" + name).c_str());
+  ::unlink((dir_ + "/" + info_.camera_names[0] + "/" + name).c_str());
+  ::unlink((dir_ + "/" + info_.camera_names[1] + "/" + name).c_str());
 }
 
 Status SessionRecorder::CommitRow(const StereoFrame& pair,
@@ -293,8 +308,11 @@ Status SessionRecorder::SetJointColumns(
                          std::to_string(values.size()) + " joint rows for " +
                              std::to_string(rows_.size()) + " frames");
   }
-  std::set<std::string> seen = {"frame", "t_left", "t_right", "seq_left",
-                                "seq_right"};
+  std::set<std::string> seen = {"frame"};
+  for (const std::string& c : info_.camera_names) {
+    seen.insert("t_" + c);
+    seen.insert("seq_" + c);
+  }
   for (const std::string& n : names) {
     if (n.empty() || !seen.insert(n).second) {
       return Status::Error(
@@ -359,8 +377,9 @@ std::string SessionRecorder::SessionYaml(const SessionSummary* summary) const {
   y << YAML::Key << "command" << YAML::Value << CommandLine();
   y << YAML::Key << "frames" << YAML::Value << frames_;
   y << YAML::Key << "images" << YAML::Value << YAML::BeginMap;
-  y << YAML::Key << "left" << YAML::Value << "left/*.png";
-  y << YAML::Key << "right" << YAML::Value << "right/*.png";
+  for (const std::string& c : info_.camera_names) {
+    y << YAML::Key << c << YAML::Value << c + "/*.png";
+  }
   y << YAML::Key << "format" << YAML::Value << "png";
   y << YAML::Key << "png_compression" << YAML::Value
     << options_.png_compression;
@@ -368,8 +387,7 @@ std::string SessionRecorder::SessionYaml(const SessionSummary* summary) const {
   y << YAML::Key << "frames_csv" << YAML::Value << "frames.csv";
   y << YAML::Key << "sources" << YAML::Value << YAML::BeginMap;
   for (int side = 0; side < 2; ++side) {
-    y << YAML::Key << (side == 0 ? "left" : "right") << YAML::Value
-      << YAML::BeginMap;
+    y << YAML::Key << info_.camera_names[side] << YAML::Value << YAML::BeginMap;
     y << YAML::Key << "uri" << YAML::Value
       << (side == 0 ? info_.left_uri : info_.right_uri);
     y << YAML::Key << "description" << YAML::Value

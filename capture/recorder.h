@@ -15,6 +15,9 @@ namespace kincal::capture {
 
 // What session.yaml records about how a session was made.
 struct SessionInfo {
+  // The two cameras' names: their image folders and frames.csv columns
+  // (t_<name>, seq_<name>), as in rig.yaml (data/session.h).
+  std::vector<std::string> camera_names = {"left", "right"};
   std::string left_uri;
   std::string right_uri;
   std::string left_description;
@@ -47,6 +50,7 @@ struct SessionSummary {
 //   DIR/right/000000.png, ...               same names: sorted, they pair
 //   DIR/frames.csv                          frame,t_left,t_right,seq_left,
 //                                           seq_right[,joint columns]
+//   (left and right are SessionInfo::camera_names, the rig's names)
 //   DIR/session.yaml                        sources, settings, command line,
 //                                           start time, how it ended
 //

@@ -1,6 +1,7 @@
 #include "data/session.h"
 
 #include <algorithm>
+#include <cctype>
 #include <cerrno>
 #include <cstdio>
 #include <cstdlib>
@@ -23,9 +24,6 @@ int Session::CountWithJoints() const {
 }
 
 namespace {
-
-const char* const kFixedColumns[] = {"frame", "t_left", "t_right", "seq_left",
-                                     "seq_right"};
 
 std::string Join(const std::vector<std::string>& names) {
   std::string s;
@@ -72,31 +70,78 @@ const std::string* FindImage(const std::map<std::string, std::string>& images,
   return it == images.end() ? nullptr : &it->second;
 }
 
-constexpr int kFixed = 5;  // frame,t_left,t_right,seq_left,seq_right
+// Where each column of frames.csv is: `frame`, per camera its t_ and seq_
+// columns (Session::cameras order), the joint columns (file order).
+struct FramesLayout {
+  int frame = -1;
+  std::vector<int> t, seq;
+  std::vector<int> joints;
+};
 
-// The header: the five fixed columns, then the joint columns (returned).
-std::vector<std::string> ParseFramesHeader(const CsvLine& header,
-                                           const std::string& file) {
-  for (int i = 0; i < kFixed; ++i) {
-    const int column = i < static_cast<int>(header.fields.size())
-                           ? header.fields[i].column
-                           : header.end_column;
-    if (i >= static_cast<int>(header.fields.size()) ||
-        header.fields[i].text != kFixedColumns[i]) {
-      throw InputError(
-          file, header.line, column,
-          std::string("header: expected column ") + std::to_string(i + 1) +
-              " to be '" + kFixedColumns[i] +
-              "' (frames.csv starts frame,t_left,t_right,seq_left,seq_right)" +
-              (i < static_cast<int>(header.fields.size())
-                   ? ", got '" + header.fields[i].text + "'"
-                   : ""));
+bool StartsWith(const std::string& s, const std::string& prefix) {
+  return s.size() > prefix.size() && s.compare(0, prefix.size(), prefix) == 0;
+}
+
+// Cameras of the header in the order of their t_ columns: names with both a
+// t_<name> and a seq_<name> column.
+std::vector<std::string> HeaderCameras(const CsvLine& header) {
+  std::set<std::string> seqs;
+  for (const CsvField& f : header.fields) {
+    if (StartsWith(f.text, "seq_")) seqs.insert(f.text.substr(4));
+  }
+  std::vector<std::string> cameras;
+  for (const CsvField& f : header.fields) {
+    if (StartsWith(f.text, "t_") && seqs.count(f.text.substr(2))) {
+      cameras.push_back(f.text.substr(2));
     }
   }
-  std::vector<std::string> joint_columns;
+  return cameras;
+}
+
+// The rig's cameras (when given) as the session names them: the same names,
+// or a version-2 left/right session for a two-camera rig named otherwise.
+std::vector<std::string> SessionCamerasFor(
+    const std::vector<std::string>& in_file,
+    const std::vector<std::string>& rig_names, const CsvLine& header,
+    const std::string& file) {
+  if (rig_names.empty()) return in_file;
+  const std::vector<std::string> v2 = {"left", "right"};
+  std::set<std::string> file_set(in_file.begin(), in_file.end());
+  std::set<std::string> rig_set(rig_names.begin(), rig_names.end());
+  if (file_set == rig_set) return rig_names;
+  if (rig_names.size() == 2 && in_file.size() == 2 &&
+      file_set == std::set<std::string>(v2.begin(), v2.end()) &&
+      !rig_set.count("left") && !rig_set.count("right")) {
+    return v2;
+  }
+  std::vector<std::string> missing, foreign;
+  for (const std::string& n : rig_names) {
+    if (!file_set.count(n)) missing.push_back(n);
+  }
+  for (const std::string& n : in_file) {
+    if (!rig_set.count(n)) foreign.push_back(n);
+  }
+  std::string msg = "the session's cameras (" + Join(in_file) +
+                    ") are not the rig's (" + Join(rig_names) + ")";
+  if (!missing.empty()) {
+    msg += "; no t_<name>, seq_<name> columns for: " + Join(missing);
+  }
+  if (!foreign.empty()) msg += "; not in the rig: " + Join(foreign);
+  msg +=
+      " (frames.csv holds t_<camera> and seq_<camera> for every camera of "
+      "rig.yaml, and one image folder per camera: the session of another "
+      "rig?)";
+  throw InputError(file, header.line, header.end_column, msg);
+}
+
+// The header: `frame`, the cameras' columns, the joint columns (returned in
+// session->joint_columns).
+FramesLayout ParseFramesHeader(const CsvLine& header,
+                               const SessionReadOptions& options,
+                               const std::string& file, Session* session) {
+  FramesLayout layout;
   std::set<std::string> seen;
-  for (size_t i = kFixed; i < header.fields.size(); ++i) {
-    const CsvField& f = header.fields[i];
+  for (const CsvField& f : header.fields) {
     if (f.text.empty()) {
       throw InputError(file, header.line, f.column, "empty column name");
     }
@@ -104,17 +149,53 @@ std::vector<std::string> ParseFramesHeader(const CsvLine& header,
       throw InputError(file, header.line, f.column,
                        "duplicate column '" + f.text + "'");
     }
-    joint_columns.push_back(f.text);
   }
-  return joint_columns;
+  const std::vector<std::string> in_file = HeaderCameras(header);
+  session->cameras =
+      SessionCamerasFor(in_file, options.camera_names, header, file);
+  if (session->cameras.empty()) {
+    throw InputError(file, header.line, header.end_column,
+                     "header: expected t_<camera> and seq_<camera> columns "
+                     "for every camera (e.g. "
+                     "frame,t_left,t_right,seq_left,seq_right)");
+  }
+  layout.t.assign(session->cameras.size(), -1);
+  layout.seq.assign(session->cameras.size(), -1);
+  session->joint_columns.clear();
+  for (size_t i = 0; i < header.fields.size(); ++i) {
+    const std::string& name = header.fields[i].text;
+    const int col = static_cast<int>(i);
+    bool camera_column = false;
+    for (size_t c = 0; c < session->cameras.size(); ++c) {
+      if (name == "t_" + session->cameras[c]) layout.t[c] = col;
+      if (name == "seq_" + session->cameras[c]) layout.seq[c] = col;
+      camera_column = camera_column || name == "t_" + session->cameras[c] ||
+                      name == "seq_" + session->cameras[c];
+    }
+    if (name == "frame") {
+      layout.frame = col;
+    } else if (!camera_column) {
+      layout.joints.push_back(col);
+      session->joint_columns.push_back(name);
+    }
+  }
+  if (layout.frame < 0) {
+    throw InputError(file, header.line, 1,
+                     "header: expected a 'frame' column (frames.csv holds "
+                     "frame, t_<camera> and seq_<camera> for every camera, "
+                     "and the joint columns)");
+  }
+  return layout;
 }
 
 // Per robot joint, its field index; InputError unless the joint columns are
 // exactly the robot's joints. Empty without joint names.
-std::vector<int> MapJointColumns(const std::vector<std::string>& joint_columns,
+std::vector<int> MapJointColumns(const Session& session,
+                                 const FramesLayout& layout,
                                  const std::vector<std::string>& joint_names,
                                  const CsvLine& header,
                                  const std::string& file) {
+  const std::vector<std::string>& joint_columns = session.joint_columns;
   std::vector<int> column_of;
   if (joint_names.empty()) return column_of;
   std::vector<std::string> missing, foreign;
@@ -123,8 +204,7 @@ std::vector<int> MapJointColumns(const std::vector<std::string>& joint_columns,
     if (it == joint_columns.end()) {
       missing.push_back(name);
     } else {
-      column_of.push_back(kFixed +
-                          static_cast<int>(it - joint_columns.begin()));
+      column_of.push_back(layout.joints[it - joint_columns.begin()]);
     }
   }
   for (const std::string& c : joint_columns) {
@@ -137,8 +217,8 @@ std::vector<int> MapJointColumns(const std::vector<std::string>& joint_columns,
   std::string msg;
   if (joint_columns.empty()) {
     msg = "no joint columns: the robot's joints (" + Join(joint_names) +
-          ") need one column each after seq_right (joint readings at "
-          "each frame)";
+          ") need one column each beside the cameras' t_ and seq_ columns "
+          "(joint readings at each frame)";
   } else {
     msg = "joint columns (" + Join(joint_columns) +
           ") do not match the robot's joints (" + Join(joint_names) + ")";
@@ -153,28 +233,26 @@ std::vector<int> MapJointColumns(const std::vector<std::string>& joint_columns,
 
 // Times and sequence numbers may be empty (unknown); anything else in them
 // must be a number.
-void ParseTimesAndSequences(const CsvLine& line, const std::string& file,
+void ParseTimesAndSequences(const CsvLine& line, const CsvLine& header,
+                            const std::string& file, const FramesLayout& layout,
                             SessionFrame* f) {
-  double* times[2] = {&f->t_left, &f->t_right};
-  for (int k = 0; k < 2; ++k) {
-    const CsvField& c = line.fields[1 + k];
-    if (c.text.empty()) continue;
-    if (!ParseFiniteDouble(c.text, times[k])) {
+  const size_t nc = layout.t.size();
+  f->t.assign(nc, 0.0);
+  f->seq.assign(nc, 0);
+  for (size_t k = 0; k < nc; ++k) {
+    const CsvField& c = line.fields[layout.t[k]];
+    if (!c.text.empty() && !ParseFiniteDouble(c.text, &f->t[k])) {
       throw InputError(file, line.line, c.column,
-                       std::string(kFixedColumns[1 + k]) +
+                       header.fields[layout.t[k]].text +
                            ": expected a time in seconds, got '" + c.text +
                            "'");
     }
-  }
-  long long* seqs[2] = {&f->seq_left, &f->seq_right};
-  for (int k = 0; k < 2; ++k) {
-    const CsvField& c = line.fields[3 + k];
-    if (c.text.empty()) continue;
-    if (!ParseInteger(c.text, seqs[k])) {
-      throw InputError(file, line.line, c.column,
-                       std::string(kFixedColumns[3 + k]) +
+    const CsvField& s = line.fields[layout.seq[k]];
+    if (!s.text.empty() && !ParseInteger(s.text, &f->seq[k])) {
+      throw InputError(file, line.line, s.column,
+                       header.fields[layout.seq[k]].text +
                            ": expected an integer sequence number, got '" +
-                           c.text + "'");
+                           s.text + "'");
     }
   }
 }
@@ -182,15 +260,12 @@ void ParseTimesAndSequences(const CsvLine& line, const std::string& file,
 // Joint cells: all empty (no reading) or all numbers; the robot's joints
 // (column_of) go to f->q.
 void ParseJointCells(const CsvLine& line, const CsvLine& header,
-                     const std::string& file, const std::vector<int>& column_of,
-                     SessionFrame* f) {
-  const size_t ncols = header.fields.size();
+                     const std::string& file, const FramesLayout& layout,
+                     const std::vector<int>& column_of, SessionFrame* f) {
   int empty = 0;
-  for (size_t i = kFixed; i < ncols; ++i) {
-    empty += line.fields[i].text.empty() ? 1 : 0;
-  }
-  if (empty != 0 && empty != static_cast<int>(ncols - kFixed)) {
-    for (size_t i = kFixed; i < ncols; ++i) {
+  for (int i : layout.joints) empty += line.fields[i].text.empty() ? 1 : 0;
+  if (empty != 0 && empty != static_cast<int>(layout.joints.size())) {
+    for (int i : layout.joints) {
       if (line.fields[i].text.empty()) {
         throw InputError(file, line.line, line.fields[i].column,
                          "joint '" + header.fields[i].text +
@@ -200,7 +275,7 @@ void ParseJointCells(const CsvLine& line, const CsvLine& header,
     }
   }
   if (empty != 0) return;
-  for (size_t i = kFixed; i < ncols; ++i) {
+  for (int i : layout.joints) {
     double v = 0;
     if (!ParseFiniteDouble(line.fields[i].text, &v)) {
       throw InputError(file, line.line, line.fields[i].column,
@@ -219,36 +294,150 @@ void ParseJointCells(const CsvLine& line, const CsvLine& header,
 
 // One frame row; `frames_seen` collects the frame numbers so far.
 SessionFrame ParseFrameRow(const CsvLine& line, const CsvLine& header,
-                           const std::string& file,
+                           const std::string& file, const FramesLayout& layout,
                            const std::vector<int>& column_of,
                            std::set<long long>* frames_seen) {
   const size_t ncols = header.fields.size();
   if (line.fields.size() != ncols) {
-    throw InputError(
-        file, line.line,
-        line.fields.size() < ncols ? line.end_column
-                                   : line.fields[ncols].column,
-        "expected " + std::to_string(ncols) + " cells (" +
-            std::to_string(kFixed) + " + " + std::to_string(ncols - kFixed) +
-            " joint columns), got " + std::to_string(line.fields.size()));
+    throw InputError(file, line.line,
+                     line.fields.size() < ncols ? line.end_column
+                                                : line.fields[ncols].column,
+                     "expected " + std::to_string(ncols) + " cells (" +
+                         std::to_string(ncols - layout.joints.size()) + " + " +
+                         std::to_string(layout.joints.size()) +
+                         " joint columns), got " +
+                         std::to_string(line.fields.size()));
   }
   SessionFrame f;
   f.line = line.line;
   long long frame = 0;
-  if (!ParseInteger(line.fields[0].text, &frame) || frame < 0 ||
-      frame > 99999999) {
-    throw InputError(file, line.line, line.fields[0].column,
-                     "frame: expected a non-negative integer, got '" +
-                         line.fields[0].text + "'");
+  const CsvField& cell = line.fields[layout.frame];
+  if (!ParseInteger(cell.text, &frame) || frame < 0 || frame > 99999999) {
+    throw InputError(
+        file, line.line, cell.column,
+        "frame: expected a non-negative integer, got '" + cell.text + "'");
   }
   if (!frames_seen->insert(frame).second) {
-    throw InputError(file, line.line, line.fields[0].column,
+    throw InputError(file, line.line, cell.column,
                      "frame " + std::to_string(frame) + " appears twice");
   }
   f.frame = static_cast<int>(frame);
-  ParseTimesAndSequences(line, file, &f);
-  ParseJointCells(line, header, file, column_of, &f);
+  ParseTimesAndSequences(line, header, file, layout, &f);
+  ParseJointCells(line, header, file, layout, column_of, &f);
   return f;
+}
+
+void RequireJointReadings(const SessionReadOptions& options, const Session& s) {
+  if (options.require_joint_readings && s.CountWithJoints() == 0) {
+    throw InputError(s.frames_csv, 0, 0,
+                     "no frame has joint readings (the joint cells are "
+                     "empty in every row)");
+  }
+}
+
+// session.yaml: version and status.
+std::string ReadSessionStatus(const std::string& yaml_path) {
+  std::error_code ec;
+  if (!std::filesystem::exists(yaml_path, ec)) {
+    throw InputError(yaml_path +
+                     ": missing (a recorded session has "
+                     "session.yaml with kincal_session: 1 and "
+                     "status)");
+  }
+  const YamlReader reader(yaml_path);
+  const YAML::Node root = reader.Load(ReadFile(yaml_path));
+  reader.ExpectMap(root, "session.yaml");
+  const YAML::Node version =
+      reader.Required(root, "kincal_session", "session.yaml");
+  if (reader.Integer(version, "kincal_session") != 1) {
+    reader.Fail(version,
+                "kincal_session: expected 1 (the version this "
+                "kincal reads)");
+  }
+  const YAML::Node status = reader.Required(root, "status", "session.yaml");
+  const std::string s = reader.String(status, "status");
+  if (s != "complete" && s != "failed" && s != "recording") {
+    reader.Fail(
+        status,
+        "status: expected complete, failed or recording, got '" + s + "'");
+  }
+  return s;
+}
+
+using ImageIndex = std::map<std::string, std::string>;
+
+// Images named otherwise than by frame number (e.g. frame numbers from 1
+// but images from 000000): when no row finds an image by its number, and
+// every camera folder holds the same names, one per row, they pair in
+// sorted order. True when it paired them.
+bool PairImagesInOrder(const std::vector<ImageIndex>& images, Session* s) {
+  for (const SessionFrame& f : s->frames) {
+    for (const ImageIndex& im : images) {
+      if (FindImage(im, f.frame)) return false;
+    }
+  }
+  if (s->frames.empty()) return false;
+  for (const ImageIndex& im : images) {
+    if (im.size() != s->frames.size()) return false;
+    auto a = images[0].begin();
+    for (auto b = im.begin(); b != im.end(); ++a, ++b) {
+      if (a->first != b->first) return false;
+    }
+  }
+  std::vector<ImageIndex::const_iterator> it;
+  for (const ImageIndex& im : images) it.push_back(im.begin());
+  for (SessionFrame& f : s->frames) {
+    f.images.clear();
+    for (auto& i : it) f.images.push_back((i++)->second);
+  }
+  return true;
+}
+
+// Every row's image in every camera folder, by frame number.
+void PairImagesByNumber(const std::vector<ImageIndex>& images, bool partial,
+                        Session* s) {
+  const size_t nc = images.size();
+  auto complete = [&](const SessionFrame& f) {
+    for (const ImageIndex& im : images) {
+      if (!FindImage(im, f.frame)) return false;
+    }
+    return true;
+  };
+  // Last row with every image (an unfinished session stops there).
+  int last_complete = -1;
+  for (size_t i = 0; i < s->frames.size(); ++i) {
+    if (complete(s->frames[i])) last_complete = static_cast<int>(i);
+  }
+  if (partial) {
+    s->dropped_tail = static_cast<int>(s->frames.size()) - 1 - last_complete;
+    s->frames.resize(last_complete + 1);
+  }
+  std::vector<std::set<std::string>> used(nc);
+  for (SessionFrame& f : s->frames) {
+    f.images.clear();
+    for (size_t k = 0; k < nc; ++k) {
+      const std::string* path = FindImage(images[k], f.frame);
+      if (path == nullptr) {
+        throw InputError(s->frames_csv, f.line, 1,
+                         "frame " + std::to_string(f.frame) + " has no " +
+                             s->folders[k] + " image (expected " + s->dir +
+                             "/" + s->folders[k] + "/" + FrameStem(f.frame) +
+                             ".png): every frame has one image per camera");
+      }
+      used[k].insert(*path);
+      f.images.push_back(*path);
+    }
+  }
+  if (partial) return;
+  for (size_t k = 0; k < nc; ++k) {
+    for (const auto& [stem, path] : images[k]) {
+      if (!used[k].count(path)) {
+        throw InputError(path + ": image without a row in " + s->frames_csv +
+                         " (every frame has one row; images without a row "
+                         "are bad input)");
+      }
+    }
+  }
 }
 
 }  // namespace
@@ -266,17 +455,18 @@ void ParseSessionFramesCsv(const std::string& text_in, const std::string& file,
   if (lines.empty()) {
     throw InputError(file, 0, 0,
                      "empty file: expected a header line "
-                     "'frame,t_left,t_right,seq_left,seq_right[,<joints>]'");
+                     "'frame,t_<camera>...,seq_<camera>...[,<joints>]' "
+                     "(e.g. frame,t_left,t_right,seq_left,seq_right)");
   }
   const CsvLine& header = lines[0];
-  session->joint_columns = ParseFramesHeader(header, file);
-  const std::vector<int> column_of = MapJointColumns(
-      session->joint_columns, options.joint_names, header, file);
+  const FramesLayout layout = ParseFramesHeader(header, options, file, session);
+  const std::vector<int> column_of =
+      MapJointColumns(*session, layout, options.joint_names, header, file);
   session->frames.clear();
   std::set<long long> frames_seen;
   for (size_t li = 1; li < lines.size(); ++li) {
-    session->frames.push_back(
-        ParseFrameRow(lines[li], header, file, column_of, &frames_seen));
+    session->frames.push_back(ParseFrameRow(lines[li], header, file, layout,
+                                            column_of, &frames_seen));
   }
 }
 
@@ -287,40 +477,12 @@ Session ReadSession(const std::string& dir_in,
   std::error_code ec;
   if (!std::filesystem::is_directory(dir, ec)) {
     throw InputError(dir +
-                     ": not a session folder (expected a folder with "
-                     "left/, right/, frames.csv and session.yaml)");
+                     ": not a session folder (expected a folder with one "
+                     "image folder per camera, frames.csv and session.yaml)");
   }
   Session s;
   s.dir = dir;
-  // session.yaml: version and status.
-  const std::string yaml_path = dir + "/session.yaml";
-  if (!std::filesystem::exists(yaml_path, ec)) {
-    throw InputError(yaml_path +
-                     ": missing (a recorded session has "
-                     "session.yaml with kincal_session: 1 and "
-                     "status)");
-  }
-  {
-    const YamlReader reader(yaml_path);
-    const YAML::Node root = reader.Load(ReadFile(yaml_path));
-    reader.ExpectMap(root, "session.yaml");
-    const YAML::Node version =
-        reader.Required(root, "kincal_session", "session.yaml");
-    if (reader.Integer(version, "kincal_session") != 1) {
-      reader.Fail(version,
-                  "kincal_session: expected 1 (the version this "
-                  "kincal reads)");
-    }
-    const YAML::Node status = reader.Required(root, "status", "session.yaml");
-    s.status = reader.String(status, "status");
-    if (s.status != "complete" && s.status != "failed" &&
-        s.status != "recording") {
-      reader.Fail(status,
-                  "status: expected complete, failed or recording, "
-                  "got '" +
-                      s.status + "'");
-    }
-  }
+  s.status = ReadSessionStatus(dir + "/session.yaml");
   const bool partial = s.status != "complete";
   // frames.csv (or the journal of an unfinished session).
   s.frames_csv = dir + "/frames.csv";
@@ -330,100 +492,53 @@ Session ReadSession(const std::string& dir_in,
       s.frames_csv = journal;
     } else {
       throw InputError(s.frames_csv +
-                       ": missing (frame,t_left,t_right,seq_left,seq_right"
-                       "[,<joints>] per stereo pair)");
+                       ": missing (frame, t_<camera>, seq_<camera> for every "
+                       "camera[, <joints>] per frame)");
     }
   }
   ParseSessionFramesCsv(ReadFile(s.frames_csv), s.frames_csv, options, partial,
                         &s);
-  // Images, paired by name.
-  std::map<std::string, std::string> images[2];
-  const char* sides[2] = {"left", "right"};
-  for (int k = 0; k < 2; ++k) {
-    const std::string folder = dir + "/" + sides[k];
+  // A v2 left/right session read for a rig named otherwise keeps its
+  // folders' names; the cameras take the rig's.
+  s.folders = s.cameras;
+  if (!options.camera_names.empty()) s.cameras = options.camera_names;
+  std::vector<ImageIndex> images;
+  for (const std::string& name : s.folders) {
+    const std::string folder = dir + "/" + name;
     if (!std::filesystem::is_directory(folder, ec)) {
-      throw InputError(folder +
-                       ": missing image folder (a session has "
-                       "left/ and right/ with one image per frame)");
+      throw InputError(folder + ": missing image folder of camera '" + name +
+                       "' (a session has one folder per camera, named as in "
+                       "rig.yaml and in frames.csv's t_" +
+                       name + " column, with one image per frame)");
     }
-    images[k] = ListImages(folder);
+    images.push_back(ListImages(folder));
   }
-  // Images named otherwise than by frame number (e.g. frame numbers from 1
-  // but images from 000000): when no row finds an image by its number, and
-  // left/ and right/ hold the same names, one per row, they pair in sorted
-  // order.
-  bool any = false;
-  for (const SessionFrame& f : s.frames) {
-    any = any || FindImage(images[0], f.frame) || FindImage(images[1], f.frame);
-  }
-  bool by_order = false;
-  if (!any && !s.frames.empty() && images[0].size() == s.frames.size() &&
-      images[1].size() == s.frames.size()) {
-    by_order = true;
-    for (auto a = images[0].begin(), b = images[1].begin();
-         a != images[0].end(); ++a, ++b) {
-      by_order = by_order && a->first == b->first;
-    }
-  }
-  if (by_order) {
-    auto a = images[0].begin(), b = images[1].begin();
-    for (SessionFrame& f : s.frames) {
-      f.left_image = (a++)->second;
-      f.right_image = (b++)->second;
-    }
-    if (options.require_joint_readings && s.CountWithJoints() == 0) {
-      throw InputError(s.frames_csv, 0, 0,
-                       "no frame has joint readings (the joint cells are "
-                       "empty in every row)");
-    }
-    return s;
-  }
-  // Last row with both images (an unfinished session stops there).
-  int last_complete = -1;
-  for (size_t i = 0; i < s.frames.size(); ++i) {
-    if (FindImage(images[0], s.frames[i].frame) &&
-        FindImage(images[1], s.frames[i].frame)) {
-      last_complete = static_cast<int>(i);
-    }
-  }
-  if (partial) {
-    s.dropped_tail = static_cast<int>(s.frames.size()) - 1 - last_complete;
-    s.frames.resize(last_complete + 1);
-  }
-  std::set<std::string> used[2];
-  for (SessionFrame& f : s.frames) {
-    const std::string* paths[2] = {FindImage(images[0], f.frame),
-                                   FindImage(images[1], f.frame)};
-    for (int k = 0; k < 2; ++k) {
-      if (paths[k] == nullptr) {
-        throw InputError(s.frames_csv, f.line, 1,
-                         "frame " + std::to_string(f.frame) + " has no " +
-                             sides[k] + " image (expected " + dir + "/" +
-                             sides[k] + "/" + FrameStem(f.frame) +
-                             ".png): frames must come in pairs");
-      }
-      used[k].insert(*paths[k]);
-    }
-    f.left_image = *paths[0];
-    f.right_image = *paths[1];
-  }
-  if (!partial) {
-    for (int k = 0; k < 2; ++k) {
-      for (const auto& [stem, path] : images[k]) {
-        if (!used[k].count(path)) {
-          throw InputError(path + ": image without a row in " + s.frames_csv +
-                           " (every stereo pair has one row; frames without "
-                           "pairs are bad input)");
-        }
-      }
-    }
-  }
-  if (options.require_joint_readings && s.CountWithJoints() == 0) {
-    throw InputError(s.frames_csv, 0, 0,
-                     "no frame has joint readings (the joint cells are "
-                     "empty in every row)");
-  }
+  if (!PairImagesInOrder(images, &s)) PairImagesByNumber(images, partial, &s);
+  RequireJointReadings(options, s);
   return s;
+}
+
+std::string SessionFramesHeader(const std::vector<std::string>& cameras,
+                                const std::vector<std::string>& joints) {
+  std::string h = "frame";
+  for (const std::string& c : cameras) h += ",t_" + c;
+  for (const std::string& c : cameras) h += ",seq_" + c;
+  for (const std::string& j : joints) h += "," + j;
+  return h;
+}
+
+void CheckSessionCameraName(const std::string& name, const std::string& what) {
+  bool ok = !name.empty() && name != "." && name != "..";
+  for (char c : name) {
+    ok = ok && (std::isalnum(static_cast<unsigned char>(c)) || c == '_' ||
+                c == '-' || c == '.');
+  }
+  if (!ok) {
+    throw InputError(what + ": camera name '" + name +
+                     "' cannot name a session's image folder and its "
+                     "frames.csv columns (t_<name>, seq_<name>): use "
+                     "letters, digits, '_', '-' and '.' only");
+  }
 }
 
 }  // namespace kincal

@@ -63,10 +63,11 @@ TEST(Session, ReadsFramesJointsAndImagePairs) {
   EXPECT_EQ(s.CountWithJoints(), 2);
   EXPECT_EQ(s.frames[0].q, (std::vector<double>{-3, 1.5}));
   EXPECT_FALSE(s.frames[1].HasJoints());
-  EXPECT_EQ(s.frames[2].seq_right, 22);
-  EXPECT_DOUBLE_EQ(s.frames[2].t_left, 0.2);
-  EXPECT_EQ(s.frames[1].left_image, dir + "/left/000001.png");
-  EXPECT_EQ(s.frames[1].right_image, dir + "/right/000001.png");
+  EXPECT_EQ(s.cameras, (std::vector<std::string>{"left", "right"}));
+  EXPECT_EQ(s.frames[2].seq[1], 22);
+  EXPECT_DOUBLE_EQ(s.frames[2].t[0], 0.2);
+  EXPECT_EQ(s.frames[1].images[0], dir + "/left/000001.png");
+  EXPECT_EQ(s.frames[1].images[1], dir + "/right/000001.png");
   // Without a robot the joint columns are listed but not read.
   const Session plain = ReadSession(dir);
   EXPECT_EQ(plain.joint_columns, (std::vector<std::string>{"j1", "j2"}));
@@ -136,7 +137,7 @@ TEST(Session, ImagesNamedOtherwisePairInSortedOrder) {
   o.joint_names = {"j1", "j2"};
   const Session s = ReadSession(dir, o);
   ASSERT_EQ(s.frames.size(), 2u);
-  EXPECT_EQ(s.frames[1].left_image, dir + "/left/img_b.png");
+  EXPECT_EQ(s.frames[1].images[0], dir + "/left/img_b.png");
   EXPECT_EQ(s.frames[1].q, (std::vector<double>{3, 4}));
   // Different names in left/ and right/ are frames without pairs.
   std::filesystem::rename(dir + "/right/img_b.png", dir + "/right/img_c.png");
@@ -182,6 +183,80 @@ TEST(Session, BadCellsAndHeaderAndStatus) {
       HasSubstr("no frame has joint readings"));
   EXPECT_THAT(ErrorOf(testing::MakeTempDir("empty"), o),
               HasSubstr("session.yaml: missing"));
+}
+
+// A session with three cameras (format v3): folders named as the cameras,
+// t_/seq_ columns found by name in any order, joints between them.
+std::string MakeThreeCameraSession(const std::string& tag, int n) {
+  const std::string dir = testing::MakeTempDir(tag);
+  for (const char* cam : {"top", "side", "wrist"}) {
+    std::filesystem::create_directories(dir + "/" + cam);
+    for (int i = 0; i < n; ++i) {
+      char name[32];
+      std::snprintf(name, sizeof(name), "/%06d.png", i);
+      Write(dir + "/" + cam + name, "x");
+    }
+  }
+  Write(dir + "/frames.csv",
+        "seq_side,j1,t_top,frame,t_side,seq_wrist,j2,seq_top,t_wrist\n"
+        "5,1.5,0.0,0,0.01,7,-3,3,0.02\n"
+        "6,2.5,0.1,1,0.11,8,4,4,0.12\n");
+  Write(dir + "/session.yaml", "kincal_session: 1\nstatus: complete\n");
+  return dir;
+}
+
+TEST(Session, ThreeCamerasWithColumnsInAnyOrder) {
+  const std::string dir = MakeThreeCameraSession("three", 2);
+  SessionReadOptions o;
+  o.joint_names = {"j1", "j2"};
+  const Session s = ReadSession(dir, o);
+  EXPECT_EQ(s.cameras, (std::vector<std::string>{"top", "side", "wrist"}));
+  EXPECT_EQ(s.joint_columns, (std::vector<std::string>{"j1", "j2"}));
+  ASSERT_EQ(s.frames.size(), 2u);
+  EXPECT_EQ(s.frames[1].seq, (std::vector<long long>{4, 6, 8}));
+  EXPECT_EQ(s.frames[1].t, (std::vector<double>{0.1, 0.11, 0.12}));
+  EXPECT_EQ(s.frames[1].q, (std::vector<double>{2.5, 4}));
+  EXPECT_EQ(s.frames[0].images[2], dir + "/wrist/000000.png");
+  // The rig's order decides the cameras' order.
+  o.camera_names = {"wrist", "top", "side"};
+  const Session r = ReadSession(dir, o);
+  EXPECT_EQ(r.cameras, o.camera_names);
+  EXPECT_EQ(r.frames[1].seq, (std::vector<long long>{8, 4, 6}));
+  EXPECT_EQ(r.frames[0].images[0], dir + "/wrist/000000.png");
+  // A rig with another camera set is named in the message.
+  o.camera_names = {"top", "side"};
+  EXPECT_THAT(ErrorOf(dir, o), HasSubstr("not in the rig: wrist"));
+  o.camera_names = {"top", "side", "wrist", "extra"};
+  EXPECT_THAT(ErrorOf(dir, o), HasSubstr("seq_<name> columns for: extra"));
+  // A camera folder missing.
+  o.camera_names.clear();
+  std::filesystem::remove_all(dir + "/side");
+  EXPECT_THAT(ErrorOf(dir, o),
+              HasSubstr("missing image folder of camera 'side'"));
+}
+
+TEST(Session, VersionTwoSessionReadsForARigNamedOtherwise) {
+  const std::string dir = MakeSession("v2names", kCsv, 3);
+  SessionReadOptions o;
+  o.camera_names = {"cam_a", "cam_b"};
+  const Session s = ReadSession(dir, o);
+  EXPECT_EQ(s.cameras, o.camera_names);
+  EXPECT_EQ(s.folders, (std::vector<std::string>{"left", "right"}));
+  EXPECT_EQ(s.frames[2].images[1], dir + "/right/000002.png");
+  // ... but not for a three-camera rig.
+  o.camera_names = {"cam_a", "cam_b", "cam_c"};
+  EXPECT_THAT(ErrorOf(dir, o), HasSubstr("not the rig's"));
+}
+
+TEST(Session, WriterHeaderAndCameraNames) {
+  EXPECT_EQ(SessionFramesHeader({"left", "right"}, {"j1"}),
+            "frame,t_left,t_right,seq_left,seq_right,j1");
+  EXPECT_EQ(SessionFramesHeader({"c0"}, {}), "frame,t_c0,seq_c0");
+  EXPECT_NO_THROW(CheckSessionCameraName("cam-1.a_b", "rig.yaml"));
+  EXPECT_THROW(CheckSessionCameraName("my cam", "rig.yaml"), InputError);
+  EXPECT_THROW(CheckSessionCameraName("a/b", "rig.yaml"), InputError);
+  EXPECT_THROW(CheckSessionCameraName("..", "rig.yaml"), InputError);
+  EXPECT_THROW(CheckSessionCameraName("", "rig.yaml"), InputError);
 }
 
 }  // namespace

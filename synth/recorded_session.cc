@@ -8,6 +8,7 @@
 #include "data/atomic_file.h"
 #include "data/error.h"
 #include "data/provenance.h"
+#include "data/session.h"
 #include "data/yaml_util.h"
 
 namespace kincal {
@@ -18,8 +19,9 @@ int RenderRecordedSession(const Rig& rig, const Target& target,
                           const std::string& dir) {
   options.Check();
   const size_t n = input.rig_from_tool.size();
-  if (rig.cameras.size() != 2) {
-    throw InputError("render: a recorded session needs a stereo rig");
+  const std::vector<std::string> cameras = rig.CameraNames();
+  for (const std::string& name : cameras) {
+    CheckSessionCameraName(name, "render: the rig");
   }
   if (!input.joints.empty() && input.joints.size() != n) {
     throw InputError("render: joint readings for " +
@@ -30,10 +32,10 @@ int RenderRecordedSession(const Rig& rig, const Target& target,
   if (std::filesystem::exists(dir + "/frames.csv", ec)) {
     throw InputError(dir + ": already holds a session (frames.csv)");
   }
-  for (const char* side : {"/left", "/right"}) {
-    std::filesystem::create_directories(dir + side, ec);
+  for (const std::string& name : cameras) {
+    std::filesystem::create_directories(dir + "/" + name, ec);
     if (ec) {
-      throw InputError(dir + side +
+      throw InputError(dir + "/" + name +
                        ": cannot create the folder: " + ec.message());
     }
   }
@@ -43,31 +45,34 @@ int RenderRecordedSession(const Rig& rig, const Target& target,
       "# written by " + ToolVersion() + ": " + CommandLine() + "\n";
   std::ostringstream frames;
   TruthTables tables(header, seed);
-  frames << header << "frame,t_left,t_right,seq_left,seq_right";
-  for (const std::string& j : input.joint_names) frames << "," << j;
-  frames << "\n";
+  frames << header << SessionFramesHeader(cameras, input.joint_names) << "\n";
   const std::vector<int> png_params = {cv::IMWRITE_PNG_COMPRESSION, 1};
   for (size_t f = 0; f < n; ++f) {
     const StereoFrameTruth frame =
         renderer.Render(input.rig_from_tool[f], &rng);
     char name[32];
     std::snprintf(name, sizeof(name), "%06zu.png", f);
-    for (size_t c = 0; c < 2; ++c) {
+    for (size_t c = 0; c < cameras.size(); ++c) {
       std::vector<uchar> png;
       cv::imencode(".png", frame.views[c].image, png, png_params);
-      WriteFileAtomic(dir + (c == 0 ? "/left/" : "/right/") + name,
+      WriteFileAtomic(dir + "/" + cameras[c] + "/" + name,
                       std::string(png.begin(), png.end()));
     }
     const double t = input.t_s.size() == n ? input.t_s[f] : 0.1 * f;
-    frames << f << "," << FormatDouble(t) << "," << FormatDouble(t) << "," << f
-           << "," << f;
+    frames << f;
+    for (size_t c = 0; c < cameras.size(); ++c)
+      frames << "," << FormatDouble(t);
+    for (size_t c = 0; c < cameras.size(); ++c) frames << "," << f;
     const bool has = !input.joints.empty() && !input.joints[f].empty();
     for (size_t j = 0; j < input.joint_names.size(); ++j) {
       frames << ",";
       if (has) frames << FormatDouble(input.joints[f].at(j));
     }
     frames << "\n";
-    tables.Add(f, frame, {"0", "1"});
+    std::vector<std::string> labels;
+    for (size_t c = 0; c < cameras.size(); ++c)
+      labels.push_back(std::to_string(c));
+    tables.Add(f, frame, labels);
   }
   WriteFileAtomic(dir + "/truth.csv", tables.TruthCsv());
   WriteFileAtomic(dir + "/corners.csv", tables.CornersCsv());
@@ -78,7 +83,11 @@ int RenderRecordedSession(const Rig& rig, const Target& target,
        << "status: complete\n"
        << "frames: " << n << "\n"
        << "source: rendered (kincal synth, seed " << seed << ")\n"
-       << "images: {left: left/*.png, right: right/*.png, format: png}\n"
+       << "images: {";
+  for (const std::string& name : cameras) {
+    yaml << name << ": " << name << "/*.png, ";
+  }
+  yaml << "format: png}\n"
        << "frames_csv: frames.csv\n"
        << "joints: [";
   for (size_t j = 0; j < input.joint_names.size(); ++j) {

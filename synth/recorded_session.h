@@ -2,13 +2,18 @@
 #define KINCAL_SYNTH_RECORDED_SESSION_H_
 
 // Renders a recorded session in the spec's layout (../shared/spec/formats.md
-// v2, "Recorded session"; data/session.h reads it back):
+// v3, "Recorded session with N cameras"; data/session.h reads it back), for
+// a rig of 1..N cameras:
 //
-//   DIR/left/000000.png ...  right/000000.png ...   8-bit gray, lossless
-//   DIR/frames.csv    frame,t_left,t_right,seq_left,seq_right,<joints>
+//   DIR/<camera>/000000.png ...   one folder per camera of the rig, named as
+//                                 in rig.yaml; 8-bit gray, lossless
+//   DIR/frames.csv    frame,t_<camera>...,seq_<camera>...,<joints>
+//                     (frame,t_left,t_right,seq_left,seq_right,... for a
+//                     left/right rig)
 //   DIR/session.yaml  kincal_session: 1, status: complete, ...
 //   DIR/truth.csv     frame, rig_from_tool (R row-major, t mm), tip in rig
-//   DIR/corners.csv   frame, camera, tag, corner, u, v, visible (px)
+//   DIR/corners.csv   frame, camera (index in the rig), tag, corner, u, v,
+//                     visible (px)
 //
 // so `kincal track --session DIR` and `kincal bundle --session DIR` read it.
 
@@ -30,8 +35,9 @@ struct RecordedSessionInput {
 };
 
 // Writes the session into `dir` (created; must not hold a session yet).
-// Returns the number of frames. InputError for bad options, a folder that is
-// not writable or already has frames.csv.
+// Returns the number of frames. InputError for bad options, a camera name
+// that cannot name a folder (data/session.h), a folder that is not writable
+// or already has frames.csv.
 int RenderRecordedSession(const Rig& rig, const Target& target,
                           const RecordedSessionInput& input,
                           const RenderOptions& options, uint64_t seed,

@@ -2,6 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <string>
+
+#include "data/error.h"
 
 namespace kincal {
 
@@ -47,6 +50,30 @@ Rigid3 PlaceRigFacingTips(const std::vector<Eigen::Matrix4d>& base_from_tip,
   base_from_rig.R.col(2) = z;
   base_from_rig.t = centroid - distance * z;
   return base_from_rig.Inverse();
+}
+
+Rig RigWithCameras(const Rig& stereo, int num_cameras, double aim_mm) {
+  if (stereo.cameras.size() != 2 || num_cameras < 1 || num_cameras > 3) {
+    throw InputError(
+        "rendered rigs have 1, 2 or 3 cameras (from a stereo "
+        "pair); got " +
+        std::to_string(num_cameras));
+  }
+  Rig rig = stereo;
+  rig.cameras.resize(std::min(num_cameras, 2));
+  if (num_cameras == 3) {
+    Camera top = stereo.cameras[0];
+    top.intrinsics.name = "top";
+    top.intrinsics.cx += 4.0;
+    top.intrinsics.cy -= 3.0;
+    const Eigen::Vector3d centre(0, -120, 0);
+    top.cam_from_rig.R =
+        Eigen::AngleAxisd(std::atan2(120.0, aim_mm), Eigen::Vector3d::UnitX())
+            .toRotationMatrix();
+    top.cam_from_rig.t = -(top.cam_from_rig.R * centre);
+    rig.cameras.push_back(top);
+  }
+  return rig;
 }
 
 }  // namespace kincal

@@ -23,6 +23,13 @@ Rigid3 PlaceRigFacingTips(const std::vector<Eigen::Matrix4d>& base_from_tip,
                           const Rig& rig, const Rigid3& tip_from_tool,
                           double in_view, double* distance_mm = nullptr);
 
+// A rig of `num_cameras` (1..3) cameras from a stereo rig (ExampleStereoRig):
+// 1 = its first camera alone; 2 = the pair; 3 = the pair and a third
+// camera "top", a copy of the first 120 mm above it (rig -y), turned down
+// towards the point `aim_mm` in front of the first camera. InputError for
+// another count or a rig without two cameras.
+Rig RigWithCameras(const Rig& stereo, int num_cameras, double aim_mm);
+
 }  // namespace kincal
 
 #endif  // KINCAL_SYNTH_RIG_PLACEMENT_H_

@@ -1,9 +1,11 @@
 #include "vision/stereo_images.h"
 
+#include <algorithm>
 #include <exception>
 #include <opencv2/imgcodecs.hpp>
 #include <sstream>
 #include <thread>
+#include <vector>
 
 #include "data/error.h"
 
@@ -26,17 +28,27 @@ cv::Mat ReadCameraImage(const std::string& path, const CameraIntrinsics& cam) {
 }
 
 void ForBothCameras(const std::function<void(int camera)>& work) {
-  std::string error[2];
-  auto guarded = [&](int c) {
-    try {
-      work(c);
-    } catch (const std::exception& e) {
-      error[c] = e.what();
+  ForEachCamera(2, work);
+}
+
+void ForEachCamera(int n, const std::function<void(int camera)>& work) {
+  std::vector<std::string> error(std::max(n, 0));
+  auto guarded = [&](int first) {
+    for (int c = first; c < n; c += 2) {
+      try {
+        work(c);
+      } catch (const std::exception& e) {
+        error[c] = e.what();
+      }
     }
   };
-  std::thread second(guarded, 1);
-  guarded(0);
-  second.join();
+  if (n > 1) {
+    std::thread second(guarded, 1);
+    guarded(0);
+    second.join();
+  } else {
+    guarded(0);
+  }
   for (const std::string& e : error) {
     if (!e.empty()) throw InputError(e);
   }

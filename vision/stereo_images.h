@@ -1,8 +1,8 @@
 #ifndef KINCAL_VISION_STEREO_IMAGES_H_
 #define KINCAL_VISION_STEREO_IMAGES_H_
 
-// Reading a recorded stereo pair for tag detection: each image checked
-// against its camera in the rig, and both cameras worked on at once.
+// Reading a recorded frame for tag detection: each image checked against
+// its camera in the rig, and the cameras worked on two at once.
 
 #include <functional>
 #include <opencv2/core.hpp>
@@ -19,6 +19,12 @@ cv::Mat ReadCameraImage(const std::string& path, const CameraIntrinsics& cam);
 // Runs work(0) and work(1) on two threads. An exception in either is
 // carried back and thrown here as InputError (the first camera's first).
 void ForBothCameras(const std::function<void(int camera)>& work);
+
+// Runs work(c) for c = 0..n-1 on two threads (even cameras on this one, odd
+// on the other; 2 at a time is what a tag detector's memory bandwidth
+// rewards). An exception is carried back and thrown here as InputError (the
+// lowest camera's first).
+void ForEachCamera(int n, const std::function<void(int camera)>& work);
 
 }  // namespace kincal
 

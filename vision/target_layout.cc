@@ -714,23 +714,26 @@ PivotTipResult MeasurePivotTip(const Rig& rig, const TargetLayoutResult& layout,
 std::vector<LayoutFrame> DetectSessionTags(
     const Session& session, const Rig& rig, const AprilTagOptions& detector,
     const std::function<void(int, int)>& progress) {
-  if (rig.cameras.size() != 2) {
-    throw InputError("a recorded session has two cameras; the rig has " +
-                     std::to_string(rig.cameras.size()));
+  const int nc = static_cast<int>(rig.cameras.size());
+  if (session.cameras.size() != rig.cameras.size()) {
+    throw InputError(session.dir + ": the session has " +
+                     std::to_string(session.cameras.size()) +
+                     " cameras, the rig " + std::to_string(nc));
   }
   detector.Check();
-  AprilTagDetector detectors[2] = {AprilTagDetector(detector),
-                                   AprilTagDetector(detector)};
+  std::vector<std::unique_ptr<AprilTagDetector>> detectors;
+  for (int c = 0; c < nc; ++c) {
+    detectors.push_back(std::make_unique<AprilTagDetector>(detector));
+  }
   std::vector<LayoutFrame> frames;
   const int total = static_cast<int>(session.frames.size());
   for (const SessionFrame& sf : session.frames) {
     LayoutFrame f;
     f.frame = sf.frame;
-    f.detections.resize(2);
-    const std::string* files[2] = {&sf.left_image, &sf.right_image};
-    ForBothCameras([&](int c) {
-      f.detections[c] = detectors[c].Detect(
-          ReadCameraImage(*files[c], rig.cameras[c].intrinsics));
+    f.detections.resize(nc);
+    ForEachCamera(nc, [&](int c) {
+      f.detections[c] = detectors[c]->Detect(
+          ReadCameraImage(sf.images[c], rig.cameras[c].intrinsics));
     });
     frames.push_back(std::move(f));
     if (progress) progress(static_cast<int>(frames.size()), total);

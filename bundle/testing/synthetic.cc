@@ -73,8 +73,10 @@ SyntheticBundle MakeSyntheticBundle(const Robot& nominal,
   const SimulatedSession sim = Simulate(nominal, so);
   s.truth = sim.truth;
   const Rigid3 tip_from_tool = TipFromTool(s.target);
+  double distance = 0.0;
   s.rig_from_base = PlaceRigFacingTips(sim.base_from_tip, s.rig, tip_from_tool,
-                                       /*in_view=*/1.0);
+                                       /*in_view=*/1.0, &distance);
+  s.rig = RigWithCameras(s.rig, o.cameras, distance);
   // flange_from_tool = flange_from_tip * tip_from_tool, where flange_from_tip
   // is the truth's tool row.
   const Chain truth = Chain::FromRobot(s.truth);

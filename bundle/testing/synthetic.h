@@ -33,6 +33,9 @@ struct SyntheticBundleOptions {
   std::vector<Effect> effects;
   double tag_size_mm = 30.0;
   int width = 1280, height = 1024;
+  // Cameras on the stand: 1, 2 (the example stereo rig) or 3
+  // (synth/rig_placement.h, RigWithCameras).
+  int cameras = 2;
 };
 
 struct SyntheticBundle {

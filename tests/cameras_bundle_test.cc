@@ -1,0 +1,114 @@
+// `kincal bundle` end to end with one, two and three cameras on a stand
+// (format v3): sessions rendered by `simulate --render --render-cameras N`
+// with a hidden true robot (same seed: same truth and poses), each bundle
+// judged on noise-free true tips at fresh poses (`kincal evaluate`), the
+// one- and three-camera figures against the stereo one on the same poses.
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "tests/testing/paths.h"
+#include "tests/testing/run.h"
+
+namespace kincal::testing {
+namespace {
+
+std::string Bh7() { return SourceDir() + "/data/robots/bh7.yaml"; }
+
+// Rows `skip`.. of an observations.csv (the first `skip` poses are the
+// rendered ones; the rest are fresh poses of the same true robot).
+void KeepRowsFrom(const std::string& in, const std::string& out, int skip) {
+  std::ifstream f(in);
+  std::ostringstream os;
+  std::string line;
+  int row = -1;
+  while (std::getline(f, line)) {
+    if (!line.empty() && line[0] == '#') continue;
+    if (row < 0 || row >= skip) os << line << "\n";
+    ++row;
+  }
+  std::ofstream(out) << os.str();
+}
+
+double EvaluateRms(const std::string& robot, const std::string& obs) {
+  const RunResult r =
+      RunKincal("evaluate --robot " + robot + " --obs " + obs + " --json");
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  return nlohmann::json::parse(r.out)["rms_mm"].get<double>();
+}
+
+constexpr int kPoses = 120;
+constexpr int kSeed = 7;
+
+// Renders the session with `cameras` cameras, bundles it, and returns the
+// bundle's RMS error at the fresh poses (mm); `json` receives its output.
+double BundleAtFreshPoses(const std::string& dir, int cameras,
+                          nlohmann::json* json, const std::string& extra = "",
+                          const std::string& bundle_extra = "") {
+  const std::string s = dir + "/s" + std::to_string(cameras);
+  RunResult r = RunKincal(
+      "simulate --robot " + Bh7() + " --out " + s + " --poses " +
+      std::to_string(kPoses) + " --noise 0 --seed " + std::to_string(kSeed) +
+      " --render --render-noise 1.5 --render-blur 0.5 --render-width 640 "
+      "--render-height 512 --render-cameras " +
+      std::to_string(cameras) + " " + extra);
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  r = RunKincal("bundle --robot " + s + "/robot.yaml --rig " + s +
+                "/rig.yaml --target " + s + "/target.yaml --session " + s +
+                "/session --quiet --out " + s + "/bcal.yaml --json " +
+                bundle_extra);
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  if (r.exit_code != 0) return NAN;
+  *json = nlohmann::json::parse(r.out);
+  const std::string fresh = dir + "/fresh.csv";
+  if (!Exists(fresh)) {
+    r = RunKincal("simulate --robot " + Bh7() + " --out " + dir +
+                  "/fresh --poses " + std::to_string(kPoses + 200) +
+                  " --noise 0 --seed " + std::to_string(kSeed));
+    EXPECT_EQ(r.exit_code, 0) << r.err;
+    KeepRowsFrom(dir + "/fresh/observations.csv", fresh, kPoses);
+  }
+  return EvaluateRms(s + "/bcal.yaml", fresh);
+}
+
+TEST(CamerasBundle, OneAndThreeCamerasWithinTwiceStereoAtFreshPoses) {
+  const std::string dir = MakeTempDir("cameras_bundle");
+  nlohmann::json j1, j2, j3;
+  const double stereo = BundleAtFreshPoses(dir, 2, &j2);
+  const double mono = BundleAtFreshPoses(dir, 1, &j1);
+  const double three = BundleAtFreshPoses(dir, 3, &j3);
+  std::printf(
+      "fresh true tips: 1 camera %.4f mm, 2 cameras %.4f mm, 3 cameras %.4f "
+      "mm\n",
+      mono, stereo, three);
+  EXPECT_LE(mono, 0.10);
+  EXPECT_LE(three, 0.10);
+  EXPECT_LE(mono, 2 * stereo);
+  EXPECT_LE(three, 2 * stereo);
+  EXPECT_EQ(j1["cameras"], 1);
+  EXPECT_EQ(j3["cameras"], 3);
+  // One camera: the held-out tips are one-camera tips, compared all the
+  // same (a one-camera rig has no better ones).
+  EXPECT_GT(j1["heldout_tips"].get<int>(), 0);
+}
+
+TEST(CamerasBundle, OneCameraNamesAHiddenBacklash) {
+  const std::string dir = MakeTempDir("cameras_bundle_bl");
+  nlohmann::json j;
+  BundleAtFreshPoses(dir, 1, &j, "--effect backlash:j3:0.05",
+                     "--extensions backlash");
+  ASSERT_EQ(j["findings"].size(), 1u) << j["extensions"].dump();
+  EXPECT_EQ(j["findings"][0]["cause"], "backlash");
+  EXPECT_EQ(j["findings"][0]["joint"], "j3");
+  const auto ci = j["findings"][0]["ci95"];
+  EXPECT_LT(ci[0].get<double>(), 0.05);
+  EXPECT_GT(ci[1].get<double>(), 0.05);
+}
+
+}  // namespace
+}  // namespace kincal::testing
