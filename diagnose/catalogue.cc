@@ -57,8 +57,8 @@ double RowLength(const Chain& chain, int row) {
 
 const std::vector<std::string>& CatalogueCauses() {
   static const std::vector<std::string> causes = {
-      "backlash",         "compliance",  "cyclic",       "gain",
-      "axis_tilt",        "drift",       "elastostatic", "thermal",
+      "backlash",         "compliance",   "cyclic",       "gain",
+      "axis_tilt",        "drift",        "elastostatic", "thermal",
       "mount_compliance", "transmission", "gravity"};
   return causes;
 }
@@ -346,8 +346,7 @@ Magnitude CandidateMagnitude(const Candidate& c, const ModelState& state,
     m.unit = "deg";
     m.value = v[0] * kRadToDeg;
     grad[0] = kRadToDeg;
-  } else if (TransmissionTerms(c.cause) > 0 &&
-             chain.rows[c.joint].periodic()) {
+  } else if (TransmissionTerms(c.cause) > 0 && chain.rows[c.joint].periodic()) {
     // RMS of the periodic error over the readings its basis was built on
     // (diagnose/periodic_basis.h: the functions are orthonormal there): |c|.
     m.unit = "deg";

@@ -15,10 +15,11 @@
 //   gravity torque of the link masses), thermal (growth of a row's lengths
 //   with temp_c or time), mount_compliance (base tilt under the arm's
 //   gravity moment), gravity (mount_compliance and the elastostatic
-//   deflection of every joint together, one candidate), transmission (a joint error that varies along the
-//   joint's travel: on revolute joints a regularised periodic function of
-//   the angle over the whole revolution, diagnose/periodic_basis.h; on
-//   prismatic joints a sine series over the travel of the data).
+//   deflection of every joint together, one candidate), transmission (a joint
+//   error that varies along the joint's travel: on revolute joints a
+//   regularised periodic function of the angle over the whole revolution,
+//   diagnose/periodic_basis.h; on prismatic joints a sine series over the
+//   travel of the data).
 
 #include <string>
 #include <vector>

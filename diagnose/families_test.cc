@@ -289,8 +289,7 @@ TEST(FamiliesTest, PeriodicTransmissionPredictsOutsideTheTravel) {
        "elbow_joint",
        {{"lo", -180.0}, {"hi", 180.0}, {"a1", 0.03}, {"b3", 0.02}}});
   const Chain chain = Chain::FromRobot(truth);
-  const std::vector<PoseInput> inputs =
-      MakePoseInputs(chain, s.observations);
+  const std::vector<PoseInput> inputs = MakePoseInputs(chain, s.observations);
   const Eigen::AngleAxisd rot(
       Eigen::Vector3d(s.meas_from_base[0], s.meas_from_base[1],
                       s.meas_from_base[2])
@@ -331,8 +330,8 @@ TEST(FamiliesTest, PeriodicTransmissionPredictsOutsideTheTravel) {
   EXPECT_FALSE(f->extrapolated.empty());
   const double extended = Evaluate(r.extended, test).stats.rms_mm;
   const double plain = Evaluate(g.extended, test).stats.rms_mm;
-  std::printf("outside the travel: geometry %.4f mm, periodic %.4f mm\n",
-              plain, extended);
+  std::printf("outside the travel: geometry %.4f mm, periodic %.4f mm\n", plain,
+              extended);
   EXPECT_GT(plain, 0.1);
   EXPECT_LT(extended, 0.6 * plain);
 }

@@ -666,7 +666,8 @@ int SelectWinner(const Selection& selection,
   };
   bool any_gravity = false;
   for (const CandidateFit& f : fits)
-    any_gravity = any_gravity || (f.score.significant && gravity(f.score.cause));
+    any_gravity =
+        any_gravity || (f.score.significant && gravity(f.score.cause));
   if (any_gravity && !only_gravity && step > 0) {
     std::vector<CandidateFit> physical = fits;
     for (CandidateFit& f : physical)
@@ -974,10 +975,9 @@ void PeriodicSupportOf(const Problem& problem, const ModelState& final_state,
     for (const auto& arc : f.extrapolated) {
       for (double x = arc[0] / kRadToDeg; x <= arc[1] / kRadToDeg;
            x += kStepRad) {
-        f.extrapolated_peak =
-            std::max(f.extrapolated_peak,
-                     std::abs(TransmissionError(coef, x, row) - mean) *
-                         kRadToDeg);
+        f.extrapolated_peak = std::max(
+            f.extrapolated_peak,
+            std::abs(TransmissionError(coef, x, row) - mean) * kRadToDeg);
       }
     }
   }
@@ -1072,8 +1072,7 @@ DiagnosisResult DiagnoseModel(const Robot& nominal, const Observations& obs,
     // The cause label carries the series length (transmission8, ...); a
     // periodic series is held in its gaps by its regulariser and says where
     // it extrapolates (Finding::extrapolated) instead.
-    if (f.cause.rfind("transmission", 0) != 0 || j < 0 || f.periodic)
-      continue;
+    if (f.cause.rfind("transmission", 0) != 0 || j < 0 || f.periodic) continue;
     series_joints.push_back(f.joint);
     units.push_back(nominal.joints[j].type == JointType::kPrismatic ? "mm"
                                                                     : "deg");
