@@ -1,8 +1,8 @@
 // kincal evaluate: fit only the base-to-measuring-frame transform, then report
 // the position error of a (calibrated) robot model on new data.
 
-#include <cmath>
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <memory>
 #include <sstream>
@@ -115,9 +115,9 @@ void PrintSeries(const EvaluateResult& r) {
 void WarnTemperatureClamped(const Robot& robot, const Observations& obs,
                             Warnings* warnings) {
   const FitRecord& rec = robot.fitted_on;
-  const bool thermal = std::any_of(
-      robot.extensions.begin(), robot.extensions.end(),
-      [](const Extension& e) { return e.cause == "thermal"; });
+  const bool thermal =
+      std::any_of(robot.extensions.begin(), robot.extensions.end(),
+                  [](const Extension& e) { return e.cause == "thermal"; });
   if (!thermal || rec.thermal_input != "temp_c" ||
       !(rec.temp_lo_c == rec.temp_lo_c))
     return;

@@ -86,8 +86,8 @@ class FrameCost {
     const int nj = chain_->num_joints();
     T q[kMaxJoints];
     for (int j = 0; j < nj; ++j) {
-      q[j] = ModelJointValue<T>(chain_->rows[j], input_->q[j],
-                                input_->s[j], input_->tau[j],
+      q[j] = ModelJointValue<T>(chain_->rows[j], input_->q[j], input_->s[j],
+                                input_->tau[j],
                                 with_errors_ ? p[nj + 2 + j] : nullptr);
     }
     Mat4<T> m = Mat4<T>::Identity();

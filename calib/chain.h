@@ -444,10 +444,10 @@ T ModelJointValueTrig(const ChainRow& row, double q_read, double s, double tau,
                       const T* err, double tau_mass, const double* trig,
                       const double* transmission_sines = nullptr) {
   if (err == nullptr) return T(q_read);
-  T q = (T(1) + err[kGain]) * q_read - T(0.5 * s) * err[kBacklash] +
-        err[kCompliance] * tau + err[kElastostatic] * tau_mass +
-        TransmissionError(err + kTransmission0, q_read, row,
-                          transmission_sines);
+  T q =
+      (T(1) + err[kGain]) * q_read - T(0.5 * s) * err[kBacklash] +
+      err[kCompliance] * tau + err[kElastostatic] * tau_mass +
+      TransmissionError(err + kTransmission0, q_read, row, transmission_sines);
   if (row.type == JointType::kRevolute) {
     for (int h = 1; h <= kMaxHarmonic; ++h) {
       const int k = CyclicCosIndex(h);
@@ -614,8 +614,7 @@ Vec3<T> TipInBase(const Chain& chain, const T* const* rows,
       for (int k = 0; k < kRowBlockSize; ++k) buf[r][k] = rows[r][k];
       if (r < chain.num_joints()) {
         ScaleRowLengths(chain.convention,
-                        T(1) + joint_errors[r][kThermal] * thermal_x,
-                        buf[r]);
+                        T(1) + joint_errors[r][kThermal] * thermal_x, buf[r]);
       }
       scaled[r] = buf[r];
     }

@@ -198,11 +198,10 @@ void ComputeJointValues(const Chain& chain, const PoseInput& in,
                            : nullptr;
     if (!hooks.need_dq[j]) {
       const double* e = chain.joint_errors[j].data();
-      out->q[j] =
-          trig ? ModelJointValueTrig<double>(row, in.q[j], in.s[j], in.tau[j],
-                                             e, tm, tr, ts)
-               : ModelJointValue<double>(row, in.q[j], in.s[j], in.tau[j], e,
-                                         tm);
+      out->q[j] = trig ? ModelJointValueTrig<double>(row, in.q[j], in.s[j],
+                                                     in.tau[j], e, tm, tr, ts)
+                       : ModelJointValue<double>(row, in.q[j], in.s[j],
+                                                 in.tau[j], e, tm);
       continue;
     }
     const std::vector<int>& f = hooks.free_entries[j];

@@ -106,8 +106,7 @@ FitRecord MakeFitRecord(const FitRecordInput& input) {
     // (calib/chain.h FourierBasis), so their covariance has no name there.
     const bool periodic_coefficient =
         q.kind == ParamKind::kJointError && q.index >= kTransmission0 &&
-        input.state != nullptr &&
-        input.state->chain.rows[q.block].periodic();
+        input.state != nullptr && input.state->chain.rows[q.block].periodic();
     if (q.kind != ParamKind::kPoint && !periodic_coefficient) {
       keep.push_back(static_cast<int>(k));
     }

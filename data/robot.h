@@ -3,10 +3,10 @@
 
 #include <Eigen/Core>
 #include <array>
-#include <utility>
 #include <limits>
 #include <map>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace kincal {

@@ -57,8 +57,8 @@ double RowLength(const Chain& chain, int row) {
 
 const std::vector<std::string>& CatalogueCauses() {
   static const std::vector<std::string> causes = {
-      "backlash",         "compliance",  "cyclic",       "gain",
-      "axis_tilt",        "drift",       "elastostatic", "thermal",
+      "backlash",         "compliance",   "cyclic",       "gain",
+      "axis_tilt",        "drift",        "elastostatic", "thermal",
       "mount_compliance", "transmission", "gravity"};
   return causes;
 }
@@ -116,7 +116,11 @@ void SetTransmissionTravel(const std::vector<Measurement>& ms, Chain* chain,
     if (!(hi > lo)) continue;
     row.transmission_lo = lo;
     row.transmission_hi = hi;
-    if (row.type == JointType::kRevolute && !row.periodic())
+    // Readings over more than one turn test whether the error repeats
+    // every turn (a gear train whose ratio is not whole does not): there
+    // the series along the travel is fitted, which can take either.
+    if (row.type == JointType::kRevolute && !row.periodic() &&
+        hi - lo < 2 * M_PI)
       row.periodic_basis = MakePeriodicBasis(q, periodic).basis;
   }
 }
@@ -342,8 +346,7 @@ Magnitude CandidateMagnitude(const Candidate& c, const ModelState& state,
     m.unit = "deg";
     m.value = v[0] * kRadToDeg;
     grad[0] = kRadToDeg;
-  } else if (TransmissionTerms(c.cause) > 0 &&
-             chain.rows[c.joint].periodic()) {
+  } else if (TransmissionTerms(c.cause) > 0 && chain.rows[c.joint].periodic()) {
     // RMS of the periodic error over the readings its basis was built on
     // (diagnose/periodic_basis.h: the functions are orthonormal there): |c|.
     m.unit = "deg";

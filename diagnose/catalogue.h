@@ -15,10 +15,11 @@
 //   gravity torque of the link masses), thermal (growth of a row's lengths
 //   with temp_c or time), mount_compliance (base tilt under the arm's
 //   gravity moment), gravity (mount_compliance and the elastostatic
-//   deflection of every joint together, one candidate), transmission (a joint error that varies along the
-//   joint's travel: on revolute joints a regularised periodic function of
-//   the angle over the whole revolution, diagnose/periodic_basis.h; on
-//   prismatic joints a sine series over the travel of the data).
+//   deflection of every joint together, one candidate), transmission (a joint
+//   error that varies along the joint's travel: on revolute joints a
+//   regularised periodic function of the angle over the whole revolution,
+//   diagnose/periodic_basis.h; on prismatic joints a sine series over the
+//   travel of the data).
 
 #include <string>
 #include <vector>
@@ -52,9 +53,10 @@ std::string SpecCauseName(const std::string& cause);
 // Sets the travel of every moving joint whose chain row has none
 // (ChainRow::transmission_lo/hi) to the range of its readings in
 // `measurements`: the interval the transmission family's series lives on.
-// Revolute joints also get their periodic basis from the readings
-// (diagnose/periodic_basis.h): their transmission is a function of the angle
-// over the whole revolution; prismatic joints keep the sine series.
+// Revolute joints whose readings span less than one turn also get their
+// periodic basis from the readings (diagnose/periodic_basis.h): their
+// transmission is a function of the angle over the whole revolution;
+// prismatic joints and readings over more than a turn keep the sine series.
 void SetTransmissionTravel(const std::vector<Measurement>& measurements,
                            Chain* chain,
                            const PeriodicBasisOptions& periodic = {});

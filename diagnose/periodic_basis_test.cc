@@ -101,8 +101,8 @@ TEST(PeriodicBasisTest, RegulariserHoldsInGapsAndBeyondTheTravel) {
     for (const auto& arc : arcs) {
       const Eigen::MatrixXd off =
           Functions(b, Readings(arc[0], arc[1], 200)).leftCols(terms);
-      peak_off = std::max(peak_off,
-                          ((off * c).array() + offset).abs().maxCoeff());
+      peak_off =
+          std::max(peak_off, ((off * c).array() + offset).abs().maxCoeff());
     }
     SCOPED_TRACE(terms);
     EXPECT_LT(peak_off, 2.0 * peak_on)

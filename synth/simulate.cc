@@ -54,8 +54,8 @@ Vec3<Jet> TipJet(const Chain& chain, const PoseInput& in, const Jet* q_read) {
       q[j] += Jet(e[kElastostatic] * in.tau_mass[j]);
     // Its value only: d/dq of the small transmission error is left out of
     // the IK's Jacobian (Newton still converges on the error's value).
-    q[j] += Jet(TransmissionError(&e[kTransmission0], q_read[j].a,
-                                  chain.rows[j]));
+    q[j] +=
+        Jet(TransmissionError(&e[kTransmission0], q_read[j].a, chain.rows[j]));
     if (chain.rows[j].type == JointType::kRevolute) {
       for (int h = 1; h <= kMaxHarmonic; ++h) {
         const int k = CyclicCosIndex(h);
@@ -332,9 +332,9 @@ std::vector<Eigen::Matrix4d> TrueTipPoses(
   for (const PoseInput& in : inputs) {
     std::vector<double> q(n);
     for (int j = 0; j < n; ++j) {
-      q[j] = ModelJointValue<double>(
-          truth.rows[j], in.q[j], in.s[j], in.tau[j],
-          truth.joint_errors[j].data(), in.tau_mass[j]);
+      q[j] =
+          ModelJointValue<double>(truth.rows[j], in.q[j], in.s[j], in.tau[j],
+                                  truth.joint_errors[j].data(), in.tau_mass[j]);
     }
     Eigen::Matrix4d m = BaseFromTipAt(truth, q);
     for (int k = 0; k < 3; ++k) m(k, 3) += truth.drift[k] * in.t_h;
