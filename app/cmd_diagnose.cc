@@ -164,6 +164,21 @@ int RunModel(const ModelArgs& args) {
       std::printf("    %d-fold cross-validated RMS %.4f -> %.4f mm\n", r.folds,
                   f.cv_rms_before_mm, f.cv_rms_after_mm);
     }
+    if (f.periodic) {
+      std::string arcs;
+      for (const auto& a : f.extrapolated) {
+        char buf[64];
+        std::snprintf(buf, sizeof buf, "%s%.1f..%.1f", arcs.empty() ? "" : ", ",
+                      a[0], a[1]);
+        arcs += buf;
+      }
+      std::printf(
+          "    periodic over the revolution: amplitude %.4f deg, supported by "
+          "the travel [%.1f, %.1f] deg; extrapolated at %s deg (largest "
+          "value there %.4f deg)\n",
+          f.amplitude, f.travel_lo, f.travel_hi,
+          arcs.empty() ? "no angle" : arcs.c_str(), f.extrapolated_peak);
+    }
     for (const Equivalent& e : f.equivalent) {
       std::printf("    equivalent on this data: %s %s %.5g %s\n",
                   e.cause.c_str(), FormatJoint(e.joint).c_str(), e.magnitude,
@@ -294,7 +309,7 @@ void AddDiagnoseCommand(CLI::App& app, Runner* run) {
       "model",
       "Fit geometry, test the catalogue of causes (backlash, compliance, "
       "cyclic, gain, axis_tilt, drift, elastostatic, thermal, "
-      "mount_compliance, transmission) against held-out poses, report "
+      "mount_compliance, transmission, gravity) against held-out poses, report "
       "findings");
   AddRobotOptions(model, &margs->robot, &margs->root, &margs->tip,
                   "robot.yaml or .urdf")

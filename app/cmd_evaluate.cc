@@ -2,6 +2,7 @@
 // the position error of a (calibrated) robot model on new data.
 
 #include <cmath>
+#include <algorithm>
 #include <cstdio>
 #include <memory>
 #include <sstream>
@@ -108,12 +109,46 @@ void PrintSeries(const EvaluateResult& r) {
   }
 }
 
+// The thermal terms hold at the temperatures they were fitted on
+// (calib/chain.h Chain::thermal_lo/hi): rows beyond are evaluated with the
+// input clamped, and the warning says so.
+void WarnTemperatureClamped(const Robot& robot, const Observations& obs,
+                            Warnings* warnings) {
+  const FitRecord& rec = robot.fitted_on;
+  const bool thermal = std::any_of(
+      robot.extensions.begin(), robot.extensions.end(),
+      [](const Extension& e) { return e.cause == "thermal"; });
+  if (!thermal || rec.thermal_input != "temp_c" ||
+      !(rec.temp_lo_c == rec.temp_lo_c))
+    return;
+  int outside = 0;
+  double lo = rec.temp_lo_c, hi = rec.temp_hi_c;
+  for (const Observation& o : obs.rows) {
+    if (!o.HasTemp() ||
+        (o.temp_c >= rec.temp_lo_c && o.temp_c <= rec.temp_hi_c))
+      continue;
+    ++outside;
+    lo = std::min(lo, o.temp_c);
+    hi = std::max(hi, o.temp_c);
+  }
+  if (outside == 0) return;
+  char msg[400];
+  std::snprintf(msg, sizeof msg,
+                "%d rows have temp_c outside the range the thermal terms were "
+                "fitted on [%.2f, %.2f] C (these rows: %.2f .. %.2f C): the "
+                "model holds the thermal input at the range's ends there "
+                "instead of extrapolating the growth linearly",
+                outside, rec.temp_lo_c, rec.temp_hi_c, lo, hi);
+  warnings->Add("temperature_clamped", msg);
+}
+
 int RunEvaluate(const EvaluateArgs& args) {
   const Robot robot = ReadRobot(args.robot, args.root, args.tip);
   Warnings warnings = CommandWarnings();
   const Observations obs =
       ReadCheckedObservations(args.obs, robot, args.robot, &warnings);
   const EvaluateResult r = Evaluate(robot, obs, args.outlier_sigmas);
+  WarnTemperatureClamped(robot, obs, &warnings);
   if (!args.residuals.empty()) WriteResiduals(args.residuals, obs, r);
   const bool labelled = obs.AnySeriesLabel();
   if (args.json) {

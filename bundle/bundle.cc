@@ -86,7 +86,7 @@ class FrameCost {
     const int nj = chain_->num_joints();
     T q[kMaxJoints];
     for (int j = 0; j < nj; ++j) {
-      q[j] = ModelJointValue<T>(chain_->rows[j].type, input_->q[j],
+      q[j] = ModelJointValue<T>(chain_->rows[j], input_->q[j],
                                 input_->s[j], input_->tau[j],
                                 with_errors_ ? p[nj + 2 + j] : nullptr);
     }
@@ -348,7 +348,7 @@ Rigid3 BaseFromFlange(const Chain& chain, const PoseInput& in,
   Mat4<double> m = Mat4<double>::Identity();
   for (int j = 0; j < nj; ++j) {
     const double q = ModelJointValue<double>(
-        chain.rows[j].type, in.q[j], in.s[j], in.tau[j],
+        chain.rows[j], in.q[j], in.s[j], in.tau[j],
         with_errors ? chain.joint_errors[j].data() : nullptr);
     m = m * RowTransform(chain.convention, chain.rows[j],
                          chain.rows[j].p.data(), q);

@@ -47,6 +47,13 @@ Chain Chain::FromRobot(const Robot& robot) {
   c.name = robot.name;
   c.convention = robot.convention;
   c.gravity = robot.gravity.normalized();
+  // The thermal terms hold at the temperatures they were fitted on.
+  const FitRecord& rec = robot.fitted_on;
+  if (rec.thermal_input == "temp_c" && rec.temp_lo_c == rec.temp_lo_c &&
+      rec.temp_hi_c >= rec.temp_lo_c) {
+    c.thermal_lo = rec.temp_lo_c - 20.0;
+    c.thermal_hi = rec.temp_hi_c - 20.0;
+  }
   for (const RobotRow& r : robot.joints) {
     ChainRow row;
     row.name = r.name;
@@ -97,12 +104,28 @@ Chain Chain::FromRobot(const Robot& robot) {
       err[kElastostatic] = e.values.at("per_knm") * unit / 1000.0;
     if (e.cause == "thermal") err[kThermal] = e.values.at("rate");
     if (e.cause == "transmission") {
-      // lo, hi: the travel (deg | mm); s1 .. s24: sine coefficients.
+      // lo, hi: the travel (deg | mm); s1 .. s24: sine coefficients over
+      // it; or a1 .. a32, b1 .. b32: Fourier coefficients (deg) of a
+      // periodic error over the revolution (FourierBasis).
       c.rows[j].transmission_lo = e.values.at("lo") * unit;
       c.rows[j].transmission_hi = e.values.at("hi") * unit;
       for (int k = 0; k < kMaxTransmissionTerms; ++k) {
         const auto it = e.values.find("s" + std::to_string(k + 1));
         if (it != e.values.end()) err[kTransmission0 + k] = it->second * unit;
+      }
+      std::vector<double> fourier(kPeriodicTerms, 0.0);
+      bool periodic = false;
+      for (int h = 1; h <= kPeriodicHarmonics; ++h) {
+        const auto a = e.values.find("a" + std::to_string(h));
+        const auto b = e.values.find("b" + std::to_string(h));
+        if (a != e.values.end()) fourier[2 * h - 2] = a->second * unit;
+        if (b != e.values.end()) fourier[2 * h - 1] = b->second * unit;
+        periodic = periodic || a != e.values.end() || b != e.values.end();
+      }
+      if (periodic) {
+        c.rows[j].periodic_basis = FourierBasis(fourier);
+        std::fill(err.begin() + kTransmission0, err.end(), 0.0);
+        err[kTransmission0] = 1.0;
       }
     }
     if (e.cause == "cyclic") {
@@ -167,7 +190,15 @@ Robot Chain::ToRobot(const Robot& description) const {
     if (err[kThermal] != 0.0)
       robot.extensions.push_back({"thermal", name, {{"rate", err[kThermal]}}});
     Extension transmission{"transmission", name, {}};
-    for (int k = 0; k < kMaxTransmissionTerms; ++k) {
+    if (rows[j].periodic()) {
+      const std::vector<double> f = PeriodicCoefficients(rows[j], err);
+      for (int h = 1; h <= kPeriodicHarmonics; ++h) {
+        if (f[2 * h - 2] == 0.0 && f[2 * h - 1] == 0.0) continue;
+        transmission.values["a" + std::to_string(h)] = f[2 * h - 2] / unit;
+        transmission.values["b" + std::to_string(h)] = f[2 * h - 1] / unit;
+      }
+    }
+    for (int k = 0; k < kMaxTransmissionTerms && !rows[j].periodic(); ++k) {
       if (err[kTransmission0 + k] == 0.0) continue;
       transmission.values["s" + std::to_string(k + 1)] =
           err[kTransmission0 + k] / unit;
@@ -195,11 +226,33 @@ Robot Chain::ToRobot(const Robot& description) const {
   return robot;
 }
 
+std::vector<double> FourierBasis(const std::vector<double>& fourier) {
+  KINCAL_CHECK(static_cast<int>(fourier.size()) == kPeriodicTerms,
+               "Fourier coefficients: " << fourier.size());
+  std::vector<double> b(kPeriodicTerms * kMaxTransmissionTerms, 0.0);
+  std::copy(fourier.begin(), fourier.end(), b.begin());
+  return b;
+}
+
+std::vector<double> PeriodicCoefficients(const ChainRow& row,
+                                         const JointErrorBlock& err) {
+  std::vector<double> f(kPeriodicTerms, 0.0);
+  if (!row.periodic()) return f;
+  for (int k = 0; k < kMaxTransmissionTerms; ++k) {
+    const double c = err[kTransmission0 + k];
+    if (c == 0.0) continue;
+    for (int t = 0; t < kPeriodicTerms; ++t)
+      f[t] += row.periodic_basis[kPeriodicTerms * k + t] * c;
+  }
+  return f;
+}
+
 void FillTransmissionSines(const Chain& chain, PoseInput* in) {
   const int n = chain.num_joints();
   bool any = false;
   for (int j = 0; j < n; ++j)
-    any = any || chain.rows[j].transmission_hi > chain.rows[j].transmission_lo;
+    any = any || chain.rows[j].periodic() ||
+          chain.rows[j].transmission_hi > chain.rows[j].transmission_lo;
   in->transmission_sines.clear();
   if (!any) return;
   in->transmission_sines.assign(kMaxTransmissionTerms * n, 0.0);
@@ -209,8 +262,7 @@ void FillTransmissionSines(const Chain& chain, PoseInput* in) {
       double unit[kMaxTransmissionTerms] = {};
       unit[k] = 1.0;
       in->transmission_sines[kMaxTransmissionTerms * j + k] =
-          TransmissionError(unit, in->q[j], chain.rows[j].transmission_lo,
-                            chain.rows[j].transmission_hi);
+          TransmissionError(unit, in->q[j], chain.rows[j]);
     }
   }
 }
@@ -266,10 +318,9 @@ std::vector<double> ModelJointValues(const Chain& chain, const PoseInput& in) {
   std::vector<double> q(n);
   for (int j = 0; j < n; ++j) {
     const ChainRow& row = chain.rows[j];
-    q[j] = ModelJointValue<double>(row.type, in.q[j], in.s[j], in.tau[j],
+    q[j] = ModelJointValue<double>(row, in.q[j], in.s[j], in.tau[j],
                                    chain.joint_errors[j].data(),
-                                   masses ? in.tau_mass[j] : 0.0,
-                                   row.transmission_lo, row.transmission_hi);
+                                   masses ? in.tau_mass[j] : 0.0);
   }
   return q;
 }

@@ -11,6 +11,7 @@
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <limits>
@@ -53,9 +54,14 @@ constexpr int kRowBlockSize = 6;
 //    gravity torque of the link masses about the joint), thermal (relative
 //    growth of the row's lengths per unit of the thermal input: per K when
 //    the data have temp_c, else per hour), transmission_1 ..
-//    transmission_24 (rad|mm, sine series of the joint error over the
-//    joint's travel, see TransmissionError)]
+//    transmission_24 (rad|mm, coefficients of the joint error's periodic
+//    basis or of its sine series over the travel, see TransmissionError)]
 constexpr int kMaxTransmissionTerms = 24;
+// Harmonics of the periodic transmission's Fourier terms (the UR10's gear
+// errors reach 15-25 cycles per revolution, docs/DIAGNOSE.md) and their
+// number (cos, sin per harmonic).
+constexpr int kPeriodicHarmonics = 32;
+constexpr int kPeriodicTerms = 2 * kPeriodicHarmonics;
 constexpr int kJointErrorBlockSize = 11 + kMaxTransmissionTerms;
 enum JointErrorIndex {
   kGain = 0,
@@ -111,8 +117,20 @@ struct ChainRow {
   Eigen::Vector3d com_mm = Eigen::Vector3d::Zero();
   // Travel [lo, hi] of the joint (internal units) over which the
   // transmission family's sine series lives; lo == hi = none. Structure,
-  // not a fitted value: set from the data the map is fitted on.
+  // not a fitted value: set from the data the map is fitted on. With a
+  // periodic basis (below) it is the travel that supports the function.
   double transmission_lo = 0.0, transmission_hi = 0.0;
+  // Periodic transmission (revolute joints): the family's coefficients c_k
+  // weight kMaxTransmissionTerms functions of the read angle over the whole
+  // revolution, phi_k(q) = sum_t B(t, k) f_t(q) with the Fourier terms
+  // f = [cos q, sin q, cos 2q, sin 2q, ..., cos Hq, sin Hq] (H =
+  // kPeriodicHarmonics); B is kPeriodicTerms x kMaxTransmissionTerms,
+  // column-major (empty = the sine series over the travel). Structure, not
+  // fitted: the diagnosis builds it from the readings
+  // (diagnose/periodic_basis.h); a robot file's Fourier coefficients become
+  // one column with c_1 = 1 (FourierBasis).
+  std::vector<double> periodic_basis;
+  bool periodic() const { return !periodic_basis.empty(); }
 };
 
 struct Chain {
@@ -124,6 +142,16 @@ struct Chain {
   std::array<double, kDriftBlockSize> drift{};  // global block (see above)
   double bound_length_mm = 5.0;
   double bound_angle_rad = 5.0 * M_PI / 180.0;
+  // The range of the thermal input (PoseInput::thermal_x) the thermal terms
+  // were fitted on: the model clamps the input to it (a growth measured over
+  // 0.4 K is not extrapolated linearly to 10 K). Unbounded unless a robot
+  // file's fitted_on states it (FromRobot: temp_c - 20 over the fitted
+  // temp_c range).
+  double thermal_lo = -std::numeric_limits<double>::infinity();
+  double thermal_hi = std::numeric_limits<double>::infinity();
+  double ThermalInput(double x) const {
+    return std::min(thermal_hi, std::max(thermal_lo, x));
+  }
 
   int num_joints() const { return static_cast<int>(rows.size()) - 1; }
   int tool_row() const { return num_joints(); }
@@ -165,8 +193,19 @@ struct PoseInput {
   std::vector<double> transmission_sines;
 };
 
-// Fills PoseInput::transmission_sines for `chain`'s travels (clears it when
-// no joint has one). Must be called again when a travel changes.
+// The periodic basis of a function given by its Fourier coefficients
+// (kPeriodicTerms, internal units): F in the first column, zeros elsewhere
+// (its coefficient c_1 = 1).
+std::vector<double> FourierBasis(const std::vector<double>& fourier);
+// A periodic row's transmission as Fourier coefficients B c (internal
+// units, [cos q, sin q, cos 2q, ...], kPeriodicTerms); zeros for a row
+// without a periodic basis.
+std::vector<double> PeriodicCoefficients(const ChainRow& row,
+                                         const JointErrorBlock& err);
+
+// Fills PoseInput::transmission_sines for `chain`'s travels and periodic
+// bases (clears it when no joint has one). Must be called again when a
+// travel or a basis changes.
 void FillTransmissionSines(const Chain& chain, PoseInput* in);
 
 // Builds PoseInputs for the rows of `obs` (in visit order). `s` follows the
@@ -307,21 +346,40 @@ Mat4<T> RowTransform(Convention convention, const ChainRow& row, const T* p,
 
 // Transmission family hook: an angle error that varies along the joint's
 // travel without being a low harmonic of the angle (the kinematic error of a
-// gear train, an encoder's non-linearity), as a sine series over the travel
-// [lo, hi] of the data, without its mean over the travel:
-//   e(q) = sum_k c_k (sin(k pi u) - m_k),  u = (q_read - lo) / (hi - lo),
-//   m_k = (1 - cos(k pi)) / (k pi) (the mean of sin(k pi u) on [0, 1]),
-// for k = 1..24 inside the travel, and 0 outside: the mean error is the
-// geometry's offset, which is also the prediction outside the travel the
-// series was fitted on. RMS over the travel: sqrt(|c|^2 / 2 - (m . c)^2)
-// (the catalogue's magnitude). `c` points at kMaxTransmissionTerms values.
+// gear train, an encoder's non-linearity). Two shapes:
+//  - periodic (ChainRow::periodic_basis, revolute joints): a function of the
+//    angle over the whole revolution, e(q) = sum_k c_k phi_k(q) (see
+//    ChainRow), defined at every angle (a gear's or an encoder's error
+//    repeats every turn); no constant term (that is the geometry's offset);
+//  - sine series over the travel [lo, hi] of the data, without its mean
+//    over the travel:
+//      e(q) = sum_k c_k (sin(k pi u) - m_k),  u = (q_read - lo) / (hi - lo),
+//      m_k = (1 - cos(k pi)) / (k pi) (the mean of sin(k pi u) on [0, 1]),
+//    for k = 1..24 inside the travel, and 0 outside (prismatic joints, and
+//    files that state it). RMS over the travel: sqrt(|c|^2 / 2 - (m . c)^2).
+// `c` points at kMaxTransmissionTerms values; `sines` (optional) at the
+// functions' values at q_read (PoseInput::transmission_sines).
 inline double TransmissionMean(int k) {  // m_k, k = 1..24
   return (k % 2 == 1) ? 2.0 / (k * M_PI) : 0.0;
 }
+// The Fourier terms f_t(q) of the periodic basis (kPeriodicTerms).
+inline void PeriodicTerms(double q, double* f) {
+  const double c1 = std::cos(q), s1 = std::sin(q);
+  double c = c1, s = s1;
+  for (int h = 0; h < kPeriodicHarmonics; ++h) {
+    f[2 * h] = c;
+    f[2 * h + 1] = s;
+    const double cn = c * c1 - s * s1;
+    s = s * c1 + c * s1;
+    c = cn;
+  }
+}
 template <typename T>
-T TransmissionError(const T* c, double q_read, double lo, double hi,
+T TransmissionError(const T* c, double q_read, const ChainRow& row,
                     const double* sines = nullptr) {
-  if (!(hi > lo) || q_read <= lo || q_read >= hi) return T(0);
+  const bool periodic = row.periodic();
+  const double lo = row.transmission_lo, hi = row.transmission_hi;
+  if (!periodic && (!(hi > lo) || q_read <= lo || q_read >= hi)) return T(0);
   if (sines != nullptr) {  // precomputed (PoseInput::transmission_sines)
     T e(0);
     for (int k = 0; k < kMaxTransmissionTerms; ++k) e += c[k] * sines[k];
@@ -332,10 +390,21 @@ T TransmissionError(const T* c, double q_read, double lo, double hi,
     for (int k = 0; k < kMaxTransmissionTerms && !any; ++k) any = c[k] != 0.0;
     if (!any) return 0.0;
   }
+  T e(0);
+  if (periodic) {
+    double f[kPeriodicTerms];
+    PeriodicTerms(q_read, f);
+    for (int k = 0; k < kMaxTransmissionTerms; ++k) {
+      const double* b = &row.periodic_basis[kPeriodicTerms * k];
+      double phi = 0.0;
+      for (int t = 0; t < kPeriodicTerms; ++t) phi += b[t] * f[t];
+      e += c[k] * phi;
+    }
+    return e;
+  }
   const double x = M_PI * (q_read - lo) / (hi - lo);
   const double two_cos = 2.0 * std::cos(x);
   double s_prev = 0.0, s = std::sin(x);  // sin(k x) by recurrence
-  T e(0);
   for (int k = 0; k < kMaxTransmissionTerms; ++k) {
     e += c[k] * (s - TransmissionMean(k + 1));
     const double next = two_cos * s - s_prev;
@@ -350,17 +419,16 @@ T TransmissionError(const T* c, double q_read, double lo, double hi,
 //       + sum_h cyclic{h}_cos cos(h q_read) + cyclic{h}_sin sin(h q_read)
 //       + elastostatic tau_mass + transmission(q_read)
 // for harmonics h = 1..3. `err` may be null (no error model). Cyclic terms
-// apply to revolute joints; the transmission series to joints with a travel
-// (ChainRow::transmission_lo < transmission_hi).
+// apply to revolute joints; the transmission function to joints with a
+// periodic basis or a travel (TransmissionError).
 template <typename T>
-T ModelJointValue(JointType type, double q_read, double s, double tau,
-                  const T* err, double tau_mass = 0.0, double travel_lo = 0.0,
-                  double travel_hi = 0.0) {
+T ModelJointValue(const ChainRow& row, double q_read, double s, double tau,
+                  const T* err, double tau_mass = 0.0) {
   if (err == nullptr) return T(q_read);
   T q = (T(1) + err[kGain]) * q_read - T(0.5 * s) * err[kBacklash] +
         err[kCompliance] * tau + err[kElastostatic] * tau_mass +
-        TransmissionError(err + kTransmission0, q_read, travel_lo, travel_hi);
-  if (type == JointType::kRevolute) {
+        TransmissionError(err + kTransmission0, q_read, row);
+  if (row.type == JointType::kRevolute) {
     for (int h = 1; h <= kMaxHarmonic; ++h) {
       const int k = CyclicCosIndex(h);
       q += err[k] * std::cos(h * q_read) + err[k + 1] * std::sin(h * q_read);
@@ -372,16 +440,15 @@ T ModelJointValue(JointType type, double q_read, double s, double tau,
 // The same with cos(h q_read), sin(h q_read) precomputed (PoseInput::trig),
 // as the fit evaluates it many times per pose.
 template <typename T>
-T ModelJointValueTrig(JointType type, double q_read, double s, double tau,
+T ModelJointValueTrig(const ChainRow& row, double q_read, double s, double tau,
                       const T* err, double tau_mass, const double* trig,
-                      double travel_lo = 0.0, double travel_hi = 0.0,
                       const double* transmission_sines = nullptr) {
   if (err == nullptr) return T(q_read);
   T q = (T(1) + err[kGain]) * q_read - T(0.5 * s) * err[kBacklash] +
         err[kCompliance] * tau + err[kElastostatic] * tau_mass +
-        TransmissionError(err + kTransmission0, q_read, travel_lo, travel_hi,
+        TransmissionError(err + kTransmission0, q_read, row,
                           transmission_sines);
-  if (type == JointType::kRevolute) {
+  if (row.type == JointType::kRevolute) {
     for (int h = 1; h <= kMaxHarmonic; ++h) {
       const int k = CyclicCosIndex(h);
       q += err[k] * trig[2 * (h - 1)] + err[k + 1] * trig[2 * (h - 1) + 1];
@@ -530,18 +597,16 @@ Vec3<T> TipInBase(const Chain& chain, const T* const* rows,
     const double tm = masses ? in.tau_mass[j] : 0.0;
     const T* err = joint_errors ? joint_errors[j] : nullptr;
     const ChainRow& row = chain.rows[j];
-    q[j] =
-        trig ? ModelJointValueTrig<T>(
-                   row.type, in.q[j], in.s[j], in.tau[j], err, tm,
-                   &in.trig[2 * kMaxHarmonic * j], row.transmission_lo,
-                   row.transmission_hi,
-                   sines ? &in.transmission_sines[kMaxTransmissionTerms * j]
-                         : nullptr)
-             : ModelJointValue<T>(row.type, in.q[j], in.s[j], in.tau[j], err,
-                                  tm, row.transmission_lo, row.transmission_hi);
+    q[j] = trig ? ModelJointValueTrig<T>(
+                      row, in.q[j], in.s[j], in.tau[j], err, tm,
+                      &in.trig[2 * kMaxHarmonic * j],
+                      sines ? &in.transmission_sines[kMaxTransmissionTerms * j]
+                            : nullptr)
+                : ModelJointValue<T>(row, in.q[j], in.s[j], in.tau[j], err, tm);
   }
   Vec3<T> p;
-  if (joint_errors != nullptr && in.thermal_x != 0.0) {
+  const double thermal_x = chain.ThermalInput(in.thermal_x);
+  if (joint_errors != nullptr && thermal_x != 0.0) {
     // Thermal growth: rows with their lengths scaled (copies).
     T buf[kMaxJoints + 1][kRowBlockSize];
     const T* scaled[kMaxJoints + 1];
@@ -549,7 +614,7 @@ Vec3<T> TipInBase(const Chain& chain, const T* const* rows,
       for (int k = 0; k < kRowBlockSize; ++k) buf[r][k] = rows[r][k];
       if (r < chain.num_joints()) {
         ScaleRowLengths(chain.convention,
-                        T(1) + joint_errors[r][kThermal] * in.thermal_x,
+                        T(1) + joint_errors[r][kThermal] * thermal_x,
                         buf[r]);
       }
       scaled[r] = buf[r];

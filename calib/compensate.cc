@@ -169,7 +169,8 @@ std::vector<std::string> Extrapolation(const Robot& robot,
     out.push_back("temperature " + FormatFixed(temp_c, 2) +
                   " C outside the fitted range [" +
                   FormatFixed(rec.temp_lo_c, 2) + ", " +
-                  FormatFixed(rec.temp_hi_c, 2) + "]");
+                  FormatFixed(rec.temp_hi_c, 2) +
+                  "] (the thermal terms are held at its end)");
   }
   return out;
 }

@@ -191,9 +191,7 @@ void ComputeJointValues(const Chain& chain, const PoseInput& in,
   for (int j = 0; j < n; ++j) {
     const double tm = masses ? in.tau_mass[j] : 0.0;
     const double* tr = trig ? &in.trig[2 * kMaxHarmonic * j] : nullptr;
-    const JointType type = chain.rows[j].type;
-    const double lo = chain.rows[j].transmission_lo;
-    const double hi = chain.rows[j].transmission_hi;
+    const ChainRow& row = chain.rows[j];
     const double* ts = static_cast<int>(in.transmission_sines.size()) ==
                                kMaxTransmissionTerms * n
                            ? &in.transmission_sines[kMaxTransmissionTerms * j]
@@ -201,10 +199,10 @@ void ComputeJointValues(const Chain& chain, const PoseInput& in,
     if (!hooks.need_dq[j]) {
       const double* e = chain.joint_errors[j].data();
       out->q[j] =
-          trig ? ModelJointValueTrig<double>(type, in.q[j], in.s[j], in.tau[j],
-                                             e, tm, tr, lo, hi, ts)
-               : ModelJointValue<double>(type, in.q[j], in.s[j], in.tau[j], e,
-                                         tm, lo, hi);
+          trig ? ModelJointValueTrig<double>(row, in.q[j], in.s[j], in.tau[j],
+                                             e, tm, tr, ts)
+               : ModelJointValue<double>(row, in.q[j], in.s[j], in.tau[j], e,
+                                         tm);
       continue;
     }
     const std::vector<int>& f = hooks.free_entries[j];
@@ -216,10 +214,9 @@ void ComputeJointValues(const Chain& chain, const PoseInput& in,
       for (size_t c = first; c < last; ++c)
         e[f[c]] = JetE(chain.joint_errors[j][f[c]], int(c - first));
       const JetE qj =
-          trig ? ModelJointValueTrig<JetE>(type, in.q[j], in.s[j], in.tau[j], e,
-                                           tm, tr, lo, hi, ts)
-               : ModelJointValue<JetE>(type, in.q[j], in.s[j], in.tau[j], e, tm,
-                                       lo, hi);
+          trig ? ModelJointValueTrig<JetE>(row, in.q[j], in.s[j], in.tau[j], e,
+                                           tm, tr, ts)
+               : ModelJointValue<JetE>(row, in.q[j], in.s[j], in.tau[j], e, tm);
       out->q[j] = qj.a;
       for (size_t c = first; c < last; ++c) {
         out->dq[j][f[c]] = qj.v[c - first];
@@ -245,10 +242,11 @@ void RunForwardPass(const Chain& chain, const ChainOps& c, const PoseInput& in,
   const int n = chain.num_joints();
   const double* q = joints.q;
   // Thermal scaling of the rows' lengths (calib/chain.h TipInBase).
-  out->thermal = in.thermal_x != 0.0;
+  const double thermal_x = chain.ThermalInput(in.thermal_x);
+  out->thermal = thermal_x != 0.0;
   for (int i = 0; i <= n; ++i) {
     out->factor[i] = out->thermal && i < n
-                         ? 1.0 + chain.joint_errors[i][kThermal] * in.thermal_x
+                         ? 1.0 + chain.joint_errors[i][kThermal] * thermal_x
                          : 1.0;
   }
   Eigen::Matrix3d R = Eigen::Matrix3d::Identity();
@@ -380,7 +378,8 @@ Eigen::Vector3d JacobianColumn(const PoseDerivatives& d, const ParamInfo& p) {
       if (d.fwd->thermal) {
         for (int e = 0; e < kRowBlockSize; ++e) {
           if (IsLength(chain.convention, e))
-            dt += d.tip->d_row[j][e] * (chain.rows[j].p[e] * in.thermal_x);
+            dt += d.tip->d_row[j][e] *
+                  (chain.rows[j].p[e] * chain.ThermalInput(in.thermal_x));
         }
       }
       return d.d_tip * dt;

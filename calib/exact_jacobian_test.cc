@@ -73,6 +73,10 @@ void Check(const Robot& robot, uint64_t seed) {
     c.rows[j].transmission_lo = lo + 0.1 * (hi - lo);
     c.rows[j].transmission_hi = hi - 0.1 * (hi - lo);
   }
+  // A periodic transmission on one revolute joint (calib/chain.h
+  // ChainRow::periodic_basis): defined at every angle.
+  c.rows[2].periodic_basis.resize(kPeriodicTerms * kMaxTransmissionTerms);
+  for (double& b : c.rows[2].periodic_basis) b = 0.1 * u(rng);
   for (double& v : c.drift) v = 1e-3 * u(rng);
   for (int i = 0; i < 3; ++i) {
     state.meas_from_base[i] = 0.3 * u(rng);

@@ -77,6 +77,19 @@ FitRecord MakeFitRecord(const FitRecordInput& input) {
       rec.frame[k] = f[k] * 180.0 / M_PI;
       rec.frame[k + 3] = f[k + 3];
     }
+    const ModelState& s = *input.state;
+    if (s.NumFrames() > 1 &&
+        static_cast<int>(s.frame_series.size()) == s.NumFrames()) {
+      for (int i = 0; i < s.NumFrames(); ++i) {
+        const double* b = s.FrameBlock(i);
+        std::array<double, 6> frame{};
+        for (int k = 0; k < 3; ++k) {
+          frame[k] = b[k] * 180.0 / M_PI;
+          frame[k + 3] = b[k + 3];
+        }
+        rec.series_frames.emplace_back(s.frame_series[i], frame);
+      }
+    }
   }
   rec.heldout_rms_mm = input.heldout_rms_mm;
   rec.systematic_rms_mm = input.systematic_rms_mm;
@@ -87,8 +100,15 @@ FitRecord MakeFitRecord(const FitRecordInput& input) {
   }
   std::vector<int> keep;
   for (size_t k = 0; k < fit->params.size(); ++k) {
-    const ParamKind kind = fit->params[k].kind;
-    if (kind != ParamKind::kPoint) {
+    const ParamInfo& q = fit->params[k];
+    // A periodic transmission's coefficients weight the diagnosis' basis of
+    // the readings; the file keeps the function's Fourier coefficients
+    // (calib/chain.h FourierBasis), so their covariance has no name there.
+    const bool periodic_coefficient =
+        q.kind == ParamKind::kJointError && q.index >= kTransmission0 &&
+        input.state != nullptr &&
+        input.state->chain.rows[q.block].periodic();
+    if (q.kind != ParamKind::kPoint && !periodic_coefficient) {
       keep.push_back(static_cast<int>(k));
     }
   }

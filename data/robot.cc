@@ -103,8 +103,14 @@ const std::vector<std::string>& OptionalFields(const std::string& cause) {
   static const std::vector<std::string> mount = {"aniso_cos", "aniso_sin"};
   static const std::vector<std::string> none;
   static const std::vector<std::string> transmission = [] {
-    std::vector<std::string> v;  // s1 .. s24: sine series coefficients
+    // s1 .. s24: sine series over the travel; a1 .. a32, b1 .. b32: the
+    // Fourier coefficients of a periodic error over the revolution.
+    std::vector<std::string> v;
     for (int k = 1; k <= 24; ++k) v.push_back("s" + std::to_string(k));
+    for (int k = 1; k <= 32; ++k) {
+      v.push_back("a" + std::to_string(k));
+      v.push_back("b" + std::to_string(k));
+    }
     return v;
   }();
   if (cause == "mount_compliance") return mount;
@@ -378,7 +384,7 @@ void ReadFittedOn(const YamlReader& r, const YAML::Node& f, Robot* robot) {
   r.ExpectMap(f, "fitted_on");
   r.CheckKeys(f,
               {"poses", "joints", "gaps", "temp_c", "thermal_input", "frame",
-               "heldout_rms_mm", "systematic_rms_mm"},
+               "series_frames", "heldout_rms_mm", "systematic_rms_mm"},
               "fitted_on");
   FitRecord& rec = robot->fitted_on;
   rec.poses = r.Integer(r.Required(f, "poses", "fitted_on"), "fitted_on.poses");
@@ -430,6 +436,18 @@ void ReadFittedOn(const YamlReader& r, const YAML::Node& f, Robot* robot) {
     const auto v = r.Numbers(f["frame"], "fitted_on.frame", 6, 6);
     rec.has_frame = true;
     for (int k = 0; k < 6; ++k) rec.frame[k] = v[k];
+  }
+  if (f["series_frames"]) {
+    const YAML::Node s = f["series_frames"];
+    r.ExpectMap(s, "fitted_on.series_frames");
+    for (const auto& kv : s) {
+      const std::string name = kv.first.Scalar();
+      const auto v =
+          r.Numbers(kv.second, "fitted_on.series_frames." + name, 6, 6);
+      std::array<double, 6> frame{};
+      for (int k = 0; k < 6; ++k) frame[k] = v[k];
+      rec.series_frames.emplace_back(name, frame);
+    }
   }
   if (f["thermal_input"]) {
     rec.thermal_input = r.String(f["thermal_input"], "fitted_on.thermal_input");
@@ -589,6 +607,20 @@ void FormatFitRecord(const Robot& robot, std::ostringstream& os) {
         os << (k ? ", " : "") << FormatDouble(rec.frame[k]);
       }
       os << "]\n";
+    }
+    if (!rec.series_frames.empty()) {
+      os << "  series_frames:\n";  // per series, as frame
+      for (const auto& sf : rec.series_frames) {
+        std::string label = "\"";  // double-quoted YAML scalar
+        for (char ch : sf.first) {
+          if (ch == '"' || ch == '\\') label += '\\';
+          label += ch;
+        }
+        os << "    " << label << "\": [";
+        for (int k = 0; k < 6; ++k)
+          os << (k ? ", " : "") << FormatDouble(sf.second[k]);
+        os << "]\n";
+      }
     }
     if (!rec.thermal_input.empty()) {
       os << "  thermal_input: " << rec.thermal_input << "\n";

@@ -3,6 +3,7 @@
 
 #include <Eigen/Core>
 #include <array>
+#include <utility>
 #include <limits>
 #include <map>
 #include <string>
@@ -89,6 +90,10 @@ struct FitRecord {
   // rotation vector in deg, translation in mm); has_frame false = unknown.
   bool has_frame = false;
   std::array<double, 6> frame{};
+  // With several series (spec v3 column `series`), every series' measuring
+  // frame (label, frame as above) in first-seen order; `frame` is the first.
+  // Empty for one series.
+  std::vector<std::pair<std::string, std::array<double, 6>>> series_frames;
   // Held-out tip RMS of the model (3D, mm) and the part of its residual above
   // the measurement noise (3D RMS, mm; 0 when none is detected); NaN = unknown.
   double heldout_rms_mm = std::numeric_limits<double>::quiet_NaN();

@@ -104,6 +104,8 @@ TEST(RobotYamlTest, NominalFitRecordAndCovarianceRoundTrip) {
   r.fitted_on.thermal_input = "temp_c";
   r.fitted_on.has_frame = true;
   r.fitted_on.frame = {1, 2, 3, 1000, -20, 5.5};
+  r.fitted_on.series_frames = {{"A", {1, 2, 3, 1000, -20, 5.5}},
+                               {"B \"2\"", {-1, 0, 0.5, 10, 20, 30}}};
   r.fitted_on.heldout_rms_mm = 0.031;
   r.fitted_on.systematic_rms_mm = 0.0;
   r.fitted_on.covariance_params = {"j3.a", "tool.d"};
@@ -125,6 +127,9 @@ TEST(RobotYamlTest, NominalFitRecordAndCovarianceRoundTrip) {
   EXPECT_EQ(back.fitted_on.thermal_input, "temp_c");
   EXPECT_TRUE(back.fitted_on.has_frame);
   EXPECT_EQ(back.fitted_on.frame[3], 1000.0);
+  ASSERT_EQ(back.fitted_on.series_frames.size(), 2u);
+  EXPECT_EQ(back.fitted_on.series_frames[1].first, "B \"2\"");
+  EXPECT_EQ(back.fitted_on.series_frames[1].second[5], 30.0);
   EXPECT_EQ(back.fitted_on.heldout_rms_mm, 0.031);
   EXPECT_EQ(back.fitted_on.covariance_params[1], "tool.d");
   EXPECT_EQ(back.fitted_on.covariance(0, 1), -1e-4);

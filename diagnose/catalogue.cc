@@ -5,6 +5,7 @@
 #include <limits>
 
 #include "data/error.h"
+#include "diagnose/periodic_basis.h"
 
 namespace kincal {
 namespace {
@@ -58,7 +59,7 @@ const std::vector<std::string>& CatalogueCauses() {
   static const std::vector<std::string> causes = {
       "backlash",         "compliance",  "cyclic",       "gain",
       "axis_tilt",        "drift",       "elastostatic", "thermal",
-      "mount_compliance", "transmission"};
+      "mount_compliance", "transmission", "gravity"};
   return causes;
 }
 
@@ -67,10 +68,27 @@ constexpr int kTransmissionTermChoices[] = {8, 16, kMaxTransmissionTerms};
 }  // namespace
 
 int TransmissionTerms(const std::string& cause) {
-  for (int t : kTransmissionTermChoices) {
+  for (int t = 1; t <= kMaxTransmissionTerms; ++t) {
     if (cause == TransmissionCause(t)) return t;
   }
   return 0;
+}
+
+std::vector<int> TransmissionTermChoices(const ChainRow& row) {
+  std::vector<int> out;
+  if (!row.periodic()) {
+    if (row.transmission_hi > row.transmission_lo)
+      out.assign(std::begin(kTransmissionTermChoices),
+                 std::end(kTransmissionTermChoices));
+    return out;
+  }
+  const int supported = PeriodicSupport(row);
+  for (int t : kTransmissionTermChoices) {
+    if (t <= supported) out.push_back(t);
+  }
+  if (supported >= 2 && (out.empty() || out.back() < supported))
+    out.push_back(supported);
+  return out;
 }
 
 std::string TransmissionCause(int terms) {
@@ -83,19 +101,23 @@ std::string SpecCauseName(const std::string& cause) {
   return cause;
 }
 
-void SetTransmissionTravel(const std::vector<Measurement>& ms, Chain* chain) {
+void SetTransmissionTravel(const std::vector<Measurement>& ms, Chain* chain,
+                           const PeriodicBasisOptions& periodic) {
   for (int j = 0; j < chain->num_joints(); ++j) {
     ChainRow& row = chain->rows[j];
     if (row.transmission_hi > row.transmission_lo) continue;
     double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+    std::vector<double> q;
     for (const Measurement& m : ms) {
       lo = std::min(lo, m.input.q[j]);
       hi = std::max(hi, m.input.q[j]);
+      q.push_back(m.input.q[j]);
     }
-    if (hi > lo) {
-      row.transmission_lo = lo;
-      row.transmission_hi = hi;
-    }
+    if (!(hi > lo)) continue;
+    row.transmission_lo = lo;
+    row.transmission_hi = hi;
+    if (row.type == JointType::kRevolute && !row.periodic())
+      row.periodic_basis = MakePeriodicBasis(q, periodic).basis;
   }
 }
 
@@ -106,7 +128,7 @@ double MagnitudeScale(const std::string& cause, int joint, const Chain& chain,
                       const std::vector<Measurement>& ms) {
   if (cause == "compliance") return MaxAbsTau(ms, joint);
   if (cause == "elastostatic") return MaxAbsTauMass(ms, joint);
-  if (cause == "mount_compliance") return MaxMoment(ms);
+  if (cause == "mount_compliance" || cause == "gravity") return MaxMoment(ms);
   if (cause == "thermal") return RowLength(chain, joint);
   return 1.0;
 }
@@ -135,6 +157,10 @@ Candidate MakeCandidate(const Chain& chain, const std::string& cause,
   } else if (cause == "thermal") {
     c.params = {JointErrorParam(chain, joint, kThermal)};
   } else if (cause == "mount_compliance") {
+    c.params = {MountParams()[0]};
+  } else if (cause == "gravity") {
+    // The mount's compliance first (the magnitude), then the elastostatic
+    // deflection of every joint: GravityCandidate picks the joints.
     c.params = {MountParams()[0]};
   } else if (TransmissionTerms(cause) > 0) {
     for (int k = 0; k < TransmissionTerms(cause); ++k)
@@ -170,6 +196,7 @@ std::vector<Candidate> CatalogueCandidates(
   std::vector<Candidate> out;
   const int nj = chain.num_joints();
   const std::vector<int> parallel = ParallelAxisRows(chain);
+  std::vector<int> elastostatic;  // joints whose link-mass torque varies
   bool has_masses = false;
   for (const ChainRow& r : chain.rows)
     has_masses = has_masses || r.mass_kg >= 0;
@@ -201,15 +228,18 @@ std::vector<Candidate> CatalogueCandidates(
     // Elastostatics needs the robot's link masses: without them the
     // uniform-beam proxy is the tip-mass compliance again on the last
     // joints (same torque shape), and the spec's cause must win.
-    if (wanted("elastostatic") && has_masses) {
+    if ((wanted("elastostatic") || wanted("gravity")) && has_masses) {
       double lo = std::numeric_limits<double>::infinity(), hi = -lo;
       for (const Measurement& m : ms) {
         if (m.input.tau_mass.size() != static_cast<size_t>(nj)) continue;
         lo = std::min(lo, m.input.tau_mass[j]);
         hi = std::max(hi, m.input.tau_mass[j]);
       }
-      if (hi - lo > 1e-6 * std::max(1.0, std::abs(hi)))
-        out.push_back(MakeCandidate(chain, "elastostatic", j));
+      if (hi - lo > 1e-6 * std::max(1.0, std::abs(hi))) {
+        elastostatic.push_back(j);
+        if (wanted("elastostatic"))
+          out.push_back(MakeCandidate(chain, "elastostatic", j));
+      }
     }
     if (wanted("thermal") && RowLength(chain, j) > 1e-6) {
       double lo = std::numeric_limits<double>::infinity(), hi = -lo;
@@ -222,8 +252,8 @@ std::vector<Candidate> CatalogueCandidates(
     // The joint's error along its travel, coarse to fine (nested series):
     // needs the travel (SetTransmissionTravel) and enough distinct readings.
     const ChainRow& row = chain.rows[j];
-    if (wanted("transmission") && row.transmission_hi > row.transmission_lo) {
-      for (int t : kTransmissionTermChoices)
+    if (wanted("transmission")) {
+      for (int t : TransmissionTermChoices(row))
         out.push_back(MakeCandidate(chain, TransmissionCause(t), j));
     }
     if (wanted("axis_tilt") && j >= 1 &&
@@ -241,6 +271,15 @@ std::vector<Candidate> CatalogueCandidates(
   }
   if (wanted("mount_compliance") && MaxMoment(ms) > 1e-9) {
     out.push_back(MakeCandidate(chain, "mount_compliance", -1));
+  }
+  // Gravity as one physical model: the mount's compliance and the link
+  // masses' elastostatic deflections together (each alone may not pass a
+  // step's test while together they carry another series' configurations).
+  if (wanted("gravity") && MaxMoment(ms) > 1e-9 && !elastostatic.empty()) {
+    Candidate g = MakeCandidate(chain, "gravity", -1);
+    for (int j : elastostatic)
+      g.params.push_back(JointErrorParam(chain, j, kElastostatic));
+    out.push_back(g);
   }
   return out;
 }
@@ -285,7 +324,9 @@ Magnitude CandidateMagnitude(const Candidate& c, const ModelState& state,
     m.unit = revolute ? "deg" : "mm";
     m.value = v[0] * max_abs_tau * angle_unit;
     grad[0] = max_abs_tau * angle_unit;
-  } else if (c.cause == "mount_compliance") {
+  } else if (c.cause == "mount_compliance" || c.cause == "gravity") {
+    // gravity: the mount's tilt at the largest moment; the joints'
+    // elastostatic deflections are in the robot file.
     m.unit = "deg";
     m.value = v[0] * max_abs_tau * kRadToDeg;
     grad[0] = max_abs_tau * kRadToDeg;
@@ -301,6 +342,14 @@ Magnitude CandidateMagnitude(const Candidate& c, const ModelState& state,
     m.unit = "deg";
     m.value = v[0] * kRadToDeg;
     grad[0] = kRadToDeg;
+  } else if (TransmissionTerms(c.cause) > 0 &&
+             chain.rows[c.joint].periodic()) {
+    // RMS of the periodic error over the readings its basis was built on
+    // (diagnose/periodic_basis.h: the functions are orthonormal there): |c|.
+    m.unit = "deg";
+    const double norm = v.norm();
+    m.value = norm * kRadToDeg;
+    if (norm > 0) grad = v / norm * kRadToDeg;
   } else if (TransmissionTerms(c.cause) > 0) {
     // RMS of the error over the travel (calib/chain.h TransmissionError):
     // sqrt(|c|^2 / 2 - (m . c)^2).

@@ -14,8 +14,11 @@
 //   (the spec's catalogue); elastostatic (joint deflection under the
 //   gravity torque of the link masses), thermal (growth of a row's lengths
 //   with temp_c or time), mount_compliance (base tilt under the arm's
-//   gravity moment), transmission (a joint error that varies along the
-//   joint's travel: a sine series over the travel of the data).
+//   gravity moment), gravity (mount_compliance and the elastostatic
+//   deflection of every joint together, one candidate), transmission (a joint error that varies along the
+//   joint's travel: on revolute joints a regularised periodic function of
+//   the angle over the whole revolution, diagnose/periodic_basis.h; on
+//   prismatic joints a sine series over the travel of the data).
 
 #include <string>
 #include <vector>
@@ -23,6 +26,7 @@
 #include "calib/chain.h"
 #include "calib/fit.h"
 #include "calib/model_state.h"
+#include "diagnose/periodic_basis.h"
 
 namespace kincal {
 
@@ -35,9 +39,10 @@ const std::vector<std::string>& CatalogueCauses();
 int CyclicHarmonic(const std::string& cause);
 std::string CyclicCause(int harmonic);
 
-// Transmission candidates carry their number of sine terms: "transmission8",
+// Transmission candidates carry their number of functions: "transmission8",
 // "transmission16", "transmission24" (nested: each series contains the
-// shorter ones). TransmissionTerms returns 8, 16, 24 for them, else 0.
+// shorter ones; a periodic basis may support fewer, "transmissionN").
+// TransmissionTerms returns N (1..24) for them, else 0.
 int TransmissionTerms(const std::string& cause);
 std::string TransmissionCause(int terms);
 // The spec's name of an internal cause: "cyclic" for cyclic2/3,
@@ -47,11 +52,21 @@ std::string SpecCauseName(const std::string& cause);
 // Sets the travel of every moving joint whose chain row has none
 // (ChainRow::transmission_lo/hi) to the range of its readings in
 // `measurements`: the interval the transmission family's series lives on.
+// Revolute joints also get their periodic basis from the readings
+// (diagnose/periodic_basis.h): their transmission is a function of the angle
+// over the whole revolution; prismatic joints keep the sine series.
 void SetTransmissionTravel(const std::vector<Measurement>& measurements,
-                           Chain* chain);
+                           Chain* chain,
+                           const PeriodicBasisOptions& periodic = {});
 
-// One catalogue candidate: a cause on a joint (joint -1 for drift and
-// mount_compliance).
+// The transmission candidates' numbers of functions on a row: 8, 16, 24 for
+// the sine series over a travel; for a periodic basis those of them that
+// the readings support, and the number supported when it is not one of
+// them (none below 2).
+std::vector<int> TransmissionTermChoices(const ChainRow& row);
+
+// One catalogue candidate: a cause on a joint (joint -1 for drift,
+// mount_compliance and gravity).
 struct Candidate {
   std::string cause;
   int joint = -1;

@@ -13,7 +13,8 @@ namespace kincal {
 namespace {
 
 TEST(CatalogueTest, CauseNamesRoundTrip) {
-  EXPECT_EQ(CatalogueCauses().size(), 10u);
+  EXPECT_EQ(CatalogueCauses().size(), 11u);
+  EXPECT_EQ(TransmissionTerms(TransmissionCause(5)), 5);  // periodic support
   EXPECT_EQ(CyclicHarmonic("cyclic"), 1);
   EXPECT_EQ(CyclicHarmonic(CyclicCause(3)), 3);
   EXPECT_EQ(CyclicHarmonic("gain"), 0);

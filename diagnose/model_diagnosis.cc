@@ -18,6 +18,7 @@
 #include "data/error.h"
 #include "diagnose/cross_validation.h"
 #include "diagnose/nonparametric.h"
+#include "diagnose/periodic_basis.h"
 #include "diagnose/travel_gaps.h"
 
 namespace kincal {
@@ -296,7 +297,8 @@ void DiagnoseOptions::Check() const {
                 CatalogueCauses().end(),
             "unknown cause '" + c +
                 "' (backlash, compliance, cyclic, gain, axis_tilt, drift, "
-                "elastostatic, thermal, mount_compliance, transmission)");
+                "elastostatic, thermal, mount_compliance, transmission, "
+                "gravity)");
   }
 }
 
@@ -473,8 +475,12 @@ StepLinearization Linearize(const Selection& selection,
   ResidualsAndJacobian(problem.train, current.state, current.free, &lin.r0,
                        &base_jac);
   const Eigen::MatrixXd basis = Basis(Normalized(base_jac));
-  for (Candidate& c : *pool)
-    c = MakeCandidate(problem.nominal, c.cause, c.joint);
+  // (Drift is trimmed to its identifiable part below, so it starts whole
+  // each step; gravity's joints come from the catalogue and are kept.)
+  for (Candidate& c : *pool) {
+    if (c.cause != "gravity")
+      c = MakeCandidate(problem.nominal, c.cause, c.joint);
+  }
   // Each parameter once (nested candidates share theirs: transmission8 is
   // the start of transmission16 and 24).
   std::vector<ParamInfo> all_params;
@@ -911,6 +917,50 @@ void UnexplainedRest(const Selection& selection, const CurrentModel& current,
   out->findings.push_back(u);
 }
 
+// Step 5b: where each periodic transmission finding is supported and where
+// it is extrapolated (Finding::travel_lo ... extrapolated_peak).
+void PeriodicSupportOf(const Problem& problem, const ModelState& final_state,
+                       const std::vector<Candidate>& accepted,
+                       DiagnosisResult* out) {
+  constexpr double kRadToDeg = 180.0 / M_PI;
+  constexpr double kStepRad = 0.5 / kRadToDeg;
+  for (size_t i = 0; i < accepted.size(); ++i) {
+    const Candidate& c = accepted[i];
+    if (TransmissionTerms(c.cause) == 0) continue;
+    const ChainRow& row = final_state.chain.rows[c.joint];
+    if (!row.periodic()) continue;
+    const double* coef =
+        final_state.chain.joint_errors[c.joint].data() + kTransmission0;
+    std::vector<double> q;
+    double sum = 0.0, lo = 1e300, hi = -1e300;
+    for (const Measurement& m : problem.train) {
+      q.push_back(m.input.q[c.joint]);
+      const double e = TransmissionError(coef, q.back(), row);
+      sum += e;
+      lo = std::min(lo, e);
+      hi = std::max(hi, e);
+    }
+    if (q.empty()) continue;
+    Finding& f = out->findings[i];
+    const double mean = sum / static_cast<double>(q.size());
+    f.periodic = true;
+    f.travel_lo = *std::min_element(q.begin(), q.end()) * kRadToDeg;
+    f.travel_hi = *std::max_element(q.begin(), q.end()) * kRadToDeg;
+    f.amplitude = 0.5 * (hi - lo) * kRadToDeg;
+    f.extrapolated = ExtrapolatedArcs(q, kWideGapMin);
+    f.extrapolated_peak = 0.0;
+    for (const auto& arc : f.extrapolated) {
+      for (double x = arc[0] / kRadToDeg; x <= arc[1] / kRadToDeg;
+           x += kStepRad) {
+        f.extrapolated_peak =
+            std::max(f.extrapolated_peak,
+                     std::abs(TransmissionError(coef, x, row) - mean) *
+                         kRadToDeg);
+      }
+    }
+  }
+}
+
 // Per measured pose: its row, whether it was held out, the final residual.
 void PerPoseResiduals(const Problem& problem, const ModelState& final_state,
                       DiagnosisResult* out) {
@@ -956,6 +1006,7 @@ DiagnosisResult DiagnoseModel(const Robot& nominal, const Observations& obs,
 
   const Refit refit = FinalRefit(selection, current, accepted, &out);
   const ModelState& final_state = refit.state;
+  PeriodicSupportOf(problem, final_state, accepted, &out);
   EstimateNoise(options, problem, current.state, &out);
   UnexplainedRest(selection, current, &out);
   out.verdict = out.findings.empty() ? "no_significant_effect" : "effect_found";
@@ -996,8 +1047,11 @@ DiagnosisResult DiagnoseModel(const Robot& nominal, const Observations& obs,
   std::vector<std::string> series_joints, units;
   for (const Finding& f : out.findings) {
     const int j = nominal.JointIndex(f.joint);
-    // The cause label carries the series length (transmission8, ...).
-    if (f.cause.rfind("transmission", 0) != 0 || j < 0) continue;
+    // The cause label carries the series length (transmission8, ...); a
+    // periodic series is held in its gaps by its regulariser and says where
+    // it extrapolates (Finding::extrapolated) instead.
+    if (f.cause.rfind("transmission", 0) != 0 || j < 0 || f.periodic)
+      continue;
     series_joints.push_back(f.joint);
     units.push_back(nominal.joints[j].type == JointType::kPrismatic ? "mm"
                                                                     : "deg");

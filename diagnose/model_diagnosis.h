@@ -32,6 +32,7 @@
 //      measurement noise (stated, from repeated poses, or an upper bound from
 //      nearest-neighbour pose pairs).
 
+#include <array>
 #include <cstdint>
 #include <limits>
 #include <nlohmann/json.hpp>
@@ -152,6 +153,17 @@ struct Finding {
   // The same share from the measured point's position alone (robot or
   // instrument, see SmoothCorrection); NaN without measured points.
   double point_cv_explained = std::numeric_limits<double>::quiet_NaN();
+  // A periodic transmission (revolute joint) only, in the reading's unit
+  // (deg): the travel of the training readings that supports it, the arcs
+  // of the revolution where it is extrapolated (gaps between readings wider
+  // than 5 deg, and beyond the travel; diagnose/periodic_basis.h
+  // ExtrapolatedArcs), its amplitude (half its peak-to-peak over the
+  // readings) and its largest deviation from its mean over the readings on
+  // those arcs (the regulariser keeps it near the supported part).
+  bool periodic = false;
+  double travel_lo = 0.0, travel_hi = 0.0;
+  std::vector<std::array<double, 2>> extrapolated;
+  double amplitude = 0.0, extrapolated_peak = 0.0;
 };
 
 struct DiagnosisResult {

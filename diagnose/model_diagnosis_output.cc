@@ -69,6 +69,15 @@ nlohmann::json DiagnosisJson(const DiagnosisResult& r,
          {"f", Num(f.f)},
          {"p_value", Num(f.p_value)},
          {"equivalent", eq}});
+    if (f.periodic) {
+      nlohmann::json arcs = nlohmann::json::array();
+      for (const auto& a : f.extrapolated) arcs.push_back({a[0], a[1]});
+      findings.back()["periodic"] = {
+          {"travel_deg", {f.travel_lo, f.travel_hi}},
+          {"extrapolated_deg", arcs},
+          {"amplitude_deg", Num(f.amplitude)},
+          {"extrapolated_peak_deg", Num(f.extrapolated_peak)}};
+    }
     if (f.cause == "unexplained") {
       nlohmann::json single = nlohmann::json::object();
       for (const auto& kv : f.single_inputs) single[kv.first] = Num(kv.second);

@@ -55,8 +55,7 @@ Vec3<Jet> TipJet(const Chain& chain, const PoseInput& in, const Jet* q_read) {
     // Its value only: d/dq of the small transmission error is left out of
     // the IK's Jacobian (Newton still converges on the error's value).
     q[j] += Jet(TransmissionError(&e[kTransmission0], q_read[j].a,
-                                  chain.rows[j].transmission_lo,
-                                  chain.rows[j].transmission_hi));
+                                  chain.rows[j]));
     if (chain.rows[j].type == JointType::kRevolute) {
       for (int h = 1; h <= kMaxHarmonic; ++h) {
         const int k = CyclicCosIndex(h);
@@ -334,9 +333,8 @@ std::vector<Eigen::Matrix4d> TrueTipPoses(
     std::vector<double> q(n);
     for (int j = 0; j < n; ++j) {
       q[j] = ModelJointValue<double>(
-          truth.rows[j].type, in.q[j], in.s[j], in.tau[j],
-          truth.joint_errors[j].data(), in.tau_mass[j],
-          truth.rows[j].transmission_lo, truth.rows[j].transmission_hi);
+          truth.rows[j], in.q[j], in.s[j], in.tau[j],
+          truth.joint_errors[j].data(), in.tau_mass[j]);
     }
     Eigen::Matrix4d m = BaseFromTipAt(truth, q);
     for (int k = 0; k < 3; ++k) m(k, 3) += truth.drift[k] * in.t_h;
