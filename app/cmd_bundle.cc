@@ -345,8 +345,8 @@ void PrintSummary(const BundleArgs& args, const BundleRun& run) {
               args.out.c_str(), run.seconds, run.obs.seconds, r.seconds);
 }
 
-// A camera whose images never show a tag of the target (spec v3): bad
-// input naming the camera, before any solve.
+// A camera whose images never show a tag of the target while another
+// camera's do (spec v3): bad input naming the camera, before any solve.
 void RefuseBlindCameras(const BundleArgs& args, const Rig& rig,
                         const SessionObservations& obs) {
   std::vector<int> corners(rig.cameras.size(), 0);
@@ -356,6 +356,12 @@ void RefuseBlindCameras(const BundleArgs& args, const Rig& rig,
         ++corners[c.camera];
       }
     }
+  }
+  // No camera with a tag at all: the start's own message (too few tracked
+  // frames) says more than naming a camera.
+  if (std::count(corners.begin(), corners.end(), 0) ==
+      static_cast<long>(corners.size())) {
+    return;
   }
   for (size_t c = 0; c < corners.size(); ++c) {
     if (corners[c] > 0) continue;

