@@ -29,10 +29,11 @@ const SyntheticBundle& Data(int frames, int cameras = 2) {
     o.noise_px = 0.1;
     o.seed = 42;
     it = cache
-             .emplace(std::make_pair(frames, cameras), MakeSyntheticBundle(
-                                  ReadRobotYaml(std::string(KINCAL_SOURCE_DIR) +
-                                                "/data/robots/bh7.yaml"),
-                                  o))
+             .emplace(std::make_pair(frames, cameras),
+                      MakeSyntheticBundle(
+                          ReadRobotYaml(std::string(KINCAL_SOURCE_DIR) +
+                                        "/data/robots/bh7.yaml"),
+                          o))
              .first;
   }
   return it->second;
@@ -65,15 +66,12 @@ BENCHMARK(BM_Bundle)
     ->Unit(benchmark::kMillisecond)
     ->Iterations(2);
 
-}  // namespace
-}  // namespace kincal
-
 // The same with one and three cameras on the stand (format v3; three:
 // the stereo pair and "top", synth/rig_placement.h). Target: 500 frames x 3
 // cameras <= 3 s, linear in frames.
 void BM_BundleCameras(benchmark::State& state) {
-  const SyntheticBundle& s = Data(static_cast<int>(state.range(0)),
-                                  static_cast<int>(state.range(1)));
+  const SyntheticBundle& s =
+      Data(static_cast<int>(state.range(0)), static_cast<int>(state.range(1)));
   BundleOptions o;
   BundleResult r;
   for (auto _ : state) {
@@ -97,5 +95,8 @@ BENCHMARK(BM_BundleCameras)
     ->Args({1000, 3})
     ->Unit(benchmark::kMillisecond)
     ->Iterations(2);
+
+}  // namespace
+}  // namespace kincal
 
 BENCHMARK_MAIN();

@@ -12,67 +12,18 @@ extern "C" {
 
 #include "data/error.h"
 #include "vision/edge_profile.h"
+#include "vision/image_lines.h"
 #include "vision/tag_family.h"
 
 namespace kincal {
 
-namespace {
-
-// Bilinear intensity at (x, y) in OpenCV pixel convention; the caller keeps
-// (x, y) at least one pixel inside the image.
-inline double Bilinear(const cv::Mat& gray, double x, double y) {
-  const int x0 = static_cast<int>(std::floor(x));
-  const int y0 = static_cast<int>(std::floor(y));
-  const double fx = x - x0;
-  const double fy = y - y0;
-  const uint8_t* r0 = gray.ptr<uint8_t>(y0) + x0;
-  const uint8_t* r1 = gray.ptr<uint8_t>(y0 + 1) + x0;
-  return (1 - fy) * ((1 - fx) * r0[0] + fx * r0[1]) +
-         fy * ((1 - fx) * r1[0] + fx * r1[1]);
-}
-
-inline bool Inside(const cv::Mat& gray, const Eigen::Vector2d& p,
-                   double margin) {
-  return p.x() >= margin && p.y() >= margin &&
-         p.x() <= gray.cols - 1 - margin && p.y() <= gray.rows - 1 - margin;
-}
-
-double Median(std::vector<double> v) {
-  if (v.empty()) return 0;
-  const size_t mid = v.size() / 2;
-  std::nth_element(v.begin(), v.begin() + mid, v.end());
-  return v[mid];
-}
-
-// A line n . x = c with |n| = 1.
-struct Line2 {
-  Eigen::Vector2d n;
-  double c;
-};
-
-// Total least squares line through points.
-Line2 FitLine(const std::vector<Eigen::Vector2d>& pts) {
-  Eigen::Vector2d mean = Eigen::Vector2d::Zero();
-  for (const auto& p : pts) mean += p;
-  mean /= static_cast<double>(pts.size());
-  Eigen::Matrix2d cov = Eigen::Matrix2d::Zero();
-  for (const auto& p : pts) cov += (p - mean) * (p - mean).transpose();
-  Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> es(cov);
-  const Eigen::Vector2d n = es.eigenvectors().col(0);  // smallest eigenvalue
-  return {n, n.dot(mean)};
-}
-
-bool Intersect(const Line2& a, const Line2& b, Eigen::Vector2d* p) {
-  Eigen::Matrix2d A;
-  A.row(0) = a.n.transpose();
-  A.row(1) = b.n.transpose();
-  const double det = A.determinant();
-  if (std::abs(det) < 1e-6) return false;
-  *p = A.inverse() * Eigen::Vector2d(a.c, b.c);
-  return true;
-}
-
-}  // namespace
+using image_lines::Bilinear;
+using image_lines::FitLine;
+using image_lines::Inside;
+using image_lines::Intersect;
+using image_lines::Line2;
+using image_lines::Median;
+using image_lines::SegmentsDistance;
 
 cv::Mat TagImage(const std::string& family, int id) {
   TagFamilyHandle f(family);
@@ -245,27 +196,6 @@ std::vector<TagDetection> AprilTagDetector::DetectInRegion(const cv::Mat& gray,
             });
   return out;
 }
-
-namespace {
-double SegmentDistance(const Eigen::Vector2d& p, const Eigen::Vector2d& a,
-                       const Eigen::Vector2d& b) {
-  const Eigen::Vector2d ab = b - a;
-  const double t = std::clamp((p - a).dot(ab) / ab.squaredNorm(), 0.0, 1.0);
-  return (p - (a + t * ab)).norm();
-}
-double SegmentsDistance(const Eigen::Vector2d& a, const Eigen::Vector2d& b,
-                        const Eigen::Vector2d& c, const Eigen::Vector2d& d) {
-  // Segments that cross have distance 0.
-  auto cross = [](const Eigen::Vector2d& u, const Eigen::Vector2d& v) {
-    return u.x() * v.y() - u.y() * v.x();
-  };
-  const double d1 = cross(b - a, c - a), d2 = cross(b - a, d - a);
-  const double d3 = cross(d - c, a - c), d4 = cross(d - c, b - c);
-  if (((d1 > 0) != (d2 > 0)) && ((d3 > 0) != (d4 > 0))) return 0.0;
-  return std::min({SegmentDistance(a, c, d), SegmentDistance(b, c, d),
-                   SegmentDistance(c, a, b), SegmentDistance(d, a, b)});
-}
-}  // namespace
 
 namespace {
 
