@@ -47,6 +47,7 @@ TEST(TipUncertainty, MatchesMonteCarloForOneAndTwoCameras) {
   double depth_sigma[2] = {0, 0};
   ToolPoseOptions options;
   options.outlier_px = 100;  // keep every observation (Gaussian noise only)
+  options.hard_outlier_px = 100;
   options.corner_outlier_px = 100;
   for (int nc = 1; nc <= 2; ++nc) {
     std::mt19937_64 rng(17 + nc);
