@@ -156,9 +156,10 @@ TEST(Bundle, OneTwoAndThreeCamerasHonestSigmaAndTipsWithinTwiceStereo) {
     }
     const double rms_z = std::sqrt(sum_z2 / n);
     tip_rms[cameras] = std::sqrt(sum_tip2 / seeds);
-    std::printf("%d camera(s): RMS z %.3f over %d parameters, tips at fresh "
-                "poses %.4f mm\n",
-                cameras, rms_z, n, tip_rms[cameras]);
+    std::printf(
+        "%d camera(s): RMS z %.3f over %d parameters, tips at fresh "
+        "poses %.4f mm\n",
+        cameras, rms_z, n, tip_rms[cameras]);
     EXPECT_GT(rms_z, 0.7) << cameras << " camera(s)";
     EXPECT_LT(rms_z, 1.4) << cameras << " camera(s)";
     EXPECT_LT(tip_rms[cameras], 0.10) << cameras << " camera(s)";

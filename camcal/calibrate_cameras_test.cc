@@ -209,9 +209,10 @@ TEST(CalibrateCameras, ThreeCamerasConnectThroughAChainOfSharedViews) {
     const double t_err = (est.t - truth.t).norm();
     const double r_err =
         Eigen::AngleAxisd(est.R * truth.R.transpose()).angle() * 180 / M_PI;
-    std::printf("camera %d: %.3f mm, %.4f deg (camera 1 sigma %.3f mm, "
-                "%.4f deg)\n",
-                c, t_err, r_err, sigma_mm, sigma_deg);
+    std::printf(
+        "camera %d: %.3f mm, %.4f deg (camera 1 sigma %.3f mm, "
+        "%.4f deg)\n",
+        c, t_err, r_err, sigma_mm, sigma_deg);
     EXPECT_LT(t_err, 4 * c * std::sqrt(3.0) * sigma_mm) << "camera " << c;
     EXPECT_LT(r_err, 4 * c * std::sqrt(3.0) * sigma_deg) << "camera " << c;
   }
