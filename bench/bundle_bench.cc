@@ -39,10 +39,9 @@ const SyntheticBundle& Data(int frames, int cameras = 2) {
   return it->second;
 }
 
-void BM_Bundle(benchmark::State& state) {
-  const SyntheticBundle& s = Data(static_cast<int>(state.range(0)));
-  BundleOptions o;
-  o.refine_cameras = state.range(1) != 0;
+// Times RunBundle on `s` and reports the problem's size and fit.
+void TimeBundle(benchmark::State& state, const SyntheticBundle& s,
+                const BundleOptions& o) {
   BundleResult r;
   for (auto _ : state) {
     r = RunBundle(s.nominal, s.rig, s.target, s.frames, o);
@@ -53,9 +52,16 @@ void BM_Bundle(benchmark::State& state) {
     corners += static_cast<int>(f.corners.size());
   }
   state.counters["frames"] = static_cast<double>(s.frames.size());
+  state.counters["cameras"] = static_cast<double>(s.rig.cameras.size());
   state.counters["corners"] = corners;
   state.counters["reproj_px"] = r.reproj_rms_px;
   state.counters["iterations"] = r.iterations;
+}
+
+void BM_Bundle(benchmark::State& state) {
+  BundleOptions o;
+  o.refine_cameras = state.range(1) != 0;
+  TimeBundle(state, Data(static_cast<int>(state.range(0))), o);
 }
 BENCHMARK(BM_Bundle)
     ->Args({125, 0})
@@ -70,22 +76,10 @@ BENCHMARK(BM_Bundle)
 // the stereo pair and "top", synth/rig_placement.h). Target: 500 frames x 3
 // cameras <= 3 s, linear in frames.
 void BM_BundleCameras(benchmark::State& state) {
-  const SyntheticBundle& s =
-      Data(static_cast<int>(state.range(0)), static_cast<int>(state.range(1)));
-  BundleOptions o;
-  BundleResult r;
-  for (auto _ : state) {
-    r = RunBundle(s.nominal, s.rig, s.target, s.frames, o);
-    benchmark::DoNotOptimize(r);
-  }
-  int corners = 0;
-  for (const BundleFrame& f : s.frames) {
-    corners += static_cast<int>(f.corners.size());
-  }
-  state.counters["frames"] = static_cast<double>(s.frames.size());
-  state.counters["cameras"] = static_cast<double>(s.rig.cameras.size());
-  state.counters["corners"] = corners;
-  state.counters["reproj_px"] = r.reproj_rms_px;
+  TimeBundle(
+      state,
+      Data(static_cast<int>(state.range(0)), static_cast<int>(state.range(1))),
+      BundleOptions());
 }
 BENCHMARK(BM_BundleCameras)
     ->Args({250, 1})

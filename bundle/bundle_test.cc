@@ -21,6 +21,22 @@ Robot Bh7() {
   return ReadRobotYaml(testing::SourceDir() + "/data/robots/bh7.yaml");
 }
 
+// Adds, over the bundle's parameters, ((estimate - truth) / sigma)^2 to
+// `sum_z2` and their count to `n` (every sigma must be finite).
+void AddSquaredErrorOverSigma(const Robot& true_robot, const BundleResult& r,
+                              double* sum_z2, int* n) {
+  ModelState truth;
+  truth.chain = Chain::FromRobot(true_robot);
+  for (const BundleParam& p : r.params) {
+    const ParamInfo info = FindParam(truth, p.name);
+    const double t = info.ToInterface(ParamValue(truth, info));
+    EXPECT_TRUE(std::isfinite(p.sigma)) << p.name;
+    const double z = (p.value - t) / p.sigma;
+    *sum_z2 += z * z;
+    ++*n;
+  }
+}
+
 TEST(HandEye, RecoversBothTransformsFromExactPoses) {
   std::mt19937_64 rng(3);
   std::normal_distribution<double> n(0, 1);
@@ -98,16 +114,7 @@ TEST(Bundle, ReportedSigmaMatchesTheSpreadOverSeeds) {
     BundleOptions o;
     o.holdout_fraction = 0.0;
     const BundleResult r = RunBundle(s.nominal, s.rig, s.target, s.frames, o);
-    ModelState truth;
-    truth.chain = Chain::FromRobot(s.truth);
-    for (const BundleParam& p : r.params) {
-      const ParamInfo info = FindParam(truth, p.name);
-      const double t = info.ToInterface(ParamValue(truth, info));
-      ASSERT_TRUE(std::isfinite(p.sigma)) << p.name;
-      const double z = (p.value - t) / p.sigma;
-      sum_z2 += z * z;
-      ++n;
-    }
+    AddSquaredErrorOverSigma(s.truth, r, &sum_z2, &n);
   }
   ASSERT_GT(n, 20);
   const double rms_z = std::sqrt(sum_z2 / n);
@@ -141,16 +148,7 @@ TEST(Bundle, OneTwoAndThreeCamerasHonestSigmaAndTipsWithinTwiceStereo) {
       BundleOptions o;
       o.holdout_fraction = 0.0;
       const BundleResult r = RunBundle(s.nominal, s.rig, s.target, s.frames, o);
-      ModelState truth;
-      truth.chain = Chain::FromRobot(s.truth);
-      for (const BundleParam& p : r.params) {
-        const ParamInfo info = FindParam(truth, p.name);
-        const double t = info.ToInterface(ParamValue(truth, info));
-        ASSERT_TRUE(std::isfinite(p.sigma)) << p.name;
-        const double z = (p.value - t) / p.sigma;
-        sum_z2 += z * z;
-        ++n;
-      }
+      AddSquaredErrorOverSigma(s.truth, r, &sum_z2, &n);
       const double tip = TipRmsAgainstTruth(s, r.calibrated, 100, 9);
       sum_tip2 += tip * tip;
     }

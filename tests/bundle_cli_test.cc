@@ -11,6 +11,7 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
+#include "tests/testing/fresh_poses.h"
 #include "tests/testing/paths.h"
 #include "tests/testing/run.h"
 
@@ -20,28 +21,6 @@ namespace {
 using ::testing::HasSubstr;
 
 std::string Bh7() { return SourceDir() + "/data/robots/bh7.yaml"; }
-
-// Rows `skip`.. of an observations.csv (the first `skip` poses are the ones
-// that were rendered; the rest are fresh poses of the same true robot).
-void KeepRowsFrom(const std::string& in, const std::string& out, int skip) {
-  std::ifstream f(in);
-  std::ostringstream os;
-  std::string line;
-  int row = -1;
-  while (std::getline(f, line)) {
-    if (!line.empty() && line[0] == '#') continue;
-    if (row < 0 || row >= skip) os << line << "\n";
-    ++row;
-  }
-  std::ofstream(out) << os.str();
-}
-
-double EvaluateRms(const std::string& robot, const std::string& obs) {
-  const RunResult r =
-      RunKincal("evaluate --robot " + robot + " --obs " + obs + " --json");
-  EXPECT_EQ(r.exit_code, 0) << r.err;
-  return nlohmann::json::parse(r.out)["rms_mm"].get<double>();
-}
 
 std::string Simulate(const std::string& dir, int poses, int seed,
                      const std::string& extra = "") {

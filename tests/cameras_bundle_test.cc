@@ -12,6 +12,7 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
+#include "tests/testing/fresh_poses.h"
 #include "tests/testing/paths.h"
 #include "tests/testing/run.h"
 
@@ -19,28 +20,6 @@ namespace kincal::testing {
 namespace {
 
 std::string Bh7() { return SourceDir() + "/data/robots/bh7.yaml"; }
-
-// Rows `skip`.. of an observations.csv (the first `skip` poses are the
-// rendered ones; the rest are fresh poses of the same true robot).
-void KeepRowsFrom(const std::string& in, const std::string& out, int skip) {
-  std::ifstream f(in);
-  std::ostringstream os;
-  std::string line;
-  int row = -1;
-  while (std::getline(f, line)) {
-    if (!line.empty() && line[0] == '#') continue;
-    if (row < 0 || row >= skip) os << line << "\n";
-    ++row;
-  }
-  std::ofstream(out) << os.str();
-}
-
-double EvaluateRms(const std::string& robot, const std::string& obs) {
-  const RunResult r =
-      RunKincal("evaluate --robot " + robot + " --obs " + obs + " --json");
-  EXPECT_EQ(r.exit_code, 0) << r.err;
-  return nlohmann::json::parse(r.out)["rms_mm"].get<double>();
-}
 
 constexpr int kPoses = 120;
 constexpr int kSeed = 7;

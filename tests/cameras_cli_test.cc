@@ -20,30 +20,16 @@
 #include "data/atomic_file.h"
 #include "synth/recorded_session.h"
 #include "synth/render.h"
+#include "tests/testing/csv_rows.h"
 #include "tests/testing/paths.h"
 #include "tests/testing/run.h"
 
 namespace kincal {
 namespace {
 
+using testing::ReadCsvRows;
 using testing::RunKincal;
 using testing::RunResult;
-
-std::vector<std::vector<std::string>> ReadCsvRows(const std::string& path) {
-  std::vector<std::vector<std::string>> rows;
-  std::ifstream in(path);
-  std::string line;
-  while (std::getline(in, line)) {
-    if (line.empty() || line[0] == '#') continue;
-    std::vector<std::string> fields;
-    std::stringstream ss(line);
-    std::string f;
-    while (std::getline(ss, f, ',')) fields.push_back(f);
-    if (line.back() == ',') fields.push_back("");
-    rows.push_back(fields);
-  }
-  return rows;
-}
 
 // ExampleStereoRig and a third camera "top" 120 mm above the first, turned
 // down towards the tool (about 450 mm away).

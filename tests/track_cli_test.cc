@@ -13,30 +13,16 @@
 #include "camcal/rig.h"
 #include "data/atomic_file.h"
 #include "synth/render.h"
+#include "tests/testing/csv_rows.h"
 #include "tests/testing/paths.h"
 #include "tests/testing/run.h"
 
 namespace kincal {
 namespace {
 
+using testing::ReadCsvRows;
 using testing::RunKincal;
 using testing::RunResult;
-
-std::vector<std::vector<std::string>> ReadCsvRows(const std::string& path) {
-  std::vector<std::vector<std::string>> rows;
-  std::ifstream in(path);
-  std::string line;
-  while (std::getline(in, line)) {
-    if (line.empty() || line[0] == '#') continue;
-    std::vector<std::string> fields;
-    std::stringstream ss(line);
-    std::string f;
-    while (std::getline(ss, f, ',')) fields.push_back(f);
-    if (!line.empty() && line.back() == ',') fields.push_back("");
-    rows.push_back(fields);
-  }
-  return rows;
-}
 
 class TrackCli : public ::testing::Test {
  protected:
