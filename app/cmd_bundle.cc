@@ -107,9 +107,11 @@ std::vector<std::string> ExpandExtensions(const Robot& robot,
   return out;
 }
 
-// --out-obs: the needle tip the cameras saw at each frame's joint readings
-// (pose refitted on the refined rig when cameras were refined); empty where
-// the pose misses the quality gate.
+// --out-obs: the point the tool row ends at as the cameras saw it at each
+// frame's joint readings (MeasuredPoint: the needle tip in the rig frame, or
+// with the cameras on the flange the rig origin in the target frame; pose
+// refitted on the refined rig when cameras were refined); empty where the
+// pose misses the quality gate.
 std::string TrackedTipsCsv(const BundleArgs& args, const Robot& robot,
                            const Target& target, const Session& session,
                            const SessionObservations& obs,
@@ -135,15 +137,20 @@ std::string TrackedTipsCsv(const BundleArgs& args, const Robot& robot,
         p.rms_px <= args.max_reproj_px &&
         SeenByEnoughCameras(f, static_cast<int>(r.rig.cameras.size()))) {
       o.has_point = true;
-      o.p_in_meas = p.rig_from_tool * target.tip_in_tool;
+      o.p_in_meas = MeasuredPoint(r.mount, target, p.rig_from_tool);
       ++*points;
     }
     out.rows.push_back(o);
   }
+  const std::string what =
+      r.mount == RigMount::kFlange
+          ? "rig origins (reference camera's optical centre) seen by the "
+            "cameras on the flange (fixed target's frame, mm)"
+          : "needle tips seen by the cameras (rig frame, mm)";
   return FormatObservationsCsv(
-      out, {"needle tips seen by the cameras (rig frame, mm) at the "
-            "session's joint readings; empty where only one camera saw "
-            "the tool, or its pose used fewer than " +
+      out, {what +
+            " at the session's joint readings; empty where only one camera "
+            "of several saw the target, or its pose used fewer than " +
             std::to_string(args.min_tags) + " tags or fit worse than " +
             FormatDouble(args.max_reproj_px) + " px"});
 }
@@ -245,7 +252,7 @@ nlohmann::json NotDeterminedJson(const Rig& rig) {
         {{"what", "scale"},
          {"why",
           "one camera sees directions only: every length (the robot's, "
-          "rig_from_base's translation) rests on target.yaml's tag sizes; a "
+          "the frames' translations) rests on target.yaml's tag sizes; a "
           "wrong tag size scales them all and no image can show it"}});
   } else {
     out.push_back(
@@ -255,15 +262,24 @@ nlohmann::json NotDeterminedJson(const Rig& rig) {
           "together; a disagreement between them shows as reprojection "
           "error, not as a scale"}});
   }
-  out.push_back({{"what", "tool beyond the target"},
-                 {"why",
-                  "the images see the tags, not the tip: the tool row ends at "
-                  "target.yaml's tip_in_tool as measured by `kincal target`"}});
+  if (rig.mount == RigMount::kFlange) {
+    out.push_back(
+        {{"what", "tool beyond the rig"},
+         {"why",
+          "the images place the cameras, not a tool: the tool row ends at the "
+          "rig origin (the reference camera's optical centre)"}});
+  } else {
+    out.push_back(
+        {{"what", "tool beyond the target"},
+         {"why",
+          "the images see the tags, not the tip: the tool row ends at "
+          "target.yaml's tip_in_tool as measured by `kincal target`"}});
+  }
   return out;
 }
 
 nlohmann::json SummaryJson(const BundleArgs& args, const Target& target,
-                           const BundleRun& run) {
+                           const BundleRun& run, const Warnings& warnings) {
   const BundleResult& r = run.result;
   nlohmann::json params = nlohmann::json::array();
   for (const BundleParam& p : r.params) {
@@ -300,8 +316,13 @@ nlohmann::json SummaryJson(const BundleArgs& args, const Target& target,
     j["extensions"] = extensions;
     j["findings"] = FindingsJson(extensions);
   }
-  j["rig_from_base"] = PoseBlockJson(r.rig_from_base);
-  j["flange_from_target"] = PoseBlockJson(r.flange_from_tool);
+  if (r.mount == RigMount::kFlange) {
+    j["flange_from_rig"] = PoseBlockJson(r.flange_from_rig);
+    j["base_from_target"] = PoseBlockJson(r.base_from_target);
+  } else {
+    j["rig_from_base"] = PoseBlockJson(r.rig_from_base);
+    j["flange_from_target"] = PoseBlockJson(r.flange_from_tool);
+  }
   j["refine_cameras"] = args.options.refine_cameras;
   if (run.cross_validation) {
     const BundleCrossValidation& cv = *run.cross_validation;
@@ -310,6 +331,7 @@ nlohmann::json SummaryJson(const BundleArgs& args, const Target& target,
                   {"heldout_tip_rms_mm", cv.heldout_tip_rms_mm},
                   {"heldout_tips", cv.heldout_tips}};
   }
+  AddWarnings(warnings, &j);
   j["termination"] = r.termination;
   j["iterations"] = r.iterations;
   j["detect_seconds"] = run.obs.seconds;
@@ -381,14 +403,14 @@ int RunBundleCommand(BundleArgs args) {
   const Robot robot = ReadRobot(args.robot);
   const Rig rig = ReadRigYaml(args.rig);
   const Target target = ReadTargetYaml(args.target);
-  if (rig.mount == RigMount::kFlange) {
-    // Not a silent solve of the wrong model: the stand's unknowns
-    // (rig_from_base, flange_from_target) do not describe this set-up.
-    throw std::runtime_error(
-        args.rig +
-        ": mount: flange (cameras on the flange, target fixed) is read but "
-        "the bundle solves only cameras on a stand (mount: world) so far; "
-        "nothing written");
+  Warnings warnings = CommandWarnings();
+  if (rig.mount == RigMount::kWorld && !target.has_tip) {
+    warnings.Add("target_without_tip",
+                 args.target + " has no tip_in_tool and " + args.rig +
+                     " puts the cameras on a stand (mount: world): the "
+                     "calibrated tool row ends at the target frame's origin. "
+                     "Measure the tip (`kincal target --pivot`), or set "
+                     "mount: flange if the cameras ride on the robot");
   }
   SessionReadOptions so;
   so.camera_names = rig.CameraNames();
@@ -437,7 +459,7 @@ int RunBundleCommand(BundleArgs args) {
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start)
           .count();
   if (args.json) {
-    PrintJson(SummaryJson(args, target, run));
+    PrintJson(SummaryJson(args, target, run, warnings));
   } else {
     PrintSummary(args, run);
   }
@@ -450,7 +472,9 @@ void AddBundleCommand(CLI::App& app, Runner* run) {
   auto args = std::make_shared<BundleArgs>();
   CLI::App* sub = app.add_subcommand("bundle", kBundleDescription);
   sub->add_option("--robot", args->robot, "robot.yaml (nominal)")->required();
-  sub->add_option("--rig", args->rig, "rig.yaml (2 cameras)")->required();
+  sub->add_option("--rig", args->rig,
+                  "rig.yaml (1..N cameras; mount: world or flange)")
+      ->required();
   sub->add_option("--target", args->target, "target.yaml")->required();
   sub->add_option("--session", args->session,
                   "recorded session folder (left/, right/, frames.csv with "

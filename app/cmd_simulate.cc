@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <iostream>
 #include <memory>
+#include <random>
 
 #include "app/app_util.h"
 #include "app/command.h"
@@ -14,6 +15,7 @@
 #include "data/provenance.h"
 #include "data/rigid3.h"
 #include "data/urdf.h"
+#include "synth/flange_scene.h"
 #include "synth/recorded_session.h"
 #include "synth/render.h"
 #include "synth/rig_placement.h"
@@ -21,6 +23,9 @@
 
 namespace kincal::app {
 namespace {
+
+// Cameras on the flange: the distance from the rig to the board.
+constexpr double kFlangeWorkingDistanceMm = 450.0;
 
 struct SimulateArgs {
   std::string robot, out, mode = "random", root, tip;
@@ -31,7 +36,18 @@ struct SimulateArgs {
   bool render = false;
   int render_width = 1280, render_height = 1024;
   int render_cameras = 2;  // 1, 2 or 3 (synth/rig_placement.h)
+  // world: the rig on a stand, the tool target on the flange; flange: the
+  // rig on the flange, a fixed board in the world (FlangeScene).
+  std::string render_mount = "world";
   RenderOptions render_options;
+};
+
+// Cameras on the flange: where the rig sits on the tool and the board in
+// the base, both hidden from the bundle (truth.json has them).
+struct FlangeScene {
+  bool on = false;
+  Rigid3 tip_from_rig;  // the rig origin at the true tool row's end
+  Rigid3 base_from_board;
 };
 
 // The simulation options of the command line (mode, effects, columns).
@@ -75,6 +91,77 @@ double PlaceRigAndScaleTool(const Robot& nominal, const Rig& rig,
   return rig_distance;
 }
 
+#ifndef KINCAL_FRONT_END
+// (bin/kincal renders nothing: it execs kincal-vision, app/front_end.h.)
+
+// The rig's hidden mounting on the flange, drawn from the seed: its origin
+// at the tool row's end (the tip frame's origin, so the true robot's tool
+// row ends at the rig origin, as the spec has the calibrated one end), its
+// optical axis tilted 0..20 deg from the tip frame's z, any roll.
+Rigid3 DrawFlangeMounting(uint64_t seed) {
+  std::mt19937_64 rng(seed ^ 0x5eedf1a9e5ull);
+  std::normal_distribution<double> n(0.0, 1.0);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  const Eigen::Vector3d axis =
+      Eigen::Vector3d(n(rng), n(rng), 0.0).normalized();
+  const double tilt = 20.0 * u(rng) * M_PI / 180.0;
+  const double roll = 2.0 * M_PI * u(rng);
+  Rigid3 r;
+  r.R = (Eigen::AngleAxisd(tilt, axis) *
+         Eigen::AngleAxisd(roll, Eigen::Vector3d::UnitZ()))
+            .toRotationMatrix();
+  return r;
+}
+
+// Cameras on the flange: a 5 x 4 AprilGrid board (tags ~50 px wide at the
+// working distance) placed where the reference camera sees it on most of
+// the seed's random poses (80x --poses drawn, same truth), turned about its
+// normal by a seeded angle; the session keeps the first --poses that see
+// half its tags, and its measuring frame is the board's (observations.csv
+// then holds the rig origins in the board frame, what `track` measures).
+FlangeScene PlaceFlangeBoard(const Robot& nominal, const Rig& rig,
+                             double distance_mm, SimulateOptions* opt,
+                             Target* board) {
+  AprilGrid grid;
+  grid.cols = 5;
+  grid.rows = 4;
+  grid.tag_size_mm = 50.0 * distance_mm / rig.cameras.at(0).intrinsics.fx;
+  *board = grid.AsTarget();
+  board->has_tip = false;
+  FlangeScene scene;
+  scene.on = true;
+  scene.tip_from_rig = DrawFlangeMounting(opt->seed);
+  SimulateOptions candidates = *opt;
+  candidates.poses = 80 * opt->poses;
+  candidates.effects.clear();
+  const SimulatedSession all = Simulate(nominal, candidates);
+  FlangeBoardPlacement place = PlaceBoardForFlangeRig(
+      all.base_from_tip, rig, scene.tip_from_rig, *board, distance_mm,
+      static_cast<int>(board->tags.size()) / 2);
+  if (static_cast<int>(place.seen.size()) < opt->poses) {
+    throw InputError("--render-mount flange: only " +
+                     std::to_string(place.seen.size()) + " of " +
+                     std::to_string(candidates.poses) +
+                     " random poses see the board; ask for fewer --poses");
+  }
+  // Turn the board about its normal through its centre (the first pass
+  // placed it; a turn keeps what each camera sees nearly the same).
+  const double turn = (opt->seed % 360) * M_PI / 180.0;
+  const Eigen::Vector3d centre(
+      0.5 * grid.cols * grid.tag_size_mm * (1 + grid.spacing_ratio),
+      0.5 * grid.rows * grid.tag_size_mm * (1 + grid.spacing_ratio), 0.0);
+  Rigid3 spin;
+  spin.R = Eigen::AngleAxisd(turn, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  spin.t = centre - spin.R * centre;
+  scene.base_from_board = place.base_from_board * spin;
+  for (int k = 0; k < opt->poses; ++k) {
+    opt->readings.push_back(all.observations.rows[place.seen[k]].q);
+  }
+  opt->meas_from_base = PoseBlockFromRigid3(scene.base_from_board.Inverse());
+  return scene;
+}
+#endif  // KINCAL_FRONT_END
+
 nlohmann::json EffectsJson(const SimulatedSession& s) {
   nlohmann::json effects = nlohmann::json::array();
   for (size_t i = 0; i < s.effects.size(); ++i) {
@@ -88,10 +175,17 @@ nlohmann::json EffectsJson(const SimulatedSession& s) {
   return effects;
 }
 
+nlohmann::json PoseJson(const Rigid3& r) {
+  const Eigen::Vector3d w = RotationVectorFromMatrix(r.R) * 180 / M_PI;
+  return {{"rotation_vector_deg", {w.x(), w.y(), w.z()}},
+          {"t_mm", {r.t.x(), r.t.y(), r.t.z()}}};
+}
+
 // truth.json: the seed, effects, measuring frame and true parameters, for
-// tests and for judging a diagnosis.
+// tests and for judging a diagnosis; with the cameras on the flange also
+// the true flange_from_rig and base_from_target.
 nlohmann::json TruthJson(const SimulatedSession& s, const SimulateOptions& opt,
-                         const std::string& mode) {
+                         const std::string& mode, const FlangeScene& scene) {
   nlohmann::json truth;
   truth["command"] = CommandLine();
   truth["seed"] = opt.seed;
@@ -112,6 +206,15 @@ nlohmann::json TruthJson(const SimulatedSession& s, const SimulateOptions& opt,
     params[p.name] = p.ToInterface(ParamValue(truth_state, p));
   }
   truth["parameters"] = params;
+  if (scene.on) {
+    const Chain chain = Chain::FromRobot(s.truth);
+    const ChainRow& tool = chain.rows[chain.tool_row()];
+    const Rigid3 flange_from_tip = Rigid3::FromMatrix(
+        RowTransform<double>(chain.convention, tool, tool.p.data(), 0.0));
+    truth["mount"] = "flange";
+    truth["flange_from_rig"] = PoseJson(flange_from_tip * scene.tip_from_rig);
+    truth["base_from_target"] = PoseJson(scene.base_from_board);
+  }
   return truth;
 }
 
@@ -120,17 +223,18 @@ nlohmann::json TruthJson(const SimulatedSession& s, const SimulateOptions& opt,
 // Returns the frames rendered.
 int WriteRenderedSession(const SimulateArgs& args, const Robot& nominal,
                          const SimulatedSession& s, const Rig& rig,
-                         const Target& target) {
-  const Rigid3 tip_from_tool = TipFromTool(target);
-  const Rigid3 rig_from_base{
-      RotationMatrixFromVector(Eigen::Vector3d(
-          s.meas_from_base[0], s.meas_from_base[1], s.meas_from_base[2])),
-      Eigen::Vector3d(s.meas_from_base[3], s.meas_from_base[4],
-                      s.meas_from_base[5])};
+                         const Target& target, const FlangeScene& scene) {
   RecordedSessionInput in;
   for (const Eigen::Matrix4d& m : s.base_from_tip) {
-    in.rig_from_tool.push_back(rig_from_base * Rigid3::FromMatrix(m) *
-                               tip_from_tool);
+    const Rigid3 base_from_tip = Rigid3::FromMatrix(m);
+    if (scene.on) {  // rig_from_board
+      in.rig_from_tool.push_back(
+          (base_from_tip * scene.tip_from_rig).Inverse() *
+          scene.base_from_board);
+    } else {  // rig_from_base * base_from_tip * tip_from_tool
+      in.rig_from_tool.push_back(Rigid3FromPoseBlock(s.meas_from_base.data()) *
+                                 base_from_tip * TipFromTool(target));
+    }
   }
   in.joint_names = nominal.JointNames();
   for (const Observation& row : s.observations.rows) {
@@ -199,18 +303,28 @@ int RunSimulate(SimulateArgs args) {
   Target target = ExampleTarget();
 #endif
   double rig_distance = 0.0;
+  FlangeScene scene;
+  Rig rendered_rig = rig;
   if (args.render) {
     args.render_options.motion_angle_deg = 30.0;
 #ifndef KINCAL_FRONT_END
     args.render_options.Check();
 #endif
-    rig_distance = PlaceRigAndScaleTool(nominal, rig, &opt, &target);
+    if (args.render_mount == "flange") {
+      rig_distance = kFlangeWorkingDistanceMm;
+      rendered_rig = RigWithCameras(rig, args.render_cameras, rig_distance);
+      rendered_rig.mount = RigMount::kFlange;
+#ifndef KINCAL_FRONT_END
+      scene =
+          PlaceFlangeBoard(nominal, rendered_rig, rig_distance, &opt, &target);
+#endif
+    } else {
+      rig_distance = PlaceRigAndScaleTool(nominal, rig, &opt, &target);
+      rendered_rig = RigWithCameras(rig, args.render_cameras, rig_distance);
+    }
   }
-  const Rig rendered_rig =
-      args.render ? RigWithCameras(rig, args.render_cameras, rig_distance)
-                  : rig;
   const SimulatedSession s = Simulate(nominal, opt);
-  const nlohmann::json truth = TruthJson(s, opt, args.mode);
+  const nlohmann::json truth = TruthJson(s, opt, args.mode, scene);
 
   const std::vector<std::string> comment = {
       "simulated session, seed " + std::to_string(opt.seed) +
@@ -222,8 +336,9 @@ int RunSimulate(SimulateArgs args) {
   const std::string obs_text = FormatObservationsCsv(s.observations, comment);
   MakeDirs(args.out);
   const int rendered =
-      args.render ? WriteRenderedSession(args, nominal, s, rendered_rig, target)
-                  : 0;
+      args.render
+          ? WriteRenderedSession(args, nominal, s, rendered_rig, target, scene)
+          : 0;
   WriteFileAtomic(args.out + "/robot.yaml", robot_text);
   WriteFileAtomic(args.out + "/truth_robot.yaml", truth_robot_text);
   WriteFileAtomic(args.out + "/observations.csv", obs_text);
@@ -290,6 +405,14 @@ void AddSimulateCommand(CLI::App& app, Runner* run) {
                   "(left, right) or 3 (and 'top', 120 mm above left, turned "
                   "down to the workspace)")
       ->check(CLI::Range(1, 3))
+      ->capture_default_str();
+  sub->add_option("--render-mount", args->render_mount,
+                  "where the rendered cameras are: world (on a stand, the "
+                  "tool target on the flange) or flange (on the flange at a "
+                  "hidden mounting, 450 mm from a fixed AprilGrid board at a "
+                  "hidden pose; observations.csv then holds the rig origins "
+                  "in the board frame)")
+      ->check(CLI::IsMember({"world", "flange"}))
       ->capture_default_str();
   sub->add_option("--render-height", args->render_height, "image height, px")
       ->capture_default_str();

@@ -37,8 +37,9 @@ inline constexpr char kCaptureDescription[] =
 inline constexpr char kBundleDescription[] =
     "Calibrate the robot from a recorded session's images: one Ceres problem "
     "over every tag corner in every camera at every frame with joint readings "
-    "(robot parameters, base in the rig, target on the flange, optionally the "
-    "cameras)";
+    "(robot parameters, base in the rig and target on the flange, or with "
+    "rig.yaml mount: flange the rig on the flange and the fixed target in the "
+    "base; optionally the cameras)";
 inline constexpr char kTargetDescription[] =
     "Measure a tool target from a recorded session of the tool: the tag "
     "poses from one bundle over every tag corner, the needle tip by pivot "

@@ -32,15 +32,22 @@ using Mat3T = Eigen::Matrix<T, 3, 3>;
 // The parameter blocks of the whole problem.
 struct State {
   Chain chain;  // rows[j].p and joint_errors[j] are parameter blocks
-  std::array<double, 6> rig_from_base{};
-  std::array<double, 6> flange_from_tool{};
+  // rig_from_tool = rig_side * M(q) * tool_side (bundle.h): rig_from_base
+  // and flange_from_tool on a stand; rig_from_flange and base_from_target
+  // with the cameras on the flange (`flange`, M inverted).
+  bool flange = false;
+  std::array<double, 6> rig_side{};
+  std::array<double, 6> tool_side{};
   std::vector<std::array<double, kNumIntrinsics>> intrinsics;
   std::vector<std::array<double, 6>> cam_from_rig;
 };
 
 // All corners of one frame f (every camera c), 2 residuals per corner i:
-//   e_i = ProjectPoint(intrinsics_c, cam_from_rig_c * rig_from_base *
-//                      base_from_flange(q_f) * flange_from_tool * X_i) - u_i
+//   e_i = ProjectPoint(intrinsics_c, cam_from_rig_c * A * M(q_f) * B * X_i)
+//         - u_i
+// with A, M, B as in bundle.h: on a stand A = rig_from_base, M =
+// base_from_flange, B = flange_from_tool; on the flange A = rig_from_flange,
+// M = flange_from_base = base_from_flange^-1, B = base_from_target;
 //   r_i = e_i                                 if |e_i| <= h
 //   r_i = e_i * sqrt(2 h |e_i| - h^2) / |e_i|  otherwise (h = huber_px),
 // so |r_i|^2 = rho(|e_i|^2), Huber's loss per corner, and the frame's cost
@@ -50,12 +57,14 @@ struct State {
 class FrameCost {
  public:
   FrameCost(const Chain* chain, const PoseInput* input, bool with_errors,
-            int num_cameras, std::vector<Eigen::Vector3d> points_in_tool,
+            bool flange, int num_cameras,
+            std::vector<Eigen::Vector3d> points_in_tool,
             std::vector<int> cameras, std::vector<Eigen::Vector2d> pixels,
             double huber_px)
       : chain_(chain),
         input_(input),
         with_errors_(with_errors),
+        flange_(flange),
         num_cameras_(num_cameras),
         points_(std::move(points_in_tool)),
         cameras_(std::move(cameras)),
@@ -65,13 +74,13 @@ class FrameCost {
   // The cost function over `block_sizes` (the layout below), 2 residuals per
   // corner.
   static ceres::CostFunction* Create(
-      const Chain* chain, const PoseInput* input, bool with_errors,
+      const Chain* chain, const PoseInput* input, bool with_errors, bool flange,
       int num_cameras, const std::vector<int>& block_sizes,
       std::vector<Eigen::Vector3d> points_in_tool, std::vector<int> cameras,
       std::vector<Eigen::Vector2d> pixels, double huber_px) {
     const int num_residuals = 2 * static_cast<int>(points_in_tool.size());
     auto* cost = new ceres::DynamicAutoDiffCostFunction<FrameCost, kStride>(
-        new FrameCost(chain, input, with_errors, num_cameras,
+        new FrameCost(chain, input, with_errors, flange, num_cameras,
                       std::move(points_in_tool), std::move(cameras),
                       std::move(pixels), huber_px));
     for (int size : block_sizes) cost->AddParameterBlock(size);
@@ -79,7 +88,7 @@ class FrameCost {
     return cost;
   }
 
-  // Blocks: rows[0..J-1] (6), rig_from_base (6), flange_from_tool (6),
+  // Blocks: rows[0..J-1] (6), A (6), B (6),
   // [joint errors 0..J-1 (9)], per camera: intrinsics (12), cam_from_rig (6).
   template <typename T>
   bool operator()(T const* const* p, T* residuals) const {
@@ -94,13 +103,17 @@ class FrameCost {
     for (int j = 0; j < nj; ++j) {
       m = m * RowTransform(chain_->convention, chain_->rows[j], p[j], q[j]);
     }
-    // rig_from_tool = rig_from_base * base_from_flange * flange_from_tool.
+    // rig_from_tool = A * M * B, M = base_from_flange or its inverse.
     const Mat3T<T> r_rb = RotationMatrixFromVectorT(p[nj]);
     const Mat3T<T> r_ft = RotationMatrixFromVectorT(p[nj + 1]);
     const Vec3<T> t_rb(p[nj][3], p[nj][4], p[nj][5]);
     const Vec3<T> t_ft(p[nj + 1][3], p[nj + 1][4], p[nj + 1][5]);
-    const Mat3T<T> r_bf = m.template block<3, 3>(0, 0);
-    const Vec3<T> t_bf = m.template block<3, 1>(0, 3);
+    Mat3T<T> r_bf = m.template block<3, 3>(0, 0);
+    Vec3<T> t_bf = m.template block<3, 1>(0, 3);
+    if (flange_) {
+      r_bf.transposeInPlace();
+      t_bf = -(r_bf * t_bf);
+    }
     const Mat3T<T> r_rf = r_rb * r_bf;
     const Vec3<T> t_rf = r_rb * t_bf + t_rb;
     const Mat3T<T> r_rt = r_rf * r_ft;
@@ -140,6 +153,7 @@ class FrameCost {
   const Chain* const chain_;
   const PoseInput* const input_;
   const bool with_errors_;
+  const bool flange_;
   const int num_cameras_;
   const std::vector<Eigen::Vector3d> points_;
   const std::vector<int> cameras_;
@@ -153,7 +167,7 @@ struct Freedom {
   std::vector<std::vector<int>> row_free;
   // Per joint: error-model indices that are free.
   std::vector<std::vector<int>> error_free;
-  bool frames = true;  // rig_from_base, flange_from_tool
+  bool frames = true;  // the two frames A and B
   bool cameras = false;
   bool with_errors = false;  // error blocks present in the residuals
 };
@@ -203,9 +217,9 @@ Built Build(State* st, const std::vector<Obs>& obs,
     params.push_back(st->chain.rows[j].p.data());
     sizes.push_back(kRowBlockSize);
   }
-  params.push_back(st->rig_from_base.data());
+  params.push_back(st->rig_side.data());
   sizes.push_back(6);
-  params.push_back(st->flange_from_tool.data());
+  params.push_back(st->tool_side.data());
   sizes.push_back(6);
   if (fr.with_errors) {
     for (int j = 0; j < nj; ++j) {
@@ -220,9 +234,9 @@ Built Build(State* st, const std::vector<Obs>& obs,
     sizes.push_back(6);
   }
   for (const Obs& o : obs) {
-    ceres::CostFunction* cost =
-        FrameCost::Create(&st->chain, &inputs[o.index], fr.with_errors, ncam,
-                          sizes, o.points, o.cameras, o.pixels, opt.huber_px);
+    ceres::CostFunction* cost = FrameCost::Create(
+        &st->chain, &inputs[o.index], fr.with_errors, st->flange, ncam, sizes,
+        o.points, o.cameras, o.pixels, opt.huber_px);
     b.blocks.push_back(problem->AddResidualBlock(cost, nullptr, params));
     b.residuals += 2 * static_cast<int>(o.points.size());
   }
@@ -235,8 +249,8 @@ Built Build(State* st, const std::vector<Obs>& obs,
     }
   }
   if (!fr.frames) {
-    problem->SetParameterBlockConstant(st->rig_from_base.data());
-    problem->SetParameterBlockConstant(st->flange_from_tool.data());
+    problem->SetParameterBlockConstant(st->rig_side.data());
+    problem->SetParameterBlockConstant(st->tool_side.data());
   }
   for (int c = 0; c < ncam; ++c) {
     double* intr = st->intrinsics[c].data();
@@ -479,9 +493,21 @@ bool HandEyeStart(const std::vector<Rigid3>& base_from_flange,
 
 Rigid3 ModelRigFromTool(const BundleResult& result, int index) {
   const bool errors = result.chain.HasJointErrors();
-  return Rigid3FromPoseBlock(result.rig_from_base.data()) *
-         BaseFromFlange(result.chain, result.inputs.at(index), errors) *
+  const Rigid3 base_from_flange =
+      BaseFromFlange(result.chain, result.inputs.at(index), errors);
+  if (result.mount == RigMount::kFlange) {
+    return Rigid3FromPoseBlock(result.flange_from_rig.data()).Inverse() *
+           base_from_flange.Inverse() *
+           Rigid3FromPoseBlock(result.base_from_target.data());
+  }
+  return Rigid3FromPoseBlock(result.rig_from_base.data()) * base_from_flange *
          Rigid3FromPoseBlock(result.flange_from_tool.data());
+}
+
+Eigen::Vector3d MeasuredPoint(RigMount mount, const Target& target,
+                              const Rigid3& rig_from_tool) {
+  if (mount == RigMount::kFlange) return rig_from_tool.Inverse().t;
+  return rig_from_tool * target.tip_in_tool;
 }
 
 namespace {
@@ -577,8 +603,9 @@ bool WellTracked(const BundleFrame& f, const BundleOptions& opt,
            !SeenByEnoughCameras(f, num_cameras));
 }
 
-// Start values of rig_from_base and flange_from_tool: hand-eye from the
-// well-tracked training frames with the nominal robot.
+// Start values of the two frames (rig_from_base and flange_from_tool, or
+// rig_from_flange and base_from_target): hand-eye from the well-tracked
+// training frames with the nominal robot.
 void StartFrames(const std::vector<BundleFrame>& frames,
                  const BundleResult& res, const BundleOptions& opt, State* st) {
   std::vector<Rigid3> bf, rt;
@@ -587,20 +614,24 @@ void StartFrames(const std::vector<BundleFrame>& frames,
     if (!WellTracked(f, opt, static_cast<int>(res.rig.cameras.size()))) {
       continue;
     }
-    bf.push_back(BaseFromFlange(st->chain, res.inputs[i], false));
+    const Rigid3 m = BaseFromFlange(st->chain, res.inputs[i], false);
+    bf.push_back(st->flange ? m.Inverse() : m);
     rt.push_back(f.rig_from_tool);
   }
   Rigid3 x, y;
   if (!HandEyeStart(bf, rt, &x, &y)) {
     throw InputError(
         "bundle: " + std::to_string(bf.size()) +
-        " training frames with a well-tracked tool (>= " +
+        " training frames with a well-tracked target (>= " +
         std::to_string(opt.start_min_tags) +
-        " tags); need at least 3 with different orientations to find where "
-        "the base is in the rig and where the target sits on the flange");
+        " tags); need at least 3 with different orientations to find " +
+        (st->flange ? "where the rig sits on the flange and where the target "
+                      "is in the base"
+                    : "where the base is in the rig and where the target "
+                      "sits on the flange"));
   }
-  st->rig_from_base = PoseBlockFromRigid3(x);
-  st->flange_from_tool = PoseBlockFromRigid3(y);
+  st->rig_side = PoseBlockFromRigid3(x);
+  st->tool_side = PoseBlockFromRigid3(y);
 }
 
 // The dense pixel Jacobian of the training frames with respect to the two
@@ -624,8 +655,7 @@ Eigen::MatrixXd PixelJacobian(State* st, const std::vector<Obs>& train,
   }
   Built b = Build(st, train, inputs, eval, opt, rig);
   ceres::Problem::EvaluateOptions eo;
-  std::vector<double*> blocks = {st->rig_from_base.data(),
-                                 st->flange_from_tool.data()};
+  std::vector<double*> blocks = {st->rig_side.data(), st->tool_side.data()};
   int col = 12;
   for (int j = 0; j < nj; ++j) {
     blocks.push_back(st->chain.rows[j].p.data());
@@ -689,7 +719,7 @@ IdentifiabilityScan ScanIdentifiability(
     const std::map<std::pair<int, int>, int>& column_of,
     const std::vector<ParamInfo>& candidates, const Chain& chain,
     double sigma_px, const Freedom& fixed_robot, const BundleOptions& opt) {
-  constexpr int kPoseColumns = 12;  // rig_from_base, flange_from_target
+  constexpr int kPoseColumns = 12;  // the two frames A and B
   std::vector<ParamInfo> ordered;
   Eigen::MatrixXd columns(J.rows(), kPoseColumns + candidates.size());
   for (int c = 0; c < kPoseColumns; ++c) {
@@ -818,9 +848,11 @@ void EstimateCovariance(State* st, const std::vector<Obs>& train,
 }
 
 // What the calibrated robot file records of the fit (data/robot.h
-// FitRecord): the nominal rows, the frames' joint travel, the rig as the
-// measuring frame and the held-out tip RMS. No covariance: the bundle's is
-// over pixels and cameras and is not propagated to the robot yet.
+// FitRecord): the nominal rows, the frames' joint travel, the measuring
+// frame (the rig on a stand: rig_from_base; the fixed target with the
+// cameras on the flange: target_from_base) and the held-out tip RMS. No
+// covariance: the bundle's is over pixels and cameras and is not propagated to
+// the robot yet.
 void RecordFit(const Robot& nominal, const std::vector<BundleFrame>& frames,
                BundleResult* res) {
   Robot& cal = res->calibrated;
@@ -841,7 +873,11 @@ void RecordFit(const Robot& nominal, const std::vector<BundleFrame>& frames,
     rec.joint_range.clear();
     return;
   }
-  const std::array<double, 6>& block = res->rig_from_base;
+  const std::array<double, 6> block =
+      res->mount == RigMount::kFlange
+          ? PoseBlockFromRigid3(
+                Rigid3FromPoseBlock(res->base_from_target.data()).Inverse())
+          : res->rig_from_base;
   rec.has_frame = true;
   for (int k = 0; k < 3; ++k) {
     rec.frame[k] = block[k] * 180.0 / M_PI;
@@ -850,19 +886,27 @@ void RecordFit(const Robot& nominal, const std::vector<BundleFrame>& frames,
   rec.heldout_rms_mm = res->heldout_tip_rms_mm;
 }
 
-// The solved state into the result: the tool row from the tip, the robot,
-// both frames and the refined rig.
+// The solved state into the result: the tool row (to the tip, or to the rig
+// origin with the cameras on the flange), the robot, both frames and the
+// refined rig.
 void WriteSolution(const Robot& nominal, const Rig& rig, const Target& target,
                    bool with_errors, State* st, BundleResult* res) {
-  const Rigid3 ft = Rigid3FromPoseBlock(st->flange_from_tool.data());
-  SetToolRow(ft * target.tip_in_tool, &st->chain);
+  const Rigid3 a = Rigid3FromPoseBlock(st->rig_side.data());
+  const Rigid3 b = Rigid3FromPoseBlock(st->tool_side.data());
+  if (st->flange) {
+    res->flange_from_rig = PoseBlockFromRigid3(a.Inverse());
+    res->base_from_target = st->tool_side;
+    SetToolRow(a.Inverse().t, &st->chain);
+  } else {
+    res->rig_from_base = st->rig_side;
+    res->flange_from_tool = st->tool_side;
+    SetToolRow(b * target.tip_in_tool, &st->chain);
+  }
   if (!with_errors) {
     for (auto& e : st->chain.joint_errors) e.fill(0.0);
   }
   res->chain = st->chain;
   res->calibrated = st->chain.ToRobot(nominal);
-  res->rig_from_base = st->rig_from_base;
-  res->flange_from_tool = st->flange_from_tool;
   for (size_t c = 0; c < rig.cameras.size(); ++c) {
     const int nd =
         static_cast<int>(rig.cameras[c].intrinsics.distortion.size());
@@ -879,7 +923,8 @@ void WriteSolution(const Robot& nominal, const Rig& rig, const Target& target,
 }
 
 // Held-out tips: the model's tip against the tracked tip of every
-// well-tracked held-out frame (mm).
+// well-tracked held-out frame (mm); with the cameras on the flange, the rig
+// origin in the target frame (MeasuredPoint).
 void HeldOutTips(const std::vector<BundleFrame>& frames, const Target& target,
                  const BundleOptions& opt, BundleResult* res) {
   std::vector<double> tip_err;
@@ -889,8 +934,9 @@ void HeldOutTips(const std::vector<BundleFrame>& frames, const Target& target,
       continue;
     }
     const Eigen::Vector3d model =
-        ModelRigFromTool(*res, i) * target.tip_in_tool;
-    const Eigen::Vector3d seen = f.rig_from_tool * target.tip_in_tool;
+        MeasuredPoint(res->mount, target, ModelRigFromTool(*res, i));
+    const Eigen::Vector3d seen =
+        MeasuredPoint(res->mount, target, f.rig_from_tool);
     tip_err.push_back((model - seen).norm());
   }
   res->heldout_tips = static_cast<int>(tip_err.size());
@@ -904,11 +950,15 @@ void NameIdentifiable(const Chain& chain,
                       const std::vector<std::string>& accepted,
                       BundleResult* res) {
   const char* fn[6] = {"rx", "ry", "rz", "tx", "ty", "tz"};
+  const bool flange = res->mount == RigMount::kFlange;
   for (int k = 0; k < 6; ++k) {
-    res->identifiable.push_back(std::string("frame.") + fn[k]);
+    res->identifiable.push_back(
+        std::string(flange ? "base_from_target." : "frame.") + fn[k]);
   }
   for (int k = 0; k < 6; ++k) {
-    res->identifiable.push_back(std::string("flange_from_target.") + fn[k]);
+    res->identifiable.push_back(
+        std::string(flange ? "flange_from_rig." : "flange_from_target.") +
+        fn[k]);
   }
   for (const std::string& a : accepted) res->identifiable.push_back(a);
   for (const ParamInfo& p : GeometryParams(chain)) {
@@ -930,7 +980,9 @@ BundleResult RunBundle(const Robot& nominal, const Rig& rig,
   BundleResult res;
   res.frames = static_cast<int>(frames.size());
   res.rig = rig;
+  res.mount = rig.mount;
   State st;
+  st.flange = rig.mount == RigMount::kFlange;
   st.chain = Chain::FromRobot(nominal);
   const int nj = st.chain.num_joints();
   if (nj > kMaxJoints) throw InputError("bundle: more than 16 joints");

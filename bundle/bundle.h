@@ -4,25 +4,38 @@
 // The image bundle: one Ceres problem from tag corners to robot parameters.
 //
 // For frame f with joint readings q_f, tag corner X (in the tool frame of
-// target.yaml) seen by camera c at pixel u:
+// target.yaml) seen by camera c at pixel u, with the cameras on a stand
+// (rig.yaml `mount: world`, the target on the flange):
 //
 //   u = project_c( cam_from_rig_c * rig_from_base * base_from_flange(q_f)
 //                  * flange_from_tool * X )
 //
+// and with the cameras on the flange (`mount: flange`, the target a fixed
+// board whose frame is target.yaml's tool frame):
+//
+//   u = project_c( cam_from_rig_c * rig_from_flange * flange_from_base(q_f)
+//                  * base_from_target * X )
+//
+// One model for both: rig_from_tool = A * M(q_f) * B, with A the rig-side
+// frame (rig_from_base | rig_from_flange), M the chain (base_from_flange or
+// its inverse) and B the target-side frame (flange_from_tool |
+// base_from_target).
+//
 // base_from_flange is the robot's chain without its tool row (calib/chain.h,
 // RowTransform and ModelJointValue, so the joint error models of `diagnose`
 // apply); project_c is camcal's ProjectPoint. Unknowns: the identifiable
-// geometry of the joint rows, rig_from_base, flange_from_tool, optionally
-// extension parameters (e.g. j3.backlash) and the cameras (with priors).
-// The needle tip follows from target.yaml: tip_in_flange = flange_from_tool *
-// tip_in_tool, which fixes the tool row of the calibrated robot.
+// geometry of the joint rows, the two frames A and B, optionally extension
+// parameters (e.g. j3.backlash) and the cameras (with priors). The tool row
+// of the calibrated robot ends at the needle tip (stand: tip_in_flange =
+// flange_from_tool * tip_in_tool) or at the rig origin, the reference
+// camera's optical centre (flange: flange_from_rig's translation).
 //
 // Residuals are pixels with a per-corner Huber loss (applied inside the
 // frame's residual block, so one frame's FK is computed once for all its
 // corners). Identifiability: the pixel Jacobian, columns scaled to unit norm,
-// scanned with Gram-Schmidt in priority order (rig_from_base and
-// flange_from_tool first, then the rows in chain order), as calibrate does on
-// tip residuals (calib/identifiability.h).
+// scanned with Gram-Schmidt in priority order (the two frames first, then
+// the rows in chain order), as calibrate does on tip residuals
+// (calib/identifiability.h).
 
 #include <Eigen/Core>
 #include <array>
@@ -104,9 +117,15 @@ struct BundleResult {
   Chain chain;       // fitted (tool row set from the tip)
   Robot calibrated;  // chain.ToRobot(nominal)
   Rig rig;           // refined cameras (= input without refine)
-  std::array<double, 6> rig_from_base{};     // [angle-axis rad, t mm]
-  std::array<double, 6> flange_from_tool{};  // [angle-axis rad, t mm]
-  std::vector<BundleParam> params;           // free parameters with sigma
+  RigMount mount = RigMount::kWorld;  // rig.mount
+  // The two frames, [angle-axis rad, t mm]. mount world: rig_from_base and
+  // flange_from_tool; mount flange: flange_from_rig and base_from_target
+  // (the other two stay zero).
+  std::array<double, 6> rig_from_base{};
+  std::array<double, 6> flange_from_tool{};
+  std::array<double, 6> flange_from_rig{};
+  std::array<double, 6> base_from_target{};
+  std::vector<BundleParam> params;  // free parameters with sigma
   std::vector<std::string> identifiable, unidentifiable;
   std::vector<std::string> relations;  // why each is unidentifiable
   int frames = 0;                      // frames given
@@ -117,7 +136,9 @@ struct BundleResult {
   double start_reproj_rms_px = 0.0;  // after the hand-eye start
   double reproj_rms_px = 0.0;        // training, final
   double heldout_reproj_rms_px = 0.0;
-  double heldout_tip_rms_mm = 0.0;  // model tip vs tracked tip
+  // Held-out frames: the model's tip vs the tip tracked from the images
+  // (rig frame); with mount flange the rig origin instead (target frame).
+  double heldout_tip_rms_mm = 0.0;
   int heldout_tips = 0;
   // Per held-out frame errors (pooling folds): corner residuals, px, and
   // |model tip - tracked tip|, mm.
@@ -138,8 +159,17 @@ BundleResult RunBundle(const Robot& nominal, const Rig& rig,
                        const std::vector<BundleFrame>& frames,
                        const BundleOptions& options);
 
-// The model's needle tip / tool pose in the rig frame for one frame.
+// The model's tool (target) pose in the rig frame for one frame, either
+// mount.
 Rigid3 ModelRigFromTool(const BundleResult& result, int index);
+
+// The point the calibrated robot's tool row ends at, for one frame, and the
+// frame it is given in: mount world, the needle tip in the rig frame from
+// rig_from_tool (the tool's pose in the rig); mount flange, the rig origin in
+// the target frame. Applied to ModelRigFromTool or to a tracked pose it gives
+// the model's and the images' point.
+Eigen::Vector3d MeasuredPoint(RigMount mount, const Target& target,
+                              const Rigid3& rig_from_tool);
 
 // Whether the frame's corners come from at least two cameras (a tool pose
 // from one camera is weak in depth: such tips are not used as measurements).
@@ -151,6 +181,8 @@ bool SeenByEnoughCameras(const BundleFrame& f, int num_cameras);
 // Closed-form hand-eye start: X = rig_from_base, Y = flange_from_tool with
 // rig_from_tool_i = X * base_from_flange_i * Y (linear in the rotations,
 // projected onto SO(3), then linear least squares for the translations).
+// The cameras on the flange are the same equation with the chain inverted:
+// pass flange_from_base_i, get X = rig_from_flange, Y = base_from_target.
 // False when the rotations do not determine X and Y.
 bool HandEyeStart(const std::vector<Rigid3>& base_from_flange,
                   const std::vector<Rigid3>& rig_from_tool, Rigid3* x,

@@ -3,12 +3,14 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <Eigen/Geometry>
 #include <cmath>
 #include <random>
 
 #include "bundle/testing/synthetic.h"
 #include "calib/model_state.h"
 #include "data/error.h"
+#include "data/rigid3.h"
 #include "data/robot.h"
 #include "synth/render.h"
 #include "synth/simulate.h"
@@ -164,6 +166,84 @@ TEST(Bundle, OneTwoAndThreeCamerasHonestSigmaAndTipsWithinTwiceStereo) {
   }
   EXPECT_LE(tip_rms[1], 2 * tip_rms[2]);
   EXPECT_LE(tip_rms[3], 2 * tip_rms[2]);
+}
+
+// Rotation angle (deg) and translation distance (mm) between two poses.
+void ExpectSamePose(const Rigid3& a, const std::array<double, 6>& block,
+                    double max_deg, double max_mm, const std::string& what) {
+  const Rigid3 b = Rigid3FromPoseBlock(block.data());
+  const double deg =
+      Eigen::AngleAxisd(a.R.transpose() * b.R).angle() * 180.0 / M_PI;
+  EXPECT_LT(deg, max_deg) << what;
+  EXPECT_LT((a.t - b.t).norm(), max_mm) << what;
+}
+
+// Cameras on the flange (mount: flange), exact corners: the bundle finds the
+// hidden mounting (flange_from_rig), the board's pose in the base and a
+// robot whose tool row ends at the rig origin at fresh poses.
+TEST(Bundle, FlangeExactCornersGiveMountingBoardAndRigOrigins) {
+  for (int cameras : {1, 2}) {
+    SyntheticBundleOptions so;
+    so.frames = 60;
+    so.noise_px = 0.0;
+    so.seed = 5;
+    so.flange = true;
+    so.cameras = cameras;
+    so.only_identifiable = true;
+    const SyntheticBundle s = MakeSyntheticBundle(Bh7(), so);
+    ASSERT_EQ(s.rig.mount, RigMount::kFlange);
+    BundleOptions o;
+    const BundleResult r = RunBundle(s.nominal, s.rig, s.target, s.frames, o);
+    EXPECT_EQ(r.mount, RigMount::kFlange);
+    EXPECT_LT(r.reproj_rms_px, 1e-3) << cameras;
+    EXPECT_LT(r.heldout_tip_rms_mm, 1e-3) << cameras;
+    ExpectSamePose(s.flange_from_rig, r.flange_from_rig, 1e-4, 1e-3,
+                   "flange_from_rig");
+    ExpectSamePose(s.base_from_target, r.base_from_target, 1e-4, 1e-3,
+                   "base_from_target");
+    EXPECT_LT(TipRmsAgainstTruth(s, r.calibrated, 100, 9), 1e-3) << cameras;
+    EXPECT_THAT(r.identifiable, ::testing::Contains("flange_from_rig.tx"));
+    EXPECT_THAT(r.identifiable, ::testing::Contains("base_from_target.rz"));
+    // The measuring frame of the record: target_from_base.
+    const Rigid3 target_from_base = s.base_from_target.Inverse();
+    EXPECT_NEAR(r.calibrated.fitted_on.frame[3], target_from_base.t.x(), 1e-3);
+  }
+}
+
+// Cameras on the flange, noisy corners, one and two cameras: the reported
+// sigma is honest (RMS of (estimate - truth) / sigma within 0.7..1.4 over
+// seeds) and the rig origins at fresh poses are within 0.10 mm.
+TEST(Bundle, FlangeHonestSigmaAndRigOriginsAtFreshPoses) {
+  for (int cameras : {2, 1}) {
+    double sum_z2 = 0, sum_tip2 = 0;
+    int n = 0;
+    const int seeds = 6;
+    for (int seed = 1; seed <= seeds; ++seed) {
+      SyntheticBundleOptions so;
+      so.frames = 80;
+      so.noise_px = 0.1;
+      so.seed = 500 + seed;
+      so.cameras = cameras;
+      so.flange = true;
+      so.only_identifiable = true;
+      const SyntheticBundle s = MakeSyntheticBundle(Bh7(), so);
+      BundleOptions o;
+      o.holdout_fraction = 0.0;
+      const BundleResult r = RunBundle(s.nominal, s.rig, s.target, s.frames, o);
+      AddSquaredErrorOverSigma(s.truth, r, &sum_z2, &n);
+      const double tip = TipRmsAgainstTruth(s, r.calibrated, 100, 9);
+      sum_tip2 += tip * tip;
+    }
+    const double rms_z = std::sqrt(sum_z2 / n);
+    const double tip_rms = std::sqrt(sum_tip2 / seeds);
+    std::printf(
+        "flange, %d camera(s): RMS z %.3f over %d parameters, rig origins at "
+        "fresh poses %.4f mm\n",
+        cameras, rms_z, n, tip_rms);
+    EXPECT_GT(rms_z, 0.7) << cameras << " camera(s)";
+    EXPECT_LT(rms_z, 1.4) << cameras << " camera(s)";
+    EXPECT_LT(tip_rms, 0.10) << cameras << " camera(s)";
+  }
 }
 
 TEST(Bundle, TooFewTrackedFramesIsBadInput) {

@@ -127,6 +127,17 @@ PosePlan DrawPoses(const Chain& truth, const SimulateOptions& opt,
     return q;
   };
   PosePlan plan;
+  if (opt.mode == SimulateOptions::kRandom && !opt.readings.empty()) {
+    for (const std::vector<double>& r : opt.readings) {
+      Require(static_cast<int>(r.size()) == n,
+              "given poses need one reading per joint");
+      std::vector<double> q(n);
+      for (int j = 0; j < n; ++j) q[j] = truth.ReadingToInternal(j, r[j]);
+      plan.poses.push_back(q);
+      plan.point_of_pose.push_back(-1);
+    }
+    return plan;
+  }
   if (opt.mode == SimulateOptions::kRandom) {
     Require(opt.poses >= 1, "--poses must be >= 1");
     for (int i = 0; i < opt.poses; ++i) {

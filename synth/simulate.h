@@ -59,6 +59,11 @@ struct SimulateOptions {
   // instead of a random one (the random draws still happen, so the rest of
   // the session is the same for the same seed).
   std::optional<std::array<double, 6>> meas_from_base;
+  // kRandom: when not empty, these joint readings (file units, robot order,
+  // one vector per pose) are the poses, in this order, instead of random
+  // ones (`poses` is ignored); the truth is drawn as without them, so a
+  // subset of a seed's random poses keeps that seed's true robot.
+  std::vector<std::vector<double>> readings;
 };
 
 struct SimulatedSession {

@@ -36,6 +36,15 @@ struct SyntheticBundleOptions {
   // Cameras on the stand: 1, 2 (the example stereo rig) or 3
   // (synth/rig_placement.h, RigWithCameras).
   int cameras = 2;
+  // Cameras on the flange instead (rig.yaml mount: flange): the rig's origin
+  // at the true robot's tool-row end, turned by a hidden rotation drawn from
+  // the seed (optical axis within 15 deg of the tool row's z), looking at a
+  // fixed 5 x 4 AprilGrid (tags of tag_size_mm) placed by
+  // PlaceBoardForFlangeRig at flange_distance_mm; the frames are the first
+  // poses of the seed's random ones whose reference camera sees half the
+  // board's tags.
+  bool flange = false;
+  double flange_distance_mm = 450.0;
 };
 
 struct SyntheticBundle {
@@ -43,7 +52,8 @@ struct SyntheticBundle {
   Rig rig;
   Target target;
   std::vector<BundleFrame> frames;
-  Rigid3 rig_from_base, flange_from_tool;  // truth
+  Rigid3 rig_from_base, flange_from_tool;    // truth, cameras on a stand
+  Rigid3 flange_from_rig, base_from_target;  // truth, cameras on the flange
 };
 
 // The three-tag holder (tag36h11 ids 0..2, edge `tag_size_mm`, the outer
