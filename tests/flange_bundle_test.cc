@@ -1,0 +1,97 @@
+// `kincal bundle` end to end with the cameras on the flange (rig.yaml
+// mount: flange, format v3): sessions rendered by `simulate --render
+// --render-mount flange` (the rig at a hidden mounting on the true robot's
+// tool-row end, a fixed AprilGrid board at a hidden pose), the bundle's robot
+// judged at fresh poses on the true rig origins (`kincal evaluate` on the
+// same seed's further random poses, whose tips are the rig origins), and a
+// hidden 0.05 deg backlash named from the images.
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <nlohmann/json.hpp>
+
+#include "tests/testing/fresh_poses.h"
+#include "tests/testing/paths.h"
+#include "tests/testing/run.h"
+
+namespace kincal::testing {
+namespace {
+
+std::string Bh7() { return SourceDir() + "/data/robots/bh7.yaml"; }
+
+constexpr int kPoses = 120;
+constexpr int kSeed = 7;
+
+// Renders a flange session with `cameras` cameras, bundles it, and returns
+// the bundle's RMS error at fresh poses (mm); `json` receives its output.
+double FlangeBundleAtFreshPoses(const std::string& dir, int cameras,
+                                nlohmann::json* json,
+                                const std::string& extra = "",
+                                const std::string& bundle_extra = "") {
+  const std::string s = dir + "/s" + std::to_string(cameras);
+  RunResult r = RunKincal(
+      "simulate --robot " + Bh7() + " --out " + s + " --poses " +
+      std::to_string(kPoses) + " --noise 0 --seed " + std::to_string(kSeed) +
+      " --render --render-mount flange --render-noise 1.5 --render-blur 0.5 "
+      "--render-width 640 --render-height 512 --render-cameras " +
+      std::to_string(cameras) + " " + extra);
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  r = RunKincal("bundle --robot " + s + "/robot.yaml --rig " + s +
+                "/rig.yaml --target " + s + "/target.yaml --session " + s +
+                "/session --quiet --out " + s + "/bcal.yaml --json " +
+                bundle_extra);
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  if (r.exit_code != 0) return NAN;
+  *json = nlohmann::json::parse(r.out);
+  const std::string fresh = dir + "/fresh.csv";
+  if (!Exists(fresh)) {
+    r = RunKincal("simulate --robot " + Bh7() + " --out " + dir +
+                  "/fresh --poses " + std::to_string(kPoses + 200) +
+                  " --noise 0 --seed " + std::to_string(kSeed));
+    EXPECT_EQ(r.exit_code, 0) << r.err;
+    KeepRowsFrom(dir + "/fresh/observations.csv", fresh, kPoses);
+  }
+  return EvaluateRms(s + "/bcal.yaml", fresh);
+}
+
+TEST(FlangeBundle, PairOnTheFlangeWithinATenthOfAMillimetreAtFreshPoses) {
+  const std::string dir = MakeTempDir("flange_bundle");
+  nlohmann::json j;
+  const double pair = FlangeBundleAtFreshPoses(dir, 2, &j);
+  std::printf("flange pair: fresh rig origins %.4f mm, %d frames used\n", pair,
+              j.value("used_frames", 0));
+  EXPECT_LE(pair, 0.10);
+  EXPECT_EQ(j["mount"], "flange");
+  EXPECT_EQ(j["cameras"], 2);
+  ASSERT_TRUE(j.contains("flange_from_rig")) << j.dump();
+  ASSERT_TRUE(j.contains("base_from_target"));
+  EXPECT_FALSE(j.contains("rig_from_base"));
+  EXPECT_EQ(j["base_from_target"]["t_mm"].size(), 3u);
+  EXPECT_GT(j["heldout_tips"].get<int>(), 0);
+  // The nominal robot on the same fresh poses is millimetres off.
+  EXPECT_GT(EvaluateRms(dir + "/s2/robot.yaml", dir + "/fresh.csv"), 10 * pair);
+}
+
+TEST(FlangeBundle, NamesAHiddenBacklashFromTheFlangeCamerasImages) {
+  const std::string dir = MakeTempDir("flange_bundle_bl");
+  for (int cameras : {2, 1}) {
+    nlohmann::json j;
+    FlangeBundleAtFreshPoses(dir, cameras, &j, "--effect backlash:j3:0.05",
+                             "--extensions backlash");
+    ASSERT_EQ(j["findings"].size(), 1u)
+        << cameras << " camera(s): " << j["extensions"].dump();
+    EXPECT_EQ(j["findings"][0]["cause"], "backlash");
+    EXPECT_EQ(j["findings"][0]["joint"], "j3");
+    const auto ci = j["findings"][0]["ci95"];
+    EXPECT_LT(ci[0].get<double>(), 0.05) << cameras;
+    EXPECT_GT(ci[1].get<double>(), 0.05) << cameras;
+    std::printf("flange, %d camera(s): backlash j3 %.4f deg, CI [%.4f, %.4f]\n",
+                cameras, j["findings"][0]["magnitude"].get<double>(),
+                ci[0].get<double>(), ci[1].get<double>());
+  }
+}
+
+}  // namespace
+}  // namespace kincal::testing
