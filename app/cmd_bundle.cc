@@ -44,6 +44,8 @@ struct BundleArgs {
   // Quality gate of --out-obs tips (as `track`).
   int min_tags = 2;
   double max_reproj_px = 0.5;
+  // A finding must move the tool row's end by at least this much (RMS, mm).
+  double min_effect_mm = 0.005;
   bool json = false, quiet = false;
 };
 
@@ -155,9 +157,13 @@ std::string TrackedTipsCsv(const BundleArgs& args, const Robot& robot,
             FormatDouble(args.max_reproj_px) + " px"});
 }
 
-// Each requested extension's estimate with its z = |value| / sigma.
+// Each requested extension's estimate with its z = |value| / sigma and its
+// effect on the tool row's end; significant when z > 4 and the effect is at
+// least min_effect_mm (a 2 um move is no finding however small its sigma:
+// the sigma assumes independent pixel errors, and rendering or detection
+// biases shared by a frame's corners are not).
 nlohmann::json ExtensionsJson(const BundleOptions& options,
-                              const BundleResult& r) {
+                              const BundleResult& r, double min_effect_mm) {
   nlohmann::json extensions = nlohmann::json::array();
   for (const std::string& name : options.extensions) {
     for (const BundleParam& p : r.params) {
@@ -165,11 +171,14 @@ nlohmann::json ExtensionsJson(const BundleOptions& options,
       const double z = std::isfinite(p.sigma) && p.sigma > 0
                            ? std::abs(p.value) / p.sigma
                            : 0.0;
-      extensions.push_back({{"name", p.name},
-                            {"value", p.value},
-                            {"sigma", p.sigma},
-                            {"z", z},
-                            {"significant", z > 4.0}});
+      const double effect = std::isfinite(p.effect_mm) ? p.effect_mm : 0.0;
+      extensions.push_back(
+          {{"name", p.name},
+           {"value", p.value},
+           {"sigma", p.sigma},
+           {"z", z},
+           {"effect_mm", effect},
+           {"significant", z > 4.0 && effect >= min_effect_mm}});
     }
   }
   return extensions;
@@ -193,6 +202,7 @@ nlohmann::json FindingsJson(const nlohmann::json& extensions) {
          {"joint", name.substr(0, dot)},
          {"magnitude", e["value"]},
          {"sigma", e["sigma"]},
+         {"effect_mm", e["effect_mm"]},
          {"ci95",
           {e["value"].get<double>() - 1.96 * e["sigma"].get<double>(),
            e["value"].get<double>() + 1.96 * e["sigma"].get<double>()}}});
@@ -312,7 +322,8 @@ nlohmann::json SummaryJson(const BundleArgs& args, const Target& target,
   j["mount"] = RigMountName(r.rig.mount);
   j["not_determined"] = NotDeterminedJson(r.rig);
   if (!args.options.extensions.empty()) {
-    const nlohmann::json extensions = ExtensionsJson(args.options, r);
+    const nlohmann::json extensions =
+        ExtensionsJson(args.options, r, args.min_effect_mm);
     j["extensions"] = extensions;
     j["findings"] = FindingsJson(extensions);
   }
@@ -525,7 +536,14 @@ void AddBundleCommand(CLI::App& app, Runner* run) {
       "comma-separated (e.g. j3.backlash,j2.gain; a cause alone, "
       "e.g. backlash, gain, compliance, cyclic, axis_tilt, means every "
       "joint); significant ones "
-      "(|value| > 4 sigma) are listed under findings");
+      "(|value| > 4 sigma and moving the tool by --min-effect) are listed "
+      "under findings");
+  sub->add_option("--min-effect", args->min_effect_mm,
+                  "a significant extension must also move the tool row's end "
+                  "(tip, or rig origin on the flange) by at least this RMS "
+                  "over the frames, mm")
+      ->capture_default_str()
+      ->check(CLI::NonNegativeNumber);
   sub->add_option("--threads", args->options.num_threads, "Ceres threads")
       ->capture_default_str()
       ->check(CLI::Range(1, 64));

@@ -944,6 +944,29 @@ void HeldOutTips(const std::vector<BundleFrame>& frames, const Target& target,
   res->heldout_tip_rms_mm = Rms(tip_err);
 }
 
+// Each fitted extension's effect_mm: the RMS over the used frames of the
+// distance the tool row's end moves when the parameter is set to zero (what
+// a finding changes in the robot's predictions).
+void ExtensionEffects(const std::vector<ParamInfo>& ext, BundleResult* res) {
+  std::vector<int> used = res->train;
+  used.insert(used.end(), res->heldout.begin(), res->heldout.end());
+  for (const ParamInfo& p : ext) {
+    for (BundleParam& bp : res->params) {
+      if (bp.name != p.name || used.empty()) continue;
+      ModelState without;
+      without.chain = res->chain;
+      *ParamAddress(&without, p) = 0.0;
+      double sum = 0.0;
+      for (int i : used) {
+        sum += (TipInBase(res->chain, res->inputs[i]) -
+                TipInBase(without.chain, res->inputs[i]))
+                   .squaredNorm();
+      }
+      bp.effect_mm = std::sqrt(sum / static_cast<double>(used.size()));
+    }
+  }
+}
+
 // Names: the two frames and the tool row's position are determined by
 // construction, its orientation is not; then the accepted candidates.
 void NameIdentifiable(const Chain& chain,
@@ -1062,6 +1085,7 @@ BundleResult RunBundle(const Robot& nominal, const Rig& rig,
   res.heldout_reproj_rms_px = Rms(res.heldout_corner_px);
   WriteSolution(nominal, rig, target, with_errors, &st, &res);
   HeldOutTips(frames, target, opt, &res);
+  ExtensionEffects(ext, &res);
   NameIdentifiable(st.chain, scan.accepted, &res);
   RecordFit(nominal, frames, &res);
   res.seconds =

@@ -40,6 +40,7 @@
 #include <Eigen/Core>
 #include <array>
 #include <cstdint>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -111,6 +112,10 @@ struct BundleParam {
   std::string name;
   double value = 0.0;  // interface units (mm, deg, 1)
   double sigma = 0.0;  // 1-sigma, interface units; NaN when unknown
+  // Extensions only: how far the parameter moves the tool row's end (the
+  // tip, or the rig origin on the flange), RMS over the used frames of the
+  // move when it is set to zero, mm; NaN for geometry.
+  double effect_mm = std::numeric_limits<double>::quiet_NaN();
 };
 
 struct BundleResult {
