@@ -273,6 +273,23 @@ void AppendPoseCells(const ToolPoseResult& r, const TipUncertainty& u,
   if (u.ok) *poses << FormatDouble(u.depth_sigma_mm);
 }
 
+// The point a frame measures: the needle tip in the rig frame, or with the
+// cameras on the flange (rig.yaml mount: flange) the rig origin (the
+// reference camera's optical centre) in the fixed target's frame, the point
+// the calibrated robot's tool row ends at (spec v3).
+Eigen::Vector3d TrackedPoint(const Rig& rig, const ToolPoseResult& r) {
+  return rig.mount == RigMount::kFlange ? r.rig_from_tool.Inverse().t
+                                        : r.tip_in_rig;
+}
+
+// The header comment saying what x,y,z are.
+std::string PointsMeaning(const Rig& rig) {
+  return rig.mount == RigMount::kFlange
+             ? "x,y,z = rig origin (reference camera's optical centre) in the "
+               "fixed target's frame, mm (rig.yaml mount: flange)"
+             : "x,y,z = needle tip tracked in the rig frame, mm";
+}
+
 Tracked TrackFrames(const TrackArgs& args, const Rig& rig, const Target& target,
                     const FrameSets& pairs, Merge* merge) {
   TrackerOptions topt;
@@ -292,7 +309,8 @@ Tracked TrackFrames(const TrackArgs& args, const Rig& rig, const Target& target,
   std::ostringstream points, poses;
   const std::string header =
       "# written by " + ToolVersion() + ": " + CommandLine() + "\n";
-  points << header << "frame,x,y,z,reproj_px,tags\n";
+  points << header << "# " << PointsMeaning(rig) << "\n"
+         << "frame,x,y,z,reproj_px,tags\n";
   poses << PosesHeader(header, ImageColumns(rig));
   // On a terminal only; silent with --json, --quiet or when piped.
   Progress progress("kincal track", args.json || args.quiet);
@@ -316,7 +334,7 @@ Tracked TrackFrames(const TrackArgs& args, const Rig& rig, const Target& target,
     if (merge->merged_row[f] >= 0) {
       Observation& row = merge->merged.rows[merge->merged_row[f]];
       row.has_point = good;
-      if (good) row.p_in_meas = r.tip_in_rig;
+      if (good) row.p_in_meas = TrackedPoint(rig, r);
       out.merged_count += good ? 1 : 0;
     }
     // The corner sigma per coordinate: the fit's RMS (a norm over x and y)
@@ -328,8 +346,8 @@ Tracked TrackFrames(const TrackArgs& args, const Rig& rig, const Target& target,
       out.rms_values.push_back(r.rms_px);
       out.depths_mm.push_back(r.rig_from_tool.t.norm());
       if (u.ok) out.depth_sigmas_mm.push_back(u.depth_sigma_mm);
-      for (int i = 0; i < 3; ++i)
-        points << "," << FormatDouble(r.tip_in_rig(i));
+      const Eigen::Vector3d point = TrackedPoint(rig, r);
+      for (int i = 0; i < 3; ++i) points << "," << FormatDouble(point(i));
       if (!good) out.failed_gate.push_back(static_cast<int>(f));
       points << "," << FormatDouble(r.rms_px) << "," << r.tags_used << "\n";
     } else {
@@ -354,18 +372,18 @@ Tracked TrackFrames(const TrackArgs& args, const Rig& rig, const Target& target,
   return out;
 }
 
-void WriteMergedObservations(const TrackArgs& args,
+void WriteMergedObservations(const TrackArgs& args, const Rig& rig,
                              const Observations& merged) {
-  WriteFileAtomic(args.out_obs,
-                  FormatObservationsCsv(
-                      merged, {"joint readings from " + merged.source +
-                               "; x,y,z = needle tip tracked in the rig "
-                               "frame (empty where the tool was not found, "
-                               "seen by one camera of a multi-camera rig, "
-                               "or with fewer than " +
-                               std::to_string(args.min_tags) +
-                               " tags or a reprojection RMS over " +
-                               FormatDouble(args.max_reproj_px) + " px)"}));
+  WriteFileAtomic(
+      args.out_obs,
+      FormatObservationsCsv(
+          merged,
+          {"joint readings from " + merged.source + "; " + PointsMeaning(rig) +
+           " (empty where the tool was not found, "
+           "seen by one camera of a multi-camera rig, "
+           "or with fewer than " +
+           std::to_string(args.min_tags) + " tags or a reprojection RMS over " +
+           FormatDouble(args.max_reproj_px) + " px)"}));
 }
 
 double MedianOf(std::vector<double> values) {
@@ -544,7 +562,7 @@ int RunTrack(const TrackArgs& args) {
   const std::string poses_path = PosesPath(args.out);
   WriteFileAtomic(poses_path, tracked.poses);
   const bool merged = !merge.merged.rows.empty();
-  if (merged) WriteMergedObservations(args, merge.merged);
+  if (merged) WriteMergedObservations(args, rig, merge.merged);
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start)
           .count();
