@@ -113,12 +113,45 @@ Rigid3 DrawFlangeMounting(uint64_t seed) {
   return r;
 }
 
+// Too few random poses see the board (a six-axis arm's wrist seldom points
+// at one spot): more from small joint moves (N(0, 8) deg or mm per joint,
+// within the robot's limits) of poses that do, until `wanted`; then the
+// visiting order is shuffled so the approach directions stay random.
+void GrowSeenPoses(const Robot& nominal, SimulateOptions candidates,
+                   const Rig& rig, const Rigid3& tip_from_rig,
+                   const Target& board, const Rigid3& base_from_board,
+                   double distance_mm, int min_tags, size_t wanted,
+                   std::vector<std::vector<double>>* seen) {
+  if (seen->size() >= wanted || seen->empty()) return;
+  std::mt19937_64 rng(candidates.seed * 7919 + 11);
+  std::normal_distribution<double> step(0.0, 8.0);
+  for (int round = 0; round < 20 && seen->size() < wanted; ++round) {
+    candidates.readings.clear();
+    for (size_t k = 0; k < 4 * wanted; ++k) {
+      std::vector<double> q = (*seen)[rng() % seen->size()];
+      for (size_t j = 0; j < q.size(); ++j) {
+        q[j] += step(rng);
+        const RobotRow& row = nominal.joints[j];
+        if (row.HasLimits()) q[j] = std::clamp(q[j], row.lower, row.upper);
+      }
+      candidates.readings.push_back(q);
+    }
+    const SimulatedSession more = Simulate(nominal, candidates);
+    for (int i : PosesSeeingBoard(more.base_from_tip, rig, tip_from_rig, board,
+                                  base_from_board, distance_mm, min_tags)) {
+      seen->push_back(candidates.readings[i]);
+    }
+  }
+  std::shuffle(seen->begin(), seen->end(), rng);
+}
+
 // Cameras on the flange: a 5 x 4 AprilGrid board (tags ~50 px wide at the
 // working distance) placed where the reference camera sees it on most of
-// the seed's random poses (80x --poses drawn, same truth), turned about its
-// normal by a seeded angle; the session keeps the first --poses that see
-// half its tags, and its measuring frame is the board's (observations.csv
-// then holds the rig origins in the board frame, what `track` measures).
+// 80x --poses random poses of the seed (same truth), turned about its
+// normal by a seeded angle; the session's poses are those that see it (near,
+// within 60 deg of its normal, half its tags; GrowSeenPoses when too few),
+// and its measuring frame is the board's (observations.csv then holds the
+// rig origins in the board frame, what `track` measures).
 FlangeScene PlaceFlangeBoard(const Robot& nominal, const Rig& rig,
                              double distance_mm, SimulateOptions* opt,
                              Target* board) {
@@ -128,24 +161,18 @@ FlangeScene PlaceFlangeBoard(const Robot& nominal, const Rig& rig,
   grid.tag_size_mm = 50.0 * distance_mm / rig.cameras.at(0).intrinsics.fx;
   *board = grid.AsTarget();
   board->has_tip = false;
+  const int min_tags = static_cast<int>(board->tags.size()) / 2;
   FlangeScene scene;
   scene.on = true;
   scene.tip_from_rig = DrawFlangeMounting(opt->seed);
   SimulateOptions candidates = *opt;
-  candidates.poses = 80 * opt->poses;
   candidates.effects.clear();
+  candidates.poses = 80 * opt->poses;
   const SimulatedSession all = Simulate(nominal, candidates);
-  FlangeBoardPlacement place = PlaceBoardForFlangeRig(
-      all.base_from_tip, rig, scene.tip_from_rig, *board, distance_mm,
-      static_cast<int>(board->tags.size()) / 2);
-  if (static_cast<int>(place.seen.size()) < opt->poses) {
-    throw InputError("--render-mount flange: only " +
-                     std::to_string(place.seen.size()) + " of " +
-                     std::to_string(candidates.poses) +
-                     " random poses see the board; ask for fewer --poses");
-  }
-  // Turn the board about its normal through its centre (the first pass
-  // placed it; a turn keeps what each camera sees nearly the same).
+  const FlangeBoardPlacement place =
+      PlaceBoardForFlangeRig(all.base_from_tip, rig, scene.tip_from_rig, *board,
+                             distance_mm, min_tags);
+  // Turn the board about its normal through its centre.
   const double turn = (opt->seed % 360) * M_PI / 180.0;
   const Eigen::Vector3d centre(
       0.5 * grid.cols * grid.tag_size_mm * (1 + grid.spacing_ratio),
@@ -154,9 +181,22 @@ FlangeScene PlaceFlangeBoard(const Robot& nominal, const Rig& rig,
   spin.R = Eigen::AngleAxisd(turn, Eigen::Vector3d::UnitZ()).toRotationMatrix();
   spin.t = centre - spin.R * centre;
   scene.base_from_board = place.base_from_board * spin;
-  for (int k = 0; k < opt->poses; ++k) {
-    opt->readings.push_back(all.observations.rows[place.seen[k]].q);
+  std::vector<std::vector<double>> seen;
+  for (int i :
+       PosesSeeingBoard(all.base_from_tip, rig, scene.tip_from_rig, *board,
+                        scene.base_from_board, distance_mm, min_tags)) {
+    seen.push_back(all.observations.rows[i].q);
   }
+  const size_t wanted = static_cast<size_t>(opt->poses);
+  GrowSeenPoses(nominal, candidates, rig, scene.tip_from_rig, *board,
+                scene.base_from_board, distance_mm, min_tags, wanted, &seen);
+  if (seen.size() < wanted) {
+    throw InputError("--render-mount flange: only " +
+                     std::to_string(seen.size()) +
+                     " poses found that see the board; ask for fewer --poses");
+  }
+  seen.resize(wanted);
+  opt->readings = seen;
   opt->meas_from_base = PoseBlockFromRigid3(scene.base_from_board.Inverse());
   return scene;
 }

@@ -27,13 +27,22 @@ struct FlangeBoardPlacement {
 // its z = 0 plane facing -z) placed for a rig at base_from_tip_i *
 // tip_from_rig: its centre at the point that the most reference-camera
 // views hold near their centre (within 0.6 of the half field of view) at
-// 0.6..1.5 times `distance_mm`, facing those cameras on average; `seen`
-// lists the poses whose reference camera sees at least `min_tags` whole
+// 0.6..1.5 times `distance_mm` (candidates: the points distance_mm along
+// each view's axis, at most ~2000 of them), facing those cameras on
+// average; `seen` lists the poses that hold it so, view it within 60 deg of
+// its normal and whose reference camera sees at least `min_tags` whole
 // front-facing tags. Deterministic.
 FlangeBoardPlacement PlaceBoardForFlangeRig(
     const std::vector<Eigen::Matrix4d>& base_from_tip, const Rig& rig,
     const Rigid3& tip_from_rig, const Target& board, double distance_mm,
     int min_tags);
+
+// The poses (indices into base_from_tip, in order) that see the board at
+// base_from_board as PlaceBoardForFlangeRig's `seen` says.
+std::vector<int> PosesSeeingBoard(
+    const std::vector<Eigen::Matrix4d>& base_from_tip, const Rig& rig,
+    const Rigid3& tip_from_rig, const Target& board,
+    const Rigid3& base_from_board, double distance_mm, int min_tags);
 
 }  // namespace kincal
 

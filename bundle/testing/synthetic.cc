@@ -127,7 +127,7 @@ SimulatedSession FlangeSession(const Robot& nominal, SimulateOptions so,
   const Rigid3 tip_from_rig = HiddenFlangeMounting(o.seed);
   // The seed's random poses (same truth), then those that see the board.
   SimulateOptions candidates = so;
-  candidates.poses = 80 * so.poses;
+  candidates.poses = 320 * so.poses;
   candidates.effects.clear();
   const SimulatedSession all = Simulate(nominal, candidates);
   const FlangeBoardPlacement place = PlaceBoardForFlangeRig(
