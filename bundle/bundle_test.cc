@@ -217,7 +217,7 @@ TEST(Bundle, FlangeHonestSigmaAndRigOriginsAtFreshPoses) {
   for (int cameras : {2, 1}) {
     double sum_z2 = 0, sum_tip2 = 0;
     int n = 0;
-    const int seeds = 6;
+    const int seeds = 12;
     for (int seed = 1; seed <= seeds; ++seed) {
       SyntheticBundleOptions so;
       so.frames = 80;
@@ -230,9 +230,15 @@ TEST(Bundle, FlangeHonestSigmaAndRigOriginsAtFreshPoses) {
       BundleOptions o;
       o.holdout_fraction = 0.0;
       const BundleResult r = RunBundle(s.nominal, s.rig, s.target, s.frames, o);
-      AddSquaredErrorOverSigma(s.truth, r, &sum_z2, &n);
+      double seed_z2 = 0;
+      int seed_n = 0;
+      AddSquaredErrorOverSigma(s.truth, r, &seed_z2, &seed_n);
+      sum_z2 += seed_z2;
+      n += seed_n;
       const double tip = TipRmsAgainstTruth(s, r.calibrated, 100, 9);
       sum_tip2 += tip * tip;
+      std::printf("  seed %d: %zu frames, RMS z %.3f, tips %.4f mm\n", seed,
+                  s.frames.size(), std::sqrt(seed_z2 / seed_n), tip);
     }
     const double rms_z = std::sqrt(sum_z2 / n);
     const double tip_rms = std::sqrt(sum_tip2 / seeds);
