@@ -82,6 +82,7 @@ std::vector<TagObs> CollectObservations(
       o.det = &d;
       o.tag = tag;
       o.px = d.corners;
+      o.use = d.usable;
       obs.push_back(o);
     }
   }
@@ -139,8 +140,10 @@ bool InitialFromObservations(const Rig& rig, const std::vector<TagObs>& obs,
     if (kv.second.size() < 2) continue;
     for (int k = 0; k < 4; ++k) {
       std::vector<PixelObservation> px;
-      for (const TagObs* o : kv.second)
-        px.push_back({o->camera, o->det->corners[k]});
+      for (const TagObs* o : kv.second) {
+        if (o->use[k]) px.push_back({o->camera, o->det->corners[k]});
+      }
+      if (px.size() < 2) continue;
       TriangulationOptions topt;
       topt.refine = false;
       const TriangulatedPoint p = TriangulatePoint(rig, px, topt);
@@ -169,6 +172,7 @@ bool InitialFromObservations(const Rig& rig, const std::vector<TagObs>& obs,
   for (const auto& o : obs) {
     if (o.camera != best) continue;
     for (int k = 0; k < 4; ++k) {
+      if (!o.use[k]) continue;
       const Eigen::Vector3d p = o.tag->CornerInTool(k);
       object.emplace_back(p.x(), p.y(), p.z());
       image.emplace_back(o.det->corners[k].x(), o.det->corners[k].y());
@@ -357,8 +361,14 @@ ToolPoseResult EstimateToolPose(
   std::vector<TagObs> obs, faint;
   for (TagObs& o : all) {
     const double c = Contrast(*o.det);
+    const int usable =
+        static_cast<int>(std::count(o.use.begin(), o.use.end(), true));
     if (c > 0 && c < options.min_contrast) {
       o.left_out = "contrast";
+      faint.push_back(o);
+    } else if (usable < 3) {
+      // The detector trusted fewer than 3 of its corners.
+      o.left_out = "corners";
       faint.push_back(o);
     } else {
       obs.push_back(o);
