@@ -513,17 +513,11 @@ bool FitSide(const cv::Mat& gray, const SideProfiles& side,
 bool RefineCornersByEdges(const cv::Mat& gray, const cv::Mat& tag_image,
                           int cells, TagDetection* det,
                           const std::vector<NeighbourTag>& others) {
-  constexpr double kFarStartPx = 0.5;
   const double start = 0.5 * (tag_image.cols - cells);
   std::array<Eigen::Vector2d, 4> c = det->corners;
   std::array<TagSideQuality, 4> quality{};
   std::array<double, 4> sigma = {0, 0, 0, 0};
-  // A start corner far off (libapriltag's, 1-2 px on a few corners) puts
-  // the pattern and the blur estimate of the first pass off as well: the
-  // blur is then estimated again and a third pass placed.
-  int passes = 2;
-  bool far_start = false;
-  for (int pass = 0; pass < passes; ++pass) {
+  for (int pass = 0; pass < 2; ++pass) {
     PatternView view{&tag_image, ImageFromTemplate(c, start, cells).inverse()};
     const Eigen::Vector2d centroid = (c[0] + c[1] + c[2] + c[3]) / 4.0;
     double shortest = 1e9;
@@ -540,9 +534,7 @@ bool RefineCornersByEdges(const cv::Mat& gray, const cv::Mat& tag_image,
       if (n.dot((a + b) / 2 - centroid) < 0) n = -n;
       const SideProfiles side =
           ProfilesOfSide(gray, view, a, b, n, cell, cells, others);
-      if (pass == 0 || (pass == 1 && far_start)) {
-        sigma[k] = SideBlur(side.profiles);
-      }
+      if (pass == 0) sigma[k] = SideBlur(side.profiles);
       if (!FitSide(gray, side, n, sigma[k], &lines[k], &quality[k])) {
         return false;
       }
@@ -552,12 +544,6 @@ bool RefineCornersByEdges(const cv::Mat& gray, const cv::Mat& tag_image,
       // Corner k joins side k-1 (from corner k-1 to k) and side k.
       if (!Intersect(lines[(k + 3) % 4], lines[k], &refined[k])) return false;
       if ((refined[k] - det->corners[k]).norm() > 3.0) return false;
-    }
-    if (pass == 0) {
-      for (int k = 0; k < 4; ++k) {
-        far_start = far_start || (refined[k] - c[k]).norm() > kFarStartPx;
-      }
-      if (far_start) passes = 3;
     }
     c = refined;
   }

@@ -54,7 +54,8 @@ struct TagObservationResult {
   double rms_px = 0;  // corner RMS against the final pose
   bool used = false;
   // Why it was left out (empty when used): "contrast" (its edges too faint
-  // to measure), "corners" (fewer than 3 corners fit the pose), "residual"
+  // to measure), "corners" (fewer than 3 corners the detector trusts
+  // (TagDetection::usable) or that fit the pose), "residual"
   // (its corners disagree with the other tags' pose).
   std::string left_out;
   double contrast = 0;       // weakest side's white - black, gray levels
