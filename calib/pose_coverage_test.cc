@@ -6,6 +6,7 @@
 #include <random>
 
 #include "data/error.h"
+#include "data/import_ipa.h"
 #include "tests/testing/paths.h"
 
 namespace kincal {
@@ -90,6 +91,22 @@ TEST(PoseCoverage, FewRowsOrBadOptions) {
   o = PoseCoverageOptions();
   o.small_travel_fraction = 1.5;
   EXPECT_THROW(o.Check(), InputError);
+}
+
+// The laser-tracker recordings of a UR10 (shared real data) raise no
+// warning: their poses determine the robot as poses over the limits do.
+TEST(PoseCoverage, NoFalseAlarmOnRealUr10Series) {
+  KINCAL_REQUIRE_SHARED_DATA("ipa-robot-accuracy");
+  const std::string dir = testing::SharedDataDir() + "/ipa-robot-accuracy/";
+  const Robot robot = Ur10();
+  for (const std::string file :
+       {"Series_A/measurements_grid.csv",
+        "Series_B/measurements_joint_configurations.csv",
+        "Series_C/measurements_random_poses.csv"}) {
+    const PoseCoverage c =
+        CheckPoseCoverage(robot, ReadIpaSeries(dir + file).observations);
+    EXPECT_TRUE(c.ok()) << file << ": " << PoseCoverageMessage(c);
+  }
 }
 
 }  // namespace

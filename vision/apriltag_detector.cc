@@ -178,8 +178,9 @@ void AprilTagDetector::RefineByEdges(const cv::Mat& gray,
     if (!RefineCornersByEdges(gray, Pattern(t.id), cells, &t, others)) {
       continue;
     }
+    const TagDetection judged = t;  // every corner against the refined ones
     for (int k = 0; k < 4; ++k) {
-      switch (JudgeCorner(t, k, options_)) {
+      switch (JudgeCorner(judged, k, options_)) {
         case CornerSource::kRefined:
           t.refined[k] = true;
           break;
