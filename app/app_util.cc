@@ -9,6 +9,7 @@
 #include <cstring>
 #include <iostream>
 
+#include "calib/pose_coverage.h"
 #include "data/error.h"
 #include "data/observation_checks.h"
 
@@ -220,5 +221,14 @@ void AddWarnings(const std::vector<Warning>& warnings, nlohmann::json* j) {
 }
 
 Warnings CommandWarnings() { return Warnings(&std::cerr); }
+
+void WarnPoseCoverage(const Robot& nominal, const Observations& obs,
+                      Warnings* warnings) {
+  const PoseCoverage coverage = CheckPoseCoverage(nominal, obs);
+  if (!coverage.ok()) {
+    warnings->Add("poses_leave_robot_undetermined",
+                  PoseCoverageMessage(coverage));
+  }
+}
 
 }  // namespace kincal::app

@@ -93,6 +93,14 @@ inline void AddWarnings(const Warnings& warnings, nlohmann::json* j) {
   AddWarnings(warnings.list(), j);
 }
 
+// Adds the warning "poses_leave_robot_undetermined" when the poses of
+// `obs` with a measured tip leave robot parameters undetermined that poses
+// over the joints' limits would determine (calib/pose_coverage.h): it names
+// them, the joints' seen travel, and points to `kincal bundle` and `kincal
+// plan --rig`. For calibrate and track --out-obs.
+void WarnPoseCoverage(const Robot& nominal, const Observations& obs,
+                      Warnings* warnings);
+
 // A command's warnings list: each warning goes to stderr as it is found (in
 // JSON mode too, so that a later refusal still shows it) and into the JSON
 // result through AddWarnings.

@@ -233,6 +233,7 @@ int RunCalibrate(CalibrateArgs args) {
       ReadCheckedObservations(args.obs, nominal, args.robot, &warnings);
   // Several series: one measuring frame each, the robot shared.
   RequireNoFrameJump(nominal, obs, "calibrate");
+  WarnPoseCoverage(nominal, obs, &warnings);
   args.options = FitOptions(args);
   Progress progress("kincal calibrate", args.json || obs.rows.size() < 500);
   progress.Stage("fitting " + std::to_string(obs.rows.size()) +

@@ -400,7 +400,8 @@ std::string JoinInts(const std::vector<int>& v) {
 }
 
 void PrintTrack(const TrackArgs& args, size_t n, const Tracked& t, bool merged,
-                const std::string& poses_path, double seconds) {
+                const std::string& poses_path, double seconds,
+                const Warnings& warnings) {
   const double median_rms = MedianOf(t.rms_values);
   const double depth_sigma = MedianOf(t.depth_sigmas_mm);
   if (args.json) {
@@ -422,6 +423,7 @@ void PrintTrack(const TrackArgs& args, size_t n, const Tracked& t, bool merged,
       j["out_obs"] = args.out_obs;
       j["merged"] = t.merged_count;
     }
+    AddWarnings(warnings, &j);
     PrintJson(j);
     return;
   }
@@ -562,11 +564,16 @@ int RunTrack(const TrackArgs& args) {
   const std::string poses_path = PosesPath(args.out);
   WriteFileAtomic(poses_path, tracked.poses);
   const bool merged = !merge.merged.rows.empty();
-  if (merged) WriteMergedObservations(args, rig, merge.merged);
+  Warnings warnings = CommandWarnings();
+  if (merged) {
+    WriteMergedObservations(args, rig, merge.merged);
+    WarnPoseCoverage(ReadRobot(args.robot), merge.merged, &warnings);
+  }
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start)
           .count();
-  PrintTrack(args, pairs.size(), tracked, merged, poses_path, seconds);
+  PrintTrack(args, pairs.size(), tracked, merged, poses_path, seconds,
+             warnings);
   return 0;
 }
 

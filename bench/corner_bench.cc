@@ -8,9 +8,11 @@
 // before its checks; the detector's final corners): the corner RMS, and the
 // RMS and maximum of a tag observation's mean corner offset (the shift its
 // four corners share, which a pose fit cannot average out). The final
-// corners are also split by what the detector kept (refined, or fallen back
-// to libapriltag's), and compared corner by corner with libapriltag's: the
-// share worse by more than 0.1 px and the RMS of the excess.
+// corners (those the detector marks usable) are also split by what the
+// detector kept (refined, or fallen back to libapriltag's), and compared
+// corner by corner with libapriltag's: the share worse by more than 0.1 px
+// and the RMS of the excess. For the corners not refined (fallen back, or
+// left out as unusable), the model's corner and libapriltag's are compared.
 //
 //   build/bin/corner_bench [--holders N] [--scene NAME]
 
@@ -97,20 +99,26 @@ std::vector<NeighbourTag> Others(const std::vector<TagDetection>& dets,
   return out;
 }
 
-void Accumulate(const TagDetection& d, const TagTruth& t,
-                const std::array<Eigen::Vector2d, 4>& corners, Stat* s) {
-  (void)d;
+// The corners' errors; with `usable`, only the corners it marks (the tag
+// shift then over those).
+void Accumulate(const TagTruth& t,
+                const std::array<Eigen::Vector2d, 4>& corners, Stat* s,
+                const std::array<bool, 4>& usable = {true, true, true, true}) {
   Eigen::Vector2d mean = Eigen::Vector2d::Zero();
+  int n = 0;
   for (int k = 0; k < 4; ++k) {
+    if (!usable[k]) continue;
     s->AddCorner(corners[k] - t.corners[k]);
-    mean += (corners[k] - t.corners[k]) / 4;
+    mean += corners[k] - t.corners[k];
+    ++n;
   }
-  s->AddTag(mean);
+  if (n > 0) s->AddTag(mean / n);
 }
 
 void RunScene(const Scene& scene, int holders) {
   std::map<std::string, Stat> stats;
-  int fallback = 0, total = 0, failed = 0, worse = 0;
+  std::map<std::string, Stat> diag_model, diag_det;  // by what was kept
+  int fallback = 0, left_out = 0, total = 0, failed = 0, worse = 0;
   double excess_sq = 0;
   for (int seed = 1; seed <= holders; ++seed) {
     std::mt19937_64 rng(1000 + seed);
@@ -136,18 +144,30 @@ void RunScene(const Scene& scene, int holders) {
             if (c.id == d.id) t = &c;
           }
           if (t == nullptr) continue;
-          Accumulate(d, *t, d.detector_corners, &stats["a libapriltag"]);
-          Accumulate(d, *t, d.corners, &stats["d final"]);
+          Accumulate(*t, d.detector_corners, &stats["a libapriltag"]);
+          Accumulate(*t, d.corners, &stats["d final (usable corners)"],
+                     d.usable);
           TagDetection raw = d;
           raw.corners = d.detector_corners;
           if (RefineCornersByEdges(view.image, TagImage("tag36h11", d.id), 8,
                                    &raw, Others(dets, d))) {
-            Accumulate(d, *t, raw.corners, &stats["c model, no checks"]);
+            Accumulate(*t, raw.corners, &stats["c model, no checks"]);
+            // Corners not refined: the model's corner against libapriltag's.
+            for (int k = 0; k < 4; ++k) {
+              if (d.refined[k]) continue;
+              const char* key = d.usable[k] ? "fallen back" : "left out";
+              diag_model[key].AddCorner(raw.corners[k] - t->corners[k]);
+              diag_det[key].AddCorner(d.detector_corners[k] - t->corners[k]);
+            }
           } else {
             ++failed;
           }
           for (int k = 0; k < 4; ++k) {
             ++total;
+            if (!d.usable[k]) {
+              ++left_out;
+              continue;
+            }
             if (!d.refined[k]) ++fallback;
             Stat& s = stats[d.refined[k] ? "e final, refined corners"
                                          : "f final, fallen back"];
@@ -162,7 +182,7 @@ void RunScene(const Scene& scene, int holders) {
         for (const TagDetection& d : previous::Refine(view.image, dets)) {
           for (const TagTruth& c : view.tags) {
             if (c.id == d.id) {
-              Accumulate(d, c, d.corners, &stats["b previous area rule"]);
+              Accumulate(c, d.corners, &stats["b previous area rule"]);
             }
           }
         }
@@ -170,10 +190,11 @@ void RunScene(const Scene& scene, int holders) {
     }
   }
   std::printf(
-      "%s: %d corners, %.1f %% fallen back, %d tags not refined; final vs "
-      "libapriltag per corner: %.2f %% worse by > 0.1 px, RMS excess %.4f "
-      "px\n",
-      scene.name.c_str(), total, 100.0 * fallback / std::max(1, total), failed,
+      "%s: %d corners, %.1f %% fallen back, %.1f %% left out, %d tags not "
+      "refined; final vs libapriltag per corner: %.2f %% worse by > 0.1 px, "
+      "RMS excess %.4f px\n",
+      scene.name.c_str(), total, 100.0 * fallback / std::max(1, total),
+      100.0 * left_out / std::max(1, total), failed,
       100.0 * worse / std::max(1, total),
       std::sqrt(excess_sq / std::max(1, total)));
   for (const auto& [name, s] : stats) {
@@ -182,6 +203,12 @@ void RunScene(const Scene& scene, int holders) {
       std::printf("  tag shift RMS %.4f max %.3f px", s.OffRms(), s.off_max);
     }
     std::printf("\n");
+  }
+  for (const auto& [name, s] : diag_model) {
+    std::printf(
+        "  not refined, %-12s %4d corners: model's corner RMS %.4f px, "
+        "libapriltag's %.4f px\n",
+        name.c_str(), s.n, s.Rms(), diag_det[name].Rms());
   }
   std::fflush(stdout);
 }

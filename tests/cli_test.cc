@@ -276,6 +276,44 @@ TEST_F(CliTest, DataThatDetermineNothingExitTwo) {
   EXPECT_THAT(r.err, HasSubstr("too few poses"));
 }
 
+// Issue 21 item 4: poses whose wrist moved over 24 deg only (simulated with
+// the wrist's limits narrowed) leave a robot parameter undetermined;
+// calibrate (against the robot's full limits) warns, naming the joints'
+// seen travel and pointing to the bundle and to plan --rig. Poses over the
+// limits give no such warning.
+TEST_F(CliTest, CalibrateWarnsWhenThePosesLeaveTheRobotUndetermined) {
+  std::string yaml = ReadFile(SourceDir() + "/data/robots/bh7.yaml");
+  for (const std::string from : {"limits: [-180, 180]", "limits: [-90, 90]"}) {
+    const size_t at = yaml.find(from);
+    ASSERT_NE(at, std::string::npos) << from;
+    yaml.replace(at, from.size(), "limits: [-31, -7]");
+  }
+  WriteText(Dir() + "/narrow.yaml", yaml);
+  RunResult r = RunKincal("simulate --robot " + Dir() + "/narrow.yaml --out " +
+                          Dir() + "/narrow --poses 120 --noise 0.03 --seed 4");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  r = RunKincal("calibrate --robot " + Robot() + " --obs " + Dir() +
+                "/narrow/observations.csv --json");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  ASSERT_TRUE(j.contains("warnings"));
+  bool found = false;
+  for (const auto& w : j["warnings"]) {
+    if (w["code"] != "poses_leave_robot_undetermined") continue;
+    found = true;
+    const std::string m = w["message"];
+    EXPECT_THAT(m, HasSubstr("j4 2"));  // seen travel 2x deg
+    EXPECT_THAT(m, HasSubstr("(small)"));
+    EXPECT_THAT(m, HasSubstr("kincal bundle"));
+    EXPECT_THAT(m, HasSubstr("kincal plan --rig"));
+  }
+  EXPECT_TRUE(found) << r.out;
+  EXPECT_THAT(r.err, HasSubstr("poses_leave_robot_undetermined"));
+  r = RunKincal("calibrate --robot " + Robot() + " --obs " + Obs() + " --json");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_THAT(r.out, ::testing::Not(HasSubstr("poses_leave_robot")));
+}
+
 TEST_F(CliTest, FailedRunKeepsExistingOutput) {
   const std::string out = Dir() + "/keep.yaml";
   WriteText(out, "previous\n");

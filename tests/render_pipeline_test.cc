@@ -9,8 +9,10 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <fstream>
 #include <nlohmann/json.hpp>
 
+#include "data/atomic_file.h"
 #include "data/observations.h"
 #include "data/robot.h"
 #include "tests/testing/paths.h"
@@ -133,4 +135,39 @@ TEST(RenderPipelineTest, MergeNeedsMatchingRows) {
 }
 
 }  // namespace
+// Issue 21 item 4: a rendered session whose wrist moved over 24 deg only
+// (simulated with the wrist's limits narrowed): track --out-obs, given the
+// robot with its full limits, warns that the tracked tips leave the robot
+// undetermined and points to the bundle and to plan --rig.
+TEST(RenderPipelineTest,
+     TrackOutObsWarnsWhenThePosesLeaveTheRobotUndetermined) {
+  const std::string dir = MakeTempDir("render_narrow");
+  std::string yaml = ReadFile(SourceDir() + "/data/robots/bh7.yaml");
+  for (const std::string from : {"limits: [-180, 180]", "limits: [-90, 90]"}) {
+    const size_t at = yaml.find(from);
+    ASSERT_NE(at, std::string::npos) << from;
+    yaml.replace(at, from.size(), "limits: [-31, -7]");
+  }
+  std::ofstream(dir + "/narrow.yaml") << yaml;
+  RunResult r =
+      RunKincal("simulate --robot " + dir + "/narrow.yaml --out " + dir +
+                "/s --poses 40 --noise 0 --seed 21 --render "
+                "--render-noise 1.5 --render-blur 0.5");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  r = RunKincal("track --rig " + dir + "/s/rig.yaml --target " + dir +
+                "/s/target.yaml --session " + dir + "/s/session --out " + dir +
+                "/points.csv --robot " + SourceDir() +
+                "/data/robots/bh7.yaml --out-obs " + dir +
+                "/tracked.csv --json --quiet");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto track = nlohmann::json::parse(r.out);
+  ASSERT_GT(track["merged"].get<int>(), 10);
+  ASSERT_TRUE(track.contains("warnings")) << r.out;
+  const std::string text = track["warnings"].dump();
+  EXPECT_NE(text.find("poses_leave_robot_undetermined"), std::string::npos);
+  EXPECT_NE(text.find("j5 2"), std::string::npos) << text;
+  EXPECT_NE(text.find("kincal bundle"), std::string::npos);
+  EXPECT_NE(r.err.find("poses_leave_robot_undetermined"), std::string::npos);
+}
+
 }  // namespace kincal::testing

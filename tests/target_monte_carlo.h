@@ -125,13 +125,19 @@ inline std::vector<LayoutFrame> RenderAndDetect(
       for (const TagDetection& d : f.detections.back()) {
         for (const TagTruth& t : view.tags) {
           if (t.id != d.id) continue;
+          // The corners the detector trusts (those the fits use).
           Eigen::Vector2d mean = Eigen::Vector2d::Zero();
+          int n = 0;
           for (int k = 0; k < 4; ++k) {
+            if (!d.usable[k]) continue;
             errors->sum_sq += (d.corners[k] - t.corners[k]).squaredNorm();
-            mean += (d.corners[k] - t.corners[k]) / 4;
+            mean += d.corners[k] - t.corners[k];
+            ++n;
           }
-          errors->n += 4;
-          errors->max_offset = std::max(errors->max_offset, mean.norm());
+          errors->n += n;
+          if (n > 0) {
+            errors->max_offset = std::max(errors->max_offset, mean.norm() / n);
+          }
         }
       }
     }

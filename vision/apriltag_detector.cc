@@ -76,6 +76,19 @@ void AprilTagOptions::Check() const {
   if (max_hamming < 0 || max_hamming > 2) {
     fail("max_hamming (expected 0..2)", max_hamming);
   }
+  if (!(max_refine_shift_px > 0.0)) {
+    fail("max_refine_shift_px (expected > 0)", max_refine_shift_px);
+  }
+  if (!(max_edge_rms_px > 0.0)) {
+    fail("max_edge_rms_px (expected > 0)", max_edge_rms_px);
+  }
+  if (!(detector_off_edges_px > 0.0)) {
+    fail("detector_off_edges_px (expected > 0)", detector_off_edges_px);
+  }
+  if (!(max_fallback_edge_rms_px >= max_edge_rms_px)) {
+    fail("max_fallback_edge_rms_px (expected >= max_edge_rms_px)",
+         max_fallback_edge_rms_px);
+  }
   if (!(decode_sharpening >= 0.0)) {
     fail("decode_sharpening (expected >= 0)", decode_sharpening);
   }
@@ -112,6 +125,43 @@ const cv::Mat& AprilTagDetector::Pattern(int id) {
   return it->second;
 }
 
+namespace {
+
+// Distance of p from the line through a and b.
+double LineDistance(const Eigen::Vector2d& p, const Eigen::Vector2d& a,
+                    const Eigen::Vector2d& b) {
+  const Eigen::Vector2d d = (b - a).normalized();
+  return std::abs(d.x() * (p - a).y() - d.y() * (p - a).x());
+}
+
+}  // namespace
+
+// Corner k joins side k-1 (corners k-1, k) and side k (corners k, k+1).
+// Refined corners whose two sides' edge points lie on their lines are taken.
+// Otherwise libapriltag's corner is judged by the same edge evidence: off
+// either refined line by more than detector_off_edges_px it is the worse of
+// the two (bench/corner_bench.cc: 0.7-2.6 px against 0.1-0.6 for the
+// refined one), and the refined corner is taken while it stays within
+// max_refine_shift_px; on the lines, it is taken while the sides scatter
+// less than max_fallback_edge_rms_px, and neither is trusted beyond that.
+CornerSource JudgeCorner(const TagDetection& t, int k,
+                         const AprilTagOptions& options) {
+  const int prev = (k + 3) % 4, next = (k + 1) % 4;
+  const double scatter =
+      std::max(t.sides[k].line_rms_px, t.sides[prev].line_rms_px);
+  const bool near = (t.corners[k] - t.detector_corners[k]).norm() <=
+                    options.max_refine_shift_px;
+  if (scatter <= options.max_edge_rms_px && near) return CornerSource::kRefined;
+  const double off_edges = std::max(
+      LineDistance(t.detector_corners[k], t.corners[prev], t.corners[k]),
+      LineDistance(t.detector_corners[k], t.corners[k], t.corners[next]));
+  if (off_edges > options.detector_off_edges_px) {
+    return near ? CornerSource::kRefined : CornerSource::kNeither;
+  }
+  return scatter <= options.max_fallback_edge_rms_px ? CornerSource::kDetector
+                                                     : CornerSource::kNeither;
+}
+
 // Each detection refined with the others' quads known (its sampling skips
 // them), then checked corner by corner against libapriltag's.
 void AprilTagDetector::RefineByEdges(const cv::Mat& gray,
@@ -128,15 +178,20 @@ void AprilTagDetector::RefineByEdges(const cv::Mat& gray,
     if (!RefineCornersByEdges(gray, Pattern(t.id), cells, &t, others)) {
       continue;
     }
+    const TagDetection judged = t;  // every corner against the refined ones
     for (int k = 0; k < 4; ++k) {
-      // Corner k joins side k-1 and side k.
-      const bool sides_ok =
-          t.sides[k].line_rms_px <= options_.max_edge_rms_px &&
-          t.sides[(k + 3) % 4].line_rms_px <= options_.max_edge_rms_px;
-      const bool near = (t.corners[k] - t.detector_corners[k]).norm() <=
-                        options_.max_refine_shift_px;
-      t.refined[k] = sides_ok && near;
-      if (!t.refined[k]) t.corners[k] = t.detector_corners[k];
+      switch (JudgeCorner(judged, k, options_)) {
+        case CornerSource::kRefined:
+          t.refined[k] = true;
+          break;
+        case CornerSource::kDetector:
+          t.corners[k] = t.detector_corners[k];
+          break;
+        case CornerSource::kNeither:
+          t.corners[k] = t.detector_corners[k];
+          t.usable[k] = false;
+          break;
+      }
     }
   }
 }

@@ -53,6 +53,10 @@ struct TagDetection {
   // from them only where refined[k] (the refinement passed its checks).
   std::array<Eigen::Vector2d, 4> detector_corners = corners;
   std::array<bool, 4> refined = {false, false, false, false};
+  // False where neither the refined nor libapriltag's corner can be trusted
+  // (JudgeCorner): the fits leave that corner out. `corners[k]` then holds
+  // libapriltag's.
+  std::array<bool, 4> usable = {true, true, true, true};
   // Per side, when the edge refinement ran (all zero otherwise).
   std::array<TagSideQuality, 4> sides{};
   double decision_margin = 0;  // libapriltag's decoding quality
@@ -87,21 +91,34 @@ struct AprilTagOptions {
   // Tags whose decision margin is below this are dropped.
   double min_decision_margin = 0.0;
   // Checks of the edge refinement, per corner (the refinement must never be
-  // worse than the detector it refines): a refined corner falls back to
-  // libapriltag's when an adjacent side's edge points scatter more than
-  // max_edge_rms_px about their line, or when it moved more than
-  // max_refine_shift_px from libapriltag's. The shift limit is wide on
-  // purpose: libapriltag's own corners are off by 1-2 px on 1-2 % of the
-  // corners of rendered holders (bench/corner_bench.cc), and a tight limit
-  // (0.3 px, then 1.5 px) put exactly those back; the edge fit's own
-  // evidence (line scatter) and the pose fit's per-corner check
-  // (vision/tool_pose.h, which compares the two against the pose) judge.
+  // worse than the detector it refines; JudgeCorner): a refined corner is
+  // taken when both adjacent sides' edge points scatter at most
+  // max_edge_rms_px about their lines and it moved at most
+  // max_refine_shift_px from libapriltag's. Otherwise libapriltag's corner
+  // is judged by the same edge evidence: farther than detector_off_edges_px
+  // from either refined side line, it is the bad one and the refined corner
+  // is taken (within max_refine_shift_px; the corner is unusable beyond);
+  // on the lines, it is taken while the sides scatter at most
+  // max_fallback_edge_rms_px, and the corner is unusable beyond. The shift
+  // limit is wide on purpose: libapriltag's own corners are off by 1-2 px
+  // on 1-2 % of the corners of rendered holders (bench/corner_bench.cc).
+  // The pose fit's per-corner check (vision/tool_pose.h) judges again
+  // against the pose.
   double max_refine_shift_px = 3.0;
   double max_edge_rms_px = 0.15;
+  double detector_off_edges_px = 0.3;
+  double max_fallback_edge_rms_px = 0.3;
 
   // Throws InputError naming the bad option and its value.
   void Check() const;
 };
+
+// Which corner a detection keeps at index k after the edge refinement (see
+// AprilTagOptions' checks); `t` holds the refined corners, libapriltag's and
+// the sides' quality. Exposed for tests.
+enum class CornerSource { kRefined, kDetector, kNeither };
+CornerSource JudgeCorner(const TagDetection& t, int k,
+                         const AprilTagOptions& options);
 
 class AprilTagDetector {
  public:

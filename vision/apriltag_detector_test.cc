@@ -214,5 +214,54 @@ TEST(AprilTagDetector, DetectInRegionReportsFullImageCoordinates) {
   EXPECT_TRUE(detector.DetectInRegion(image, cv::Rect(0, 0, 150, 150)).empty());
 }
 
+// A square tag of side 100 px, refined corners exact, sides' scatter given.
+TagDetection JudgedTag(double scatter) {
+  TagDetection t;
+  t.corners = {Eigen::Vector2d(0, 100), Eigen::Vector2d(100, 100),
+               Eigen::Vector2d(100, 0), Eigen::Vector2d(0, 0)};
+  t.detector_corners = t.corners;
+  for (TagSideQuality& s : t.sides) s.line_rms_px = 0.05;
+  // Corner 2 joins sides 1 and 2.
+  t.sides[1].line_rms_px = scatter;
+  return t;
+}
+
+TEST(JudgeCorner, RefinedWhereTheEdgesAgree) {
+  const AprilTagOptions o;
+  TagDetection t = JudgedTag(0.05);
+  t.detector_corners[2] += Eigen::Vector2d(1.5, -1.0);  // libapriltag off
+  EXPECT_EQ(JudgeCorner(t, 2, o), CornerSource::kRefined);
+  // Moved further than the refinement's bound: neither is trusted when
+  // libapriltag's is off the edges.
+  t.detector_corners[2] = t.corners[2] + Eigen::Vector2d(3.0, -2.0);
+  EXPECT_EQ(JudgeCorner(t, 2, o), CornerSource::kNeither);
+}
+
+TEST(JudgeCorner, ScatteredSidesJudgeLibapriltagsCornerByTheirLines) {
+  const AprilTagOptions o;
+  // Sides scatter 0.2 px: libapriltag's corner 1 px off one side's line is
+  // the bad one; the refined corner is taken.
+  TagDetection t = JudgedTag(0.2);
+  t.detector_corners[2] += Eigen::Vector2d(1.0, 0.0);
+  EXPECT_EQ(JudgeCorner(t, 2, o), CornerSource::kRefined);
+  // On both lines (0.1 px away): libapriltag's corner is taken.
+  t.detector_corners[2] = t.corners[2] + Eigen::Vector2d(0.1, -0.1);
+  EXPECT_EQ(JudgeCorner(t, 2, o), CornerSource::kDetector);
+  // The same with sides scattering 0.5 px: neither.
+  t.sides[1].line_rms_px = 0.5;
+  EXPECT_EQ(JudgeCorner(t, 2, o), CornerSource::kNeither);
+  // Corners not next to the scattered side are refined.
+  EXPECT_EQ(JudgeCorner(t, 0, o), CornerSource::kRefined);
+}
+
+TEST(JudgeCorner, RejectsInconsistentOptions) {
+  AprilTagOptions o;
+  o.max_fallback_edge_rms_px = 0.1;  // below max_edge_rms_px
+  EXPECT_THROW(o.Check(), InputError);
+  o = AprilTagOptions();
+  o.detector_off_edges_px = 0;
+  EXPECT_THROW(o.Check(), InputError);
+}
+
 }  // namespace
 }  // namespace kincal

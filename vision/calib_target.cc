@@ -225,6 +225,7 @@ TargetObservation CalibTargetDetector::Detect(const cv::Mat& gray) {
     const int i = index_of(det.id);
     if (i < 0 || i >= num_tags || count[i] != 1) continue;
     for (int k = 0; k < 4; ++k) {
+      if (!det.usable[k]) continue;
       obs.p_in_target.push_back(impl_->points[4 * i + k]);
       obs.pixels.push_back(det.corners[k]);
     }

@@ -318,6 +318,7 @@ Problem CollectProblem(const Rig& rig, const std::vector<LayoutFrame>& frames,
           continue;
         }
         for (int k = 0; k < 4; ++k) {
+          if (!d.usable[k]) continue;
           p.corners.push_back(
               {fi, index[d.id], static_cast<int>(c), k, d.corners[k]});
         }

@@ -24,6 +24,9 @@ struct ToolPoseOptions {
   //  - before the fit, one whose edges have a contrast under min_contrast
   //    gray levels (TagSideQuality::contrast, the weakest side) is left out
   //    ("contrast");
+  //  - before the fit, one the detector's edge refinement could not refine
+  //    (libapriltag's corners) is left out while refined ones determine the
+  //    pose ("unrefined");
   //  - after the fit, the worst is left out while its corner RMS exceeds
   //    max(outlier_px, outlier_ratio * median tag RMS) ("residual"), the
   //    fit redone each time; between outlier_px and hard_outlier_px only
@@ -54,7 +57,9 @@ struct TagObservationResult {
   double rms_px = 0;  // corner RMS against the final pose
   bool used = false;
   // Why it was left out (empty when used): "contrast" (its edges too faint
-  // to measure), "corners" (fewer than 3 corners fit the pose), "residual"
+  // to measure), "corners" (fewer than 3 corners the detector trusts
+  // (TagDetection::usable) or that fit the pose), "unrefined" (the edge
+  // refinement failed on it while other tags were refined), "residual"
   // (its corners disagree with the other tags' pose).
   std::string left_out;
   double contrast = 0;       // weakest side's white - black, gray levels

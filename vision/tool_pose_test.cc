@@ -177,5 +177,90 @@ TEST(ToolPose, PerCornerCheckFallsBackOrDrops) {
   EXPECT_LT((r.tip_in_rig - clean.tip_in_rig).norm(), 0.05);
 }
 
+// Corners the detector marks unusable take no part, though they fit the
+// pose here: one such corner leaves the tag with three, two leave the tag
+// out ("corners").
+TEST(ToolPose, UnusableCornersTakeNoPart) {
+  const Rig rig = ExampleStereoRig(640, 512);
+  const Target target = ExampleTarget();
+  RenderOptions o;
+  o.blur_sigma_px = 0.6;
+  StereoRenderer renderer(rig, target, o);
+  std::mt19937_64 rng(4);
+  const StereoFrameTruth frame = renderer.Render(ExampleToolPose(3), &rng);
+  AprilTagDetector detector;
+  std::vector<std::vector<TagDetection>> dets;
+  for (const auto& v : frame.views) dets.push_back(detector.Detect(v.image));
+  ASSERT_GE(dets[0].size(), 3u);
+  const ToolPoseResult clean = EstimateToolPose(rig, target, dets);
+  ASSERT_TRUE(clean.found);
+  TagDetection& a = dets[0][0];
+  a.usable[3] = false;
+  TagDetection& b = dets[0][1];
+  b.usable[0] = b.usable[1] = false;
+  const ToolPoseResult r = EstimateToolPose(rig, target, dets);
+  ASSERT_TRUE(r.found);
+  EXPECT_EQ(r.tags_used, clean.tags_used - 1);
+  bool saw_a = false, saw_b = false;
+  for (const auto& t : r.tags) {
+    if (t.camera != 0) continue;
+    if (t.tag_id == a.id) {
+      saw_a = true;
+      EXPECT_TRUE(t.used);
+      EXPECT_FALSE(t.corner_used[3]);
+    }
+    if (t.tag_id == b.id) {
+      saw_b = true;
+      EXPECT_FALSE(t.used);
+      EXPECT_EQ(t.left_out, "corners");
+    }
+  }
+  EXPECT_TRUE(saw_a && saw_b);
+  EXPECT_LT(r.rms_px, 0.1);
+  EXPECT_LT((r.tip_in_rig - clean.tip_in_rig).norm(), 0.05);
+}
+
+// A tag the edge refinement could not refine (libapriltag's corners, here
+// moved 1 px as libapriltag's are on a few per cent of corners) is left out
+// while the refined tags determine the pose; alone in its camera it stays.
+TEST(ToolPose, UnrefinedTagLeftOutWhileOthersDetermineThePose) {
+  const Rig rig = ExampleStereoRig(640, 512);
+  const Target target = ExampleTarget();
+  RenderOptions o;
+  o.blur_sigma_px = 0.6;
+  StereoRenderer renderer(rig, target, o);
+  std::mt19937_64 rng(4);
+  const StereoFrameTruth frame = renderer.Render(ExampleToolPose(3), &rng);
+  AprilTagDetector detector;
+  std::vector<std::vector<TagDetection>> dets;
+  for (const auto& v : frame.views) dets.push_back(detector.Detect(v.image));
+  ASSERT_GE(dets[0].size(), 3u);
+  const ToolPoseResult clean = EstimateToolPose(rig, target, dets);
+  ASSERT_TRUE(clean.found);
+  TagDetection& a = dets[0][0];
+  a.refined = {false, false, false, false};
+  a.sides = {};
+  for (auto& c : a.corners) c += Eigen::Vector2d(0.7, -0.7);
+  a.detector_corners = a.corners;
+  const ToolPoseResult r = EstimateToolPose(rig, target, dets);
+  ASSERT_TRUE(r.found);
+  EXPECT_EQ(r.tags_used, clean.tags_used - 1);
+  for (const auto& t : r.tags) {
+    if (t.camera == 0 && t.tag_id == a.id) {
+      EXPECT_EQ(t.left_out, "unrefined");
+    }
+  }
+  EXPECT_LT((r.tip_in_rig - clean.tip_in_rig).norm(), 0.05);
+  // Every tag unrefined (a detector without refinement): all are used.
+  for (auto& c : a.corners) c -= Eigen::Vector2d(0.7, -0.7);
+  for (auto& cam : dets) {
+    for (TagDetection& d : cam) {
+      d.refined = {false, false, false, false};
+      d.sides = {};
+    }
+  }
+  EXPECT_EQ(EstimateToolPose(rig, target, dets).tags_used, clean.tags_used);
+}
+
 }  // namespace
 }  // namespace kincal

@@ -22,6 +22,7 @@ std::vector<StereoCorner> MatchTagCorners(
     for (const auto& b : view1) {
       if (b.id != a.id) continue;
       for (int k = 0; k < 4; ++k) {
+        if (!a.usable[k] || !b.usable[k]) continue;
         out.push_back({a.id, k, a.corners[k], b.corners[k]});
       }
     }
