@@ -177,6 +177,11 @@ int RunCompensate(const CompensateArgs& args) {
   if (!args.obs.empty() && options.targets_in_measuring_frame) {
     throw InputError("--obs registers its own frame: leave out --frame");
   }
+  if (!options.series.empty() && !options.targets_in_measuring_frame) {
+    throw InputError("--series " + options.series +
+                     " names a measuring frame: give it with --frame "
+                     "measuring (targets in the base frame need none)");
+  }
   if (!args.obs.empty()) {
     const Observations obs =
         ReadCheckedObservations(args.obs, robot, args.robot, &warnings);
@@ -299,6 +304,10 @@ void AddCompensateCommand(CLI::App& app, Runner* run) {
                   "when the model was fitted)")
       ->check(CLI::IsMember({"base", "measuring"}))
       ->capture_default_str();
+  sub->add_option("--series", args->options.series,
+                  "with --frame measuring and a model fitted on several "
+                  "series: the series whose instrument frame the targets "
+                  "are in (default: the first, with a warning)");
   sub->add_option("--out", args->out,
                   "Q.csv to write: target and one column "
                   "per joint (the robot file's units)")

@@ -257,6 +257,18 @@ void FillTransmissionSines(const Chain& chain, PoseInput* in) {
   if (!any) return;
   in->transmission_sines.assign(kMaxTransmissionTerms * n, 0.0);
   for (int j = 0; j < n; ++j) {
+    const ChainRow& row = chain.rows[j];
+    if (row.periodic()) {  // the basis functions at the reading: B^T f(q)
+      double f[kPeriodicTerms];
+      PeriodicTerms(in->q[j], f);
+      for (int k = 0; k < kMaxTransmissionTerms; ++k) {
+        const double* b = &row.periodic_basis[kPeriodicTerms * k];
+        double phi = 0.0;
+        for (int t = 0; t < kPeriodicTerms; ++t) phi += b[t] * f[t];
+        in->transmission_sines[kMaxTransmissionTerms * j + k] = phi;
+      }
+      continue;
+    }
     // Each term through the hook itself (a unit coefficient vector).
     for (int k = 0; k < kMaxTransmissionTerms; ++k) {
       double unit[kMaxTransmissionTerms] = {};

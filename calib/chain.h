@@ -395,6 +395,9 @@ T TransmissionError(const T* c, double q_read, const ChainRow& row,
     double f[kPeriodicTerms];
     PeriodicTerms(q_read, f);
     for (int k = 0; k < kMaxTransmissionTerms; ++k) {
+      if constexpr (std::is_same_v<T, double>) {
+        if (c[k] == 0.0) continue;
+      }
       const double* b = &row.periodic_basis[kPeriodicTerms * k];
       double phi = 0.0;
       for (int t = 0; t < kPeriodicTerms; ++t) phi += b[t] * f[t];

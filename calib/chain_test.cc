@@ -178,6 +178,36 @@ TEST(ChainTest, ApproachDirectionAndGravityTorque) {
   EXPECT_NEAR(axes[4].z(), 0.0, 1e-12);
 }
 
+// The cached transmission terms (PoseInput::transmission_sines) are the
+// terms TransmissionError evaluates one at a time: for a periodic basis and
+// for a sine series over the travel.
+TEST(ChainTest, CachedTransmissionTermsMatchTheFunction) {
+  Chain c = Bh7();
+  c.rows[1].periodic_basis.resize(kPeriodicTerms * kMaxTransmissionTerms);
+  for (size_t i = 0; i < c.rows[1].periodic_basis.size(); ++i) {
+    c.rows[1].periodic_basis[i] = std::sin(0.37 * static_cast<double>(i));
+  }
+  c.rows[2].transmission_lo = -1.0;
+  c.rows[2].transmission_hi = 1.5;
+  const PoseInput base = Input(c, {50, 200, -40, 30, 10});
+  for (double q2 : {-2.9, 0.3, 3.0}) {
+    PoseInput in = base;
+    in.q[1] = q2;
+    FillTransmissionSines(c, &in);
+    ASSERT_EQ(in.transmission_sines.size(),
+              static_cast<size_t>(kMaxTransmissionTerms * c.num_joints()));
+    for (int j : {1, 2}) {
+      for (int k = 0; k < kMaxTransmissionTerms; ++k) {
+        double unit[kMaxTransmissionTerms] = {};
+        unit[k] = 1.0;
+        EXPECT_NEAR(in.transmission_sines[kMaxTransmissionTerms * j + k],
+                    TransmissionError(unit, in.q[j], c.rows[j]), 1e-12)
+            << "joint " << j << " term " << k;
+      }
+    }
+  }
+}
+
 TEST(ChainTest, RobotRoundTripKeepsValuesAndExtensions) {
   const Robot robot =
       ReadRobotYaml(testing::SourceDir() + "/data/robots/bh7.yaml");

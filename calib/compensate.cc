@@ -5,6 +5,7 @@
 #include <cmath>
 #include <random>
 
+#include "calib/fit_record.h"
 #include "calib/model_state.h"
 #include "data/error.h"
 #include "data/rigid3.h"
@@ -213,20 +214,54 @@ void WarnAboutTheModel(const Robot& robot, const Chain& chain,
 
 // The recorded measuring frame (fitted_on.frame: rotation vector deg, mm)
 // as a pose block (rad, mm).
-std::array<double, kFrameBlockSize> RecordedFrameBlock(const FitRecord& rec) {
-  std::array<double, kFrameBlockSize> block = rec.frame;
-  for (int k = 0; k < 3; ++k) block[k] *= M_PI / 180.0;
-  return block;
+// The recorded measuring frames as a state's frame blocks (rad, mm): one, or
+// one per series with their labels so the covariance's frame.<series>.*
+// resolve.
+void SetRecordedFrames(const FitRecord& rec, ModelState* state) {
+  auto block = [](const std::array<double, 6>& deg_mm) {
+    std::array<double, kFrameBlockSize> b = deg_mm;
+    for (int k = 0; k < 3; ++k) b[k] *= M_PI / 180.0;
+    return b;
+  };
+  state->meas_from_base = block(rec.frame);
+  state->more_frames.clear();
+  state->frame_series.clear();
+  if (rec.series_frames.size() < 2) return;
+  state->meas_from_base = block(rec.series_frames[0].second);
+  for (size_t i = 0; i < rec.series_frames.size(); ++i) {
+    state->frame_series.push_back(rec.series_frames[i].first);
+    if (i > 0) state->more_frames.push_back(block(rec.series_frames[i].second));
+  }
 }
 
-// A target given in the measuring frame, in the base frame.
-IkTarget FromMeasuringFrame(const FitRecord& rec, const IkTarget& t) {
+// A target given in measuring frame `frame` of `state`, in the base frame.
+IkTarget FromMeasuringFrame(const ModelState& state, int frame,
+                            const IkTarget& t) {
   const Rigid3 base_from_meas =
-      Rigid3FromPoseBlock(RecordedFrameBlock(rec).data()).Inverse();
+      Rigid3FromPoseBlock(state.FrameBlock(frame)).Inverse();
   IkTarget out = t;
   out.position_mm = base_from_meas * t.position_mm;
   out.rotation = base_from_meas.R * t.rotation;
   return out;
+}
+
+// Targets in the measuring frame of a model fitted on several series, with
+// no series named: the first series' frame is used, and said.
+void WarnAboutTheFrame(const FitRecord& rec, const CompensateOptions& options,
+                       Warnings* warnings) {
+  if (!options.targets_in_measuring_frame || !options.series.empty() ||
+      rec.series_frames.size() < 2) {
+    return;
+  }
+  std::string others;
+  for (size_t i = 1; i < rec.series_frames.size(); ++i) {
+    others += (i > 1 ? ", " : "") + rec.series_frames[i].first;
+  }
+  warnings->Add("series_frame_assumed",
+                "the model was fitted on several series, each with its own "
+                "measuring frame: the targets are taken in series " +
+                    rec.series_frames[0].first + "'s frame (others: " + others +
+                    "); name the instrument's series with --series");
 }
 
 // The target of a joint program row: the nominal kinematics at its readings
@@ -283,11 +318,28 @@ void Judge(const Robot& robot, const TipUncertainty& uncertainty,
 
 }  // namespace
 
-TipUncertainty::TipUncertainty(const Robot& robot, const Chain& chain)
-    : covariance_(&robot.fitted_on.covariance) {
+int SeriesFrameIndex(const FitRecord& rec, const std::string& series) {
+  if (series.empty() || rec.series_frames.size() < 2) return 0;
+  std::string known;
+  for (size_t i = 0; i < rec.series_frames.size(); ++i) {
+    if (rec.series_frames[i].first == series) return static_cast<int>(i);
+    known += (i ? ", " : "") + rec.series_frames[i].first;
+  }
+  throw InputError("--series " + series +
+                   ": the model was fitted on the series " + known +
+                   "; the targets' frame must be one of them");
+}
+
+TipUncertainty::TipUncertainty(const Robot& robot, const Chain& chain,
+                               const std::string& series)
+    : covariance_(&robot.fitted_on.covariance),
+      frame_(SeriesFrameIndex(robot.fitted_on, series)) {
   const FitRecord& rec = robot.fitted_on;
   state_.chain = chain;
-  state_.meas_from_base = RecordedFrameBlock(rec);
+  // A periodic transmission's covariance names the fitted functions'
+  // coefficients: the row takes their basis back (same prediction).
+  ApplyPeriodicBases(rec, &state_.chain);
+  SetRecordedFrames(rec, &state_);
   // The tip in the measuring frame when the covariance carries the frame:
   // the frame's correlation with the robot's parameters takes out what the
   // registration absorbs (targets are located through the instrument).
@@ -310,10 +362,9 @@ double TipUncertainty::SigmaMm(const std::vector<double>& q,
   auto tip = [&] {
     const Eigen::Vector3d b =
         ModelPoseAtReadings(state.chain, q, context).block<3, 1>(0, 3);
-    return in_measuring_frame_
-               ? Eigen::Vector3d(
-                     ApplyFrame(state.meas_from_base.data(), Vec3<double>(b)))
-               : b;
+    return in_measuring_frame_ ? Eigen::Vector3d(ApplyFrame(
+                                     state.FrameBlock(frame_), Vec3<double>(b)))
+                               : b;
   };
   Eigen::MatrixXd jac(3, p);
   for (int k = 0; k < p; ++k) {
@@ -339,14 +390,18 @@ CompensateResult Compensate(const Robot& robot,
   if (options.ik.limits.empty()) options.ik.limits = JointLimits(robot);
   const Chain chain = Chain::FromRobot(robot);
   const Chain nominal = NominalChain(robot);
-  const TipUncertainty uncertainty(robot, chain);
+  const TipUncertainty uncertainty(robot, chain, options.series);
   if (options.targets_in_measuring_frame && !robot.fitted_on.has_frame) {
     throw InputError(
         "targets in the measuring frame: the robot file records no frame "
         "(fitted_on.frame); calibrate or diagnose it with a current kincal, "
         "or give the targets in the base frame");
   }
+  ModelState frames;
+  SetRecordedFrames(robot.fitted_on, &frames);
+  const int frame = SeriesFrameIndex(robot.fitted_on, options.series);
   CompensateResult result;
+  WarnAboutTheFrame(robot.fitted_on, options, &result.warnings);
   WarnAboutTheModel(robot, chain, &result.warnings);
   std::vector<double> previous = options.start, previous_s;
   std::vector<double> previous_nom = options.start;
@@ -360,7 +415,7 @@ CompensateResult Compensate(const Robot& robot,
     CompensateTarget target = t;
     IkResult controller;
     if (options.targets_in_measuring_frame && !t.from_joints) {
-      target.target = FromMeasuringFrame(robot.fitted_on, t.target);
+      target.target = FromMeasuringFrame(frames, frame, t.target);
     }
     if (t.from_joints) {
       target.target = ProgramTarget(nominal, t.seed);

@@ -60,6 +60,11 @@ struct CompensateOptions {
   // registered in (robot.yaml fitted_on.frame), e.g. points a tracker
   // measured; false = in the robot's base frame.
   bool targets_in_measuring_frame = false;
+  // With targets in the measuring frame and a model fitted on several series
+  // (fitted_on.series_frames): the series whose instrument frame the targets
+  // are in; empty = the first series (a warning `series_frame_assumed`
+  // names it).
+  std::string series;
 };
 
 struct CompensatedTarget {
@@ -105,7 +110,10 @@ class TipUncertainty {
  public:
   // Throws InputError when a covariance parameter names nothing in the model,
   // or names the frame while fitted_on records none.
-  TipUncertainty(const Robot& robot, const Chain& chain);
+  // `series`: the measuring frame of that series (fitted_on.series_frames;
+  // empty = the first).
+  TipUncertainty(const Robot& robot, const Chain& chain,
+                 const std::string& series = "");
   // mm, 3D; NaN when the robot carries no covariance.
   double SigmaMm(const std::vector<double>& q, const IkContext& context) const;
 
@@ -114,7 +122,13 @@ class TipUncertainty {
   ModelState state_;
   std::vector<ParamInfo> params_;
   bool in_measuring_frame_ = false;
+  int frame_ = 0;  // the frame targets are located through
 };
+
+// The frame index of `series` among fitted_on.series_frames (0 for a model of
+// one series or an empty `series`); throws InputError naming the recorded
+// series when it is not one of them.
+int SeriesFrameIndex(const FitRecord& rec, const std::string& series);
 
 }  // namespace kincal
 

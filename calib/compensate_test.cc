@@ -3,6 +3,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <Eigen/Geometry>
 #include <cmath>
 #include <random>
 
@@ -148,6 +149,55 @@ TEST(CompensateTest, SigmaPropagatesTheCovariance) {
   // A covariance naming nothing in the model is refused.
   real.fitted_on.covariance_params = {"tool.q"};
   EXPECT_THROW(Compensate(real, targets, CompensateOptions{}), InputError);
+}
+
+// A model fitted on two series (one measuring frame each): the covariance's
+// frame.<series>.* resolve; targets given in series B's instrument frame are
+// located through B's frame, not the first series'.
+TEST(CompensateTest, TargetsInTheMeasuringFrameOfANamedSeries) {
+  Robot real = ExtendedUr10();
+  real.fitted_on.poses = 100;
+  real.fitted_on.has_frame = true;
+  real.fitted_on.frame = {0, 0, 0, 0, 0, 0};
+  const std::array<double, 6> frame_b = {0, 0, 90, 1000, -200, 50};
+  real.fitted_on.series_frames = {{"A", real.fitted_on.frame}, {"B", frame_b}};
+  real.fitted_on.covariance_params = {"frame.B.x", "tool.d"};
+  real.fitted_on.covariance = Eigen::Matrix2d::Identity() * 0.04;
+  real.fitted_on.systematic_rms_mm = 0.0;
+  auto targets = RandomTargets(real, 3, false, 9);
+  // Base -> B: rotation 90 deg about z, then the translation.
+  const Eigen::Matrix3d rz =
+      Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  const Eigen::Vector3d t_b(1000, -200, 50);
+  auto in_b = targets;
+  for (auto& t : in_b) t.target.position_mm = rz * t.target.position_mm + t_b;
+  CompensateOptions options;
+  options.targets_in_measuring_frame = true;
+  options.series = "B";
+  const CompensateResult r = Compensate(real, in_b, options);
+  const CompensateResult base = Compensate(real, targets, CompensateOptions{});
+  ASSERT_EQ(r.reached, 3);
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 6; ++j) {
+      EXPECT_NEAR(r.targets[i].q[j], base.targets[i].q[j], 1e-6);
+    }
+    // frame.B.x (0.2 mm) and tool.d (0.2 mm, along the flange axis).
+    EXPECT_GT(r.targets[i].sigma_mm, 0.2);
+    EXPECT_LE(r.targets[i].sigma_mm, 0.2 * std::sqrt(2.0) + 1e-4);
+  }
+  EXPECT_FALSE(r.warnings.Has("series_frame_assumed"));
+  // No series named: the first one's frame, and a warning says so.
+  options.series.clear();
+  EXPECT_TRUE(
+      Compensate(real, targets, options).warnings.Has("series_frame_assumed"));
+  // A series the model was not fitted on is refused, naming the others.
+  options.series = "Z";
+  try {
+    Compensate(real, in_b, options);
+    FAIL() << "unknown series accepted";
+  } catch (const InputError& e) {
+    EXPECT_THAT(e.what(), HasSubstr("A, B"));
+  }
 }
 
 TEST(CompensateTest, ExtrapolationAndUnreachableTargetsAreNamed) {

@@ -1,9 +1,11 @@
 #include "calib/fit_record.h"
 
+#include <Eigen/QR>
 #include <algorithm>
 #include <cmath>
 
 #include "calib/chain.h"
+#include "data/error.h"
 
 namespace kincal {
 
@@ -100,15 +102,19 @@ FitRecord MakeFitRecord(const FitRecordInput& input) {
   }
   std::vector<int> keep;
   for (size_t k = 0; k < fit->params.size(); ++k) {
-    const ParamInfo& q = fit->params[k];
-    // A periodic transmission's coefficients weight the diagnosis' basis of
-    // the readings; the file keeps the function's Fourier coefficients
-    // (calib/chain.h FourierBasis), so their covariance has no name there.
-    const bool periodic_coefficient =
-        q.kind == ParamKind::kJointError && q.index >= kTransmission0 &&
-        input.state != nullptr && input.state->chain.rows[q.block].periodic();
-    if (q.kind != ParamKind::kPoint && !periodic_coefficient) {
+    if (fit->params[k].kind != ParamKind::kPoint) {
       keep.push_back(static_cast<int>(k));
+    }
+  }
+  if (input.state != nullptr) {
+    // Only the rows whose fitted coefficients the covariance names.
+    for (auto& jb : PeriodicBases(input.state->chain)) {
+      const bool named = std::any_of(keep.begin(), keep.end(), [&](int k) {
+        const ParamInfo& q = fit->params[k];
+        return q.kind == ParamKind::kJointError && q.index >= kTransmission0 &&
+               input.state->chain.rows[q.block].name == jb.first;
+      });
+      if (named) rec.periodic_bases.push_back(std::move(jb));
     }
   }
   const int p = static_cast<int>(keep.size());
@@ -128,6 +134,62 @@ FitRecord MakeFitRecord(const FitRecordInput& input) {
     rec.covariance.resize(0, 0);
   }
   return rec;
+}
+
+std::vector<std::pair<std::string, Eigen::MatrixXd>> PeriodicBases(
+    const Chain& chain) {
+  static_assert(kFourierTerms == kPeriodicTerms,
+                "robot file and chain agree on the Fourier terms");
+  std::vector<std::pair<std::string, Eigen::MatrixXd>> out;
+  for (int j = 0; j < chain.num_joints(); ++j) {
+    const ChainRow& row = chain.rows[j];
+    // A row keeps a basis only while its transmission is in the model.
+    if (!row.periodic() ||
+        std::all_of(chain.joint_errors[j].begin() + kTransmission0,
+                    chain.joint_errors[j].end(),
+                    [](double c) { return c == 0.0; })) {
+      continue;
+    }
+    const Eigen::Map<const Eigen::MatrixXd> b(
+        row.periodic_basis.data(), kPeriodicTerms, kMaxTransmissionTerms);
+    int m = kMaxTransmissionTerms;
+    while (m > 0 && b.col(m - 1).isZero(0.0)) --m;
+    if (m > 0) out.emplace_back(row.name, b.leftCols(m));
+  }
+  return out;
+}
+
+void ApplyPeriodicBases(const FitRecord& rec, Chain* chain) {
+  for (const auto& [name, basis] : rec.periodic_bases) {
+    int j = 0;
+    while (j < chain->num_joints() && chain->rows[j].name != name) ++j;
+    if (j == chain->num_joints() || !chain->rows[j].periodic() ||
+        basis.rows() != kPeriodicTerms ||
+        basis.cols() > kMaxTransmissionTerms) {
+      throw InputError("covariance.periodic_basis." + name +
+                       ": names no periodic transmission of the robot (" +
+                       std::to_string(basis.rows()) + " x " +
+                       std::to_string(basis.cols()) + ")");
+    }
+    ChainRow& row = chain->rows[j];
+    const std::vector<double> f =
+        PeriodicCoefficients(row, chain->joint_errors[j]);
+    const Eigen::Map<const Eigen::VectorXd> fourier(f.data(), kPeriodicTerms);
+    const Eigen::VectorXd c = basis.colPivHouseholderQr().solve(fourier);
+    // The file prints 17 significant digits: B c reproduces F to rounding.
+    if ((basis * c - fourier).norm() > 1e-6 * (1e-12 + fourier.norm())) {
+      throw InputError("covariance.periodic_basis." + name +
+                       ": does not reproduce the joint's Fourier "
+                       "coefficients (was the file edited by hand? remove "
+                       "covariance: or recalibrate)");
+    }
+    row.periodic_basis.assign(kPeriodicTerms * kMaxTransmissionTerms, 0.0);
+    std::copy(basis.data(), basis.data() + basis.size(),
+              row.periodic_basis.begin());
+    for (int k = 0; k < kMaxTransmissionTerms; ++k) {
+      chain->joint_errors[j][kTransmission0 + k] = k < c.size() ? c[k] : 0.0;
+    }
+  }
 }
 
 Robot WithFitRecord(const Robot& calibrated, const Robot& nominal,

@@ -5,9 +5,13 @@
 // (robot.yaml `nominal:`, `fitted_on:`, `covariance:`; data/robot.h
 // FitRecord): written by calibrate and diagnose, read by compensate.
 
+#include <Eigen/Core>
 #include <limits>
+#include <string>
+#include <utility>
 #include <vector>
 
+#include "calib/chain.h"
 #include "calib/fit.h"
 #include "data/observations.h"
 #include "data/robot.h"
@@ -49,6 +53,22 @@ struct FitRecordInput {
 // in interface units (fixed points left out: they are not part of the robot;
 // the frame stays, as the targets are located through it).
 FitRecord MakeFitRecord(const FitRecordInput& input);
+
+// The bases of `chain`'s periodic transmission rows with non-zero
+// coefficients (FitRecord
+// periodic_bases: kPeriodicTerms rows, columns up to the last non-zero one),
+// so a robot file's covariance can name the fitted coefficients
+// <joint>.transmission<k>.
+std::vector<std::pair<std::string, Eigen::MatrixXd>> PeriodicBases(
+    const Chain& chain);
+
+// The inverse on reading: every periodic row of `chain` named in
+// rec.periodic_bases gets that basis and the coefficients c with B c = its
+// Fourier coefficients (least squares), so the covariance's
+// <joint>.transmission<k> address them. Throws InputError when a basis
+// names no periodic row or cannot reproduce the row's Fourier coefficients
+// (a file edited by hand).
+void ApplyPeriodicBases(const FitRecord& rec, Chain* chain);
 
 // `calibrated` with the record and `nominal`'s rows as its nominal.
 Robot WithFitRecord(const Robot& calibrated, const Robot& nominal,

@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "calib/chain.h"
+#include "data/error.h"
 
 namespace kincal {
 namespace {
@@ -114,6 +115,60 @@ TEST(FitRecordTest, RowsSubsetAndRecordedNominal) {
   EXPECT_EQ(out.nominal_joints[1].a_mm, 200.0);
   EXPECT_EQ(out.joints[1].a_mm, 200.3);
   EXPECT_EQ(out.fitted_on.poses, 1);
+}
+
+// The file's periodic basis round trip: a chain whose periodic row has a
+// fitted basis and coefficients, written as its Fourier coefficients (as
+// the robot file stores them) and read back through ApplyPeriodicBases,
+// predicts the same pose and names the same coefficients.
+TEST(FitRecordTest, PeriodicBasesRoundTripThroughFourierCoefficients) {
+  Robot robot;
+  robot.name = "two";
+  for (const char* name : {"j1", "j2"}) {
+    RobotRow row;
+    row.name = name;
+    row.a_mm = 300.0;
+    robot.joints.push_back(row);
+  }
+  robot.tool.name = "tool";
+  robot.tool.d_mm = 100.0;
+  Chain fitted = Chain::FromRobot(robot);
+  std::vector<double> b(kPeriodicTerms * kMaxTransmissionTerms, 0.0);
+  for (int k = 0; k < 3; ++k) {
+    for (int t = 0; t < kPeriodicTerms; ++t) {
+      b[kPeriodicTerms * k + t] = std::sin(0.7 * (k + 1) * (t + 1)) / (t + 1);
+    }
+  }
+  fitted.rows[1].periodic_basis = b;
+  fitted.joint_errors[1][kTransmission0 + 0] = 2e-4;
+  fitted.joint_errors[1][kTransmission0 + 2] = -1e-4;
+  const auto bases = PeriodicBases(fitted);
+  ASSERT_EQ(bases.size(), 1u);
+  EXPECT_EQ(bases[0].first, "j2");
+  EXPECT_EQ(bases[0].second.cols(), 3);  // trailing zero columns dropped
+  FitRecord rec;
+  rec.periodic_bases = bases;
+  // As read from a file: the Fourier coefficients in one column, c_1 = 1.
+  Chain file_form = fitted;
+  file_form.rows[1].periodic_basis = FourierBasis(
+      PeriodicCoefficients(fitted.rows[1], fitted.joint_errors[1]));
+  for (int k = 0; k < kMaxTransmissionTerms; ++k)
+    file_form.joint_errors[1][kTransmission0 + k] = k == 0 ? 1.0 : 0.0;
+  Chain read = file_form;
+  ApplyPeriodicBases(rec, &read);
+  EXPECT_NEAR(read.joint_errors[1][kTransmission0 + 0], 2e-4, 1e-15);
+  EXPECT_NEAR(read.joint_errors[1][kTransmission0 + 1], 0.0, 1e-15);
+  EXPECT_NEAR(read.joint_errors[1][kTransmission0 + 2], -1e-4, 1e-15);
+  // A basis that cannot give the row's coefficients is refused.
+  FitRecord wrong = rec;
+  wrong.periodic_bases[0].second.col(0).setZero();
+  Chain again = file_form;
+  EXPECT_THROW(ApplyPeriodicBases(wrong, &again), InputError);
+  // A basis naming a row that is not periodic is refused.
+  wrong = rec;
+  wrong.periodic_bases[0].first = "j1";
+  again = file_form;
+  EXPECT_THROW(ApplyPeriodicBases(wrong, &again), InputError);
 }
 
 }  // namespace

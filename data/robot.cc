@@ -462,10 +462,53 @@ void ReadFittedOn(const YamlReader& r, const YAML::Node& f, Robot* robot) {
       r.NumberOr(f, "systematic_rms_mm", rec.systematic_rms_mm, "fitted_on");
 }
 
+// covariance.periodic_basis: {<joint>: [[m numbers] x kFourierTerms rows]}
+// for joints with a periodic transmission (a1..b32) among extensions.
+void ReadPeriodicBases(const YamlReader& r, const YAML::Node& node,
+                       Robot* robot) {
+  r.ExpectMap(node, "covariance.periodic_basis");
+  for (const auto& entry : node) {
+    const std::string joint = r.String(entry.first, "periodic_basis key");
+    const std::string what = "covariance.periodic_basis." + joint;
+    const bool periodic = std::any_of(
+        robot->extensions.begin(), robot->extensions.end(),
+        [&](const Extension& e) {
+          if (e.joint != joint || e.cause != "transmission") return false;
+          for (const auto& [key, value] : e.values) {
+            if ((key[0] == 'a' || key[0] == 'b') && key.size() > 1) {
+              return true;
+            }
+          }
+          return false;
+        });
+    if (!periodic) {
+      r.Fail(entry.first, what +
+                              ": no periodic transmission (a1.., b1..) of "
+                              "this joint among extensions; a basis belongs "
+                              "to such a joint");
+    }
+    r.ExpectSequence(entry.second, what);
+    if (static_cast<int>(entry.second.size()) != kFourierTerms) {
+      r.Fail(entry.second, what + ": expected " +
+                               std::to_string(kFourierTerms) +
+                               " rows (cos q, sin q, ..., sin 32q), got " +
+                               std::to_string(entry.second.size()));
+    }
+    const int m = static_cast<int>(entry.second[0].size());
+    Eigen::MatrixXd basis(kFourierTerms, m);
+    for (int t = 0; t < kFourierTerms; ++t) {
+      const auto row = r.Numbers(entry.second[t],
+                                 what + "[" + std::to_string(t) + "]", m, m);
+      for (int k = 0; k < m; ++k) basis(t, k) = row[k];
+    }
+    robot->fitted_on.periodic_bases.emplace_back(joint, basis);
+  }
+}
+
 // covariance: {params: [names], matrix: [[...], ...]} (symmetric, n x n).
 void ReadCovariance(const YamlReader& r, const YAML::Node& c, Robot* robot) {
   r.ExpectMap(c, "covariance");
-  r.CheckKeys(c, {"params", "matrix"}, "covariance");
+  r.CheckKeys(c, {"params", "matrix", "periodic_basis"}, "covariance");
   const YAML::Node params = r.Required(c, "params", "covariance");
   r.ExpectSequence(params, "covariance.params");
   FitRecord& rec = robot->fitted_on;
@@ -498,6 +541,7 @@ void ReadCovariance(const YamlReader& r, const YAML::Node& c, Robot* robot) {
       r.Fail(m[i], "covariance.matrix: negative variance on the diagonal");
     }
   }
+  if (c["periodic_basis"]) ReadPeriodicBases(r, c["periodic_basis"], robot);
 }
 
 }  // namespace
@@ -562,6 +606,34 @@ std::string Geometry(const Robot& robot, const RobotRow& row) {
   }
   return os.str();
 }
+void FormatMatrixRows(const Eigen::MatrixXd& m, const char* indent,
+                      std::ostringstream& os) {
+  for (int i = 0; i < m.rows(); ++i) {
+    os << indent << "- [";
+    for (int k = 0; k < m.cols(); ++k) {
+      os << (k ? ", " : "") << FormatDouble(m(i, k));
+    }
+    os << "]\n";
+  }
+}
+
+void FormatCovariance(const FitRecord& rec, std::ostringstream& os) {
+  if (rec.covariance_params.empty()) return;
+  os << "covariance:  # interface units, parameter order below\n  params: [";
+  for (size_t i = 0; i < rec.covariance_params.size(); ++i) {
+    os << (i ? ", " : "") << rec.covariance_params[i];
+  }
+  os << "]\n  matrix:\n";
+  FormatMatrixRows(rec.covariance, "    ", os);
+  if (rec.periodic_bases.empty()) return;
+  // Fourier coefficients [a1, b1, a2, ...] = B c for <joint>.transmission<k>.
+  os << "  periodic_basis:\n";
+  for (const auto& jb : rec.periodic_bases) {
+    os << "    " << jb.first << ":\n";
+    FormatMatrixRows(jb.second, "      ", os);
+  }
+}
+
 // nominal:, fitted_on: and covariance: when the robot has them.
 void FormatFitRecord(const Robot& robot, std::ostringstream& os) {
   if (robot.HasNominal()) {
@@ -633,20 +705,7 @@ void FormatFitRecord(const Robot& robot, std::ostringstream& os) {
          << "\n";
     }
   }
-  if (!rec.covariance_params.empty()) {
-    os << "covariance:  # interface units, parameter order below\n  params: [";
-    for (size_t i = 0; i < rec.covariance_params.size(); ++i) {
-      os << (i ? ", " : "") << rec.covariance_params[i];
-    }
-    os << "]\n  matrix:\n";
-    for (int i = 0; i < rec.covariance.rows(); ++i) {
-      os << "    - [";
-      for (int k = 0; k < rec.covariance.cols(); ++k) {
-        os << (k ? ", " : "") << FormatDouble(rec.covariance(i, k));
-      }
-      os << "]\n";
-    }
-  }
+  FormatCovariance(rec, os);
 }
 }  // namespace
 

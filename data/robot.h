@@ -71,6 +71,10 @@ struct Extension {
 // (robot.yaml `fitted_on:` and `covariance:`, written by calibrate, diagnose
 // and bundle): compensate flags targets outside the data's travel and
 // temperature and predicts each target's error from it.
+// Fourier terms of a periodic transmission in a robot file (a1..a32,
+// b1..b32).
+constexpr int kFourierTerms = 64;
+
 struct FitRecord {
   int poses = 0;  // 0 = no record
   // Per joint (robot order), the readings' range [lo, hi] in the data (reading
@@ -104,6 +108,12 @@ struct FitRecord {
   // out). Empty = unknown.
   std::vector<std::string> covariance_params;
   Eigen::MatrixXd covariance;
+  // A periodic transmission's coefficients in the covariance are those of the
+  // functions the diagnosis fitted (<joint>.transmission1..m, deg): per such
+  // joint, the basis B (kFourierTerms rows in the order cos q, sin q,
+  // cos 2q, ..., sin 32q; m columns) with the row's Fourier coefficients
+  // [a1, b1, a2, ...] = B c. Empty = none.
+  std::vector<std::pair<std::string, Eigen::MatrixXd>> periodic_bases;
 
   bool present() const { return poses > 0; }
 };

@@ -141,6 +141,50 @@ TEST(RobotYamlTest, NominalFitRecordAndCovarianceRoundTrip) {
   EXPECT_EQ(again.nominal_joints[2].a_mm, 200.0);
 }
 
+// A periodic transmission's covariance names the fitted functions'
+// coefficients; the file carries their basis (64 Fourier terms x m).
+TEST(RobotYamlTest, PeriodicBasisRoundTripAndErrors) {
+  Robot r = ParseRobotYaml(kSpecExample, "r.yaml");
+  Extension e;
+  e.cause = "transmission";
+  e.joint = "j2";
+  e.values = {{"a1", 0.01}, {"b1", -0.02}, {"lo", -90.0}, {"hi", 90.0}};
+  r.extensions.push_back(e);
+  r.fitted_on.poses = 10;
+  r.fitted_on.covariance_params = {"j2.transmission1", "j2.transmission2"};
+  r.fitted_on.covariance = Eigen::Matrix2d::Identity() * 1e-6;
+  Eigen::MatrixXd basis = Eigen::MatrixXd::Zero(kFourierTerms, 2);
+  basis(0, 0) = 1.0;
+  basis(1, 1) = -2.0;
+  basis(5, 1) = 0.25;
+  r.fitted_on.periodic_bases = {{"j2", basis}};
+  const std::string text = FormatRobotYaml(r);
+  const Robot back = ParseRobotYaml(text, "back.yaml");
+  ASSERT_EQ(back.fitted_on.periodic_bases.size(), 1u);
+  EXPECT_EQ(back.fitted_on.periodic_bases[0].first, "j2");
+  EXPECT_EQ(back.fitted_on.periodic_bases[0].second, basis);
+  // A basis for a joint without a periodic transmission is refused, placed.
+  std::string wrong = text;
+  const size_t at = wrong.find("    j2:\n", wrong.find("periodic_basis"));
+  ASSERT_NE(at, std::string::npos);
+  wrong.replace(at, 8, "    j3:\n");
+  try {
+    ParseRobotYaml(wrong, "r.yaml");
+    FAIL() << "basis of a joint without periodic transmission accepted";
+  } catch (const InputError& err) {
+    EXPECT_THAT(err.what(), HasSubstr("periodic_basis.j3"));
+    EXPECT_THAT(err.what(), HasSubstr("r.yaml:"));
+  }
+  // Too few rows.
+  std::string short_rows = text.substr(0, text.rfind("      - ["));
+  try {
+    ParseRobotYaml(short_rows, "r.yaml");
+    FAIL() << "basis with 63 rows accepted";
+  } catch (const InputError& err) {
+    EXPECT_THAT(err.what(), HasSubstr("expected 64 rows"));
+  }
+}
+
 TEST(RobotYamlTest, FitRecordErrorsArePlaced) {
   const std::string base = std::string(kSpecExample) +
                            "covariance:\n  params: [j3.a, tool.d]\n"
