@@ -125,6 +125,27 @@ TEST(BundleCli, ProgressOnStderrNotWithJson) {
   EXPECT_THAT(r.err, ::testing::Not(HasSubstr("kincal bundle:")));
 }
 
+// A target without a tip on a stand calibrates the target frame's origin:
+// allowed (a board), but said, with what to do.
+TEST(BundleCli, TargetWithoutTipOnAStandIsAWarning) {
+  const std::string dir = MakeTempDir("bundle_notip");
+  const std::string s = Simulate(dir + "/s", 12, 3);
+  RunShell("grep -v '^tip_in_tool\\|^tip_sigma' " + s + "/target.yaml > " +
+           dir + "/notip.yaml");
+  const RunResult r =
+      RunKincal("bundle --robot " + s + "/robot.yaml --rig " + s +
+                "/rig.yaml --target " + dir + "/notip.yaml --session " + s +
+                "/session --out " + dir + "/cal.yaml --quiet --json");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  bool found = false;
+  for (const auto& w : j.at("warnings")) {
+    found = found || w.at("code") == "target_without_tip";
+  }
+  EXPECT_TRUE(found) << r.out;
+  EXPECT_THAT(r.err, HasSubstr("kincal target --pivot"));
+}
+
 TEST(BundleCli, BadInputExitsTwoAndWritesNothing) {
   const std::string dir = MakeTempDir("bundle_bad");
   const std::string s = Simulate(dir + "/s", 12, 3);
