@@ -24,35 +24,13 @@ std::string Bh7() { return SourceDir() + "/data/robots/bh7.yaml"; }
 constexpr int kPoses = 120;
 constexpr int kSeed = 7;
 
-// Renders the session with `cameras` cameras, bundles it, and returns the
-// bundle's RMS error at the fresh poses (mm); `json` receives its output.
+// The session with `cameras` cameras on a stand, bundled, at fresh poses
+// (RenderedBundleAtFreshPoses).
 double BundleAtFreshPoses(const std::string& dir, int cameras,
                           nlohmann::json* json, const std::string& extra = "",
                           const std::string& bundle_extra = "") {
-  const std::string s = dir + "/s" + std::to_string(cameras);
-  RunResult r = RunKincal(
-      "simulate --robot " + Bh7() + " --out " + s + " --poses " +
-      std::to_string(kPoses) + " --noise 0 --seed " + std::to_string(kSeed) +
-      " --render --render-noise 1.5 --render-blur 0.5 --render-width 640 "
-      "--render-height 512 --render-cameras " +
-      std::to_string(cameras) + " " + extra);
-  EXPECT_EQ(r.exit_code, 0) << r.err;
-  r = RunKincal("bundle --robot " + s + "/robot.yaml --rig " + s +
-                "/rig.yaml --target " + s + "/target.yaml --session " + s +
-                "/session --quiet --out " + s + "/bcal.yaml --json " +
-                bundle_extra);
-  EXPECT_EQ(r.exit_code, 0) << r.err;
-  if (r.exit_code != 0) return NAN;
-  *json = nlohmann::json::parse(r.out);
-  const std::string fresh = dir + "/fresh.csv";
-  if (!Exists(fresh)) {
-    r = RunKincal("simulate --robot " + Bh7() + " --out " + dir +
-                  "/fresh --poses " + std::to_string(kPoses + 200) +
-                  " --noise 0 --seed " + std::to_string(kSeed));
-    EXPECT_EQ(r.exit_code, 0) << r.err;
-    KeepRowsFrom(dir + "/fresh/observations.csv", fresh, kPoses);
-  }
-  return EvaluateRms(s + "/bcal.yaml", fresh);
+  return RenderedBundleAtFreshPoses(Bh7(), dir, kPoses, kSeed, cameras, json,
+                                    std::string("") + extra, bundle_extra);
 }
 
 TEST(CamerasBundle, OneAndThreeCamerasWithinTwiceStereoAtFreshPoses) {

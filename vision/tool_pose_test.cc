@@ -60,6 +60,27 @@ TEST(Triangulate, MatchesCornersById) {
   EXPECT_TRUE(MatchTagCorners({a, a}, {c}).empty());
 }
 
+// The example tool at ExampleToolPose(pose) rendered by `rig` (blur
+// 0.6 px, noise drawn from `seed`), and each view's detections.
+struct RenderedDetections {
+  StereoFrameTruth frame;
+  std::vector<std::vector<TagDetection>> dets;
+};
+RenderedDetections RenderAndDetect(const Rig& rig, const Target& target,
+                                   int pose, uint64_t seed) {
+  RenderOptions o;
+  o.blur_sigma_px = 0.6;
+  StereoRenderer renderer(rig, target, o);
+  std::mt19937_64 rng(seed);
+  RenderedDetections out;
+  out.frame = renderer.Render(ExampleToolPose(pose), &rng);
+  AprilTagDetector detector;
+  for (const auto& v : out.frame.views) {
+    out.dets.push_back(detector.Detect(v.image));
+  }
+  return out;
+}
+
 struct PoseErrors {
   double rot_deg = 0, trans_mm = 0, tip_mm = 0, rms_px = 0;
 };
@@ -103,14 +124,9 @@ TEST(ToolPose, RenderedFramesRecoverPoseAndTip) {
 TEST(ToolPose, RejectsOutlierTagAndWorksWithOneCamera) {
   const Rig rig = ExampleStereoRig(640, 512);
   const Target target = ExampleTarget();
-  RenderOptions o;
-  o.blur_sigma_px = 0.6;
-  StereoRenderer renderer(rig, target, o);
-  std::mt19937_64 rng(2);
-  const StereoFrameTruth frame = renderer.Render(ExampleToolPose(2), &rng);
-  AprilTagDetector detector;
-  std::vector<std::vector<TagDetection>> dets;
-  for (const auto& v : frame.views) dets.push_back(detector.Detect(v.image));
+  RenderedDetections rendered = RenderAndDetect(rig, target, 2, 2);
+  const StereoFrameTruth& frame = rendered.frame;
+  std::vector<std::vector<TagDetection>>& dets = rendered.dets;
   ASSERT_FALSE(dets[1].empty());
   // A tag whose detection itself is off (libapriltag's corners too).
   for (auto& c : dets[1][0].corners) c += Eigen::Vector2d(6, -2);
@@ -143,14 +159,8 @@ TEST(ToolPose, RejectsOutlierTagAndWorksWithOneCamera) {
 TEST(ToolPose, PerCornerCheckFallsBackOrDrops) {
   const Rig rig = ExampleStereoRig(640, 512);
   const Target target = ExampleTarget();
-  RenderOptions o;
-  o.blur_sigma_px = 0.6;
-  StereoRenderer renderer(rig, target, o);
-  std::mt19937_64 rng(4);
-  const StereoFrameTruth frame = renderer.Render(ExampleToolPose(3), &rng);
-  AprilTagDetector detector;
-  std::vector<std::vector<TagDetection>> dets;
-  for (const auto& v : frame.views) dets.push_back(detector.Detect(v.image));
+  RenderedDetections rendered = RenderAndDetect(rig, target, 3, 4);
+  std::vector<std::vector<TagDetection>>& dets = rendered.dets;
   ASSERT_GE(dets[0].size(), 2u);
   const ToolPoseResult clean = EstimateToolPose(rig, target, dets);
   ASSERT_TRUE(clean.found);
@@ -183,14 +193,8 @@ TEST(ToolPose, PerCornerCheckFallsBackOrDrops) {
 TEST(ToolPose, UnusableCornersTakeNoPart) {
   const Rig rig = ExampleStereoRig(640, 512);
   const Target target = ExampleTarget();
-  RenderOptions o;
-  o.blur_sigma_px = 0.6;
-  StereoRenderer renderer(rig, target, o);
-  std::mt19937_64 rng(4);
-  const StereoFrameTruth frame = renderer.Render(ExampleToolPose(3), &rng);
-  AprilTagDetector detector;
-  std::vector<std::vector<TagDetection>> dets;
-  for (const auto& v : frame.views) dets.push_back(detector.Detect(v.image));
+  RenderedDetections rendered = RenderAndDetect(rig, target, 3, 4);
+  std::vector<std::vector<TagDetection>>& dets = rendered.dets;
   ASSERT_GE(dets[0].size(), 3u);
   const ToolPoseResult clean = EstimateToolPose(rig, target, dets);
   ASSERT_TRUE(clean.found);
@@ -226,14 +230,8 @@ TEST(ToolPose, UnusableCornersTakeNoPart) {
 TEST(ToolPose, UnrefinedTagLeftOutWhileOthersDetermineThePose) {
   const Rig rig = ExampleStereoRig(640, 512);
   const Target target = ExampleTarget();
-  RenderOptions o;
-  o.blur_sigma_px = 0.6;
-  StereoRenderer renderer(rig, target, o);
-  std::mt19937_64 rng(4);
-  const StereoFrameTruth frame = renderer.Render(ExampleToolPose(3), &rng);
-  AprilTagDetector detector;
-  std::vector<std::vector<TagDetection>> dets;
-  for (const auto& v : frame.views) dets.push_back(detector.Detect(v.image));
+  RenderedDetections rendered = RenderAndDetect(rig, target, 3, 4);
+  std::vector<std::vector<TagDetection>>& dets = rendered.dets;
   ASSERT_GE(dets[0].size(), 3u);
   const ToolPoseResult clean = EstimateToolPose(rig, target, dets);
   ASSERT_TRUE(clean.found);
