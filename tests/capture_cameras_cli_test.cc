@@ -3,7 +3,8 @@
 // --render-cameras N` is replayed folder by folder through `kincal capture
 // --camera NAME='folder:...'`, its joint readings given as a controller log
 // (--joints); `kincal track --session` must then give the same tips and the
-// same observations from the captured session as from the rendered one.
+// same observations from the captured session as from the rendered one, and
+// `kincal bundle --session` the same frames and reprojection RMS.
 
 #include <gtest/gtest.h>
 
@@ -115,6 +116,17 @@ void Track(const Rendered& r, const std::string& session,
   EXPECT_GE(j["found"].get<int>(), r.frames / 2);  // tips to compare
 }
 
+// `kincal bundle --session` with the rendered robot, rig and target.
+nlohmann::json Bundle(const Rendered& r, const std::string& session,
+                      const std::string& out) {
+  const RunResult b =
+      RunKincal("bundle --robot " + r.dir + "/robot.yaml --rig " + r.dir +
+                "/rig.yaml --target " + r.dir + "/target.yaml --session " +
+                session + " --quiet --out " + out + " --json");
+  EXPECT_EQ(b.exit_code, 0) << b.err;
+  return b.exit_code == 0 ? nlohmann::json::parse(b.out) : nlohmann::json();
+}
+
 // Same header, same rows; numbers equal to 1e-9 relative (joint readings
 // pass through the log and frames.csv as text, 10 digits), other cells
 // identical.
@@ -145,7 +157,7 @@ void ExpectSameCsv(const std::string& a, const std::string& b) {
 }
 
 // Replays `r` through capture and checks the captured session against the
-// rendered one: layout, frames.csv header, capture's JSON, and track.
+// rendered one: layout, frames.csv header, capture's JSON, track and bundle.
 void CaptureAndCompare(const Rendered& r) {
   ASSERT_EQ(r.frames, kPoses);
   const std::string out = r.dir + "/captured";
@@ -173,15 +185,25 @@ void CaptureAndCompare(const Rendered& r) {
   Track(r, out, r.dir + "/points_captured.csv", r.dir + "/obs_captured.csv");
   ExpectSameCsv(r.dir + "/points_rendered.csv", r.dir + "/points_captured.csv");
   ExpectSameCsv(r.dir + "/obs_rendered.csv", r.dir + "/obs_captured.csv");
+
+  // The bundle sees the same corners at the same readings (the readings
+  // went through 10-digit text, hence the relative 1e-4).
+  const auto b1 = Bundle(r, r.dir + "/session", r.dir + "/cal_rendered.yaml");
+  const auto b2 = Bundle(r, out, r.dir + "/cal_captured.yaml");
+  ASSERT_TRUE(b1.contains("used_frames") && b2.contains("used_frames"));
+  EXPECT_GT(b1["used_frames"].get<int>(), 0);
+  EXPECT_EQ(b1["used_frames"], b2["used_frames"]);
+  const double rms = b1["reproj_rms_px"].get<double>();
+  EXPECT_NEAR(b2["reproj_rms_px"].get<double>(), rms, 1e-4 * rms);
 }
 
-TEST(CaptureCamerasCli, ThreeCamerasReplayIntoASessionTrackReadsTheSame) {
+TEST(CaptureCamerasCli, ThreeCamerasReplayIntoASessionTrackAndBundleReadAlike) {
   const Rendered r = RenderWithJointLog(3);
   ASSERT_EQ(r.cameras.size(), 3u);
   CaptureAndCompare(r);
 }
 
-TEST(CaptureCamerasCli, OneCameraReplaysIntoASessionTrackReadsTheSame) {
+TEST(CaptureCamerasCli, OneCameraReplaysIntoASessionTrackAndBundleReadAlike) {
   const Rendered r = RenderWithJointLog(1);
   ASSERT_EQ(r.cameras.size(), 1u);
   CaptureAndCompare(r);
