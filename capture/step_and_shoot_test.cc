@@ -132,6 +132,56 @@ TEST(StepAndShootTest, RecordsOneAveragedPairPerSettledPoseUntilBye) {
   EXPECT_EQ(first.at<uint8_t>(0, 0), 5);
 }
 
+TEST(StepAndShootTest, ThreeCamerasRecordOneAveragedSetPerPose) {
+  // Folders l and r as above, and a third camera "t" (value 10 k + 1).
+  const std::string dir = WriteStereoFolders(4);
+  ::mkdir((dir + "/t").c_str(), 0755);
+  for (int k = 0; k < 4; ++k) {
+    char name[32];
+    std::snprintf(name, sizeof(name), "/t/%03d.png", k);
+    cv::imwrite(dir + name, cv::Mat(8, 8, CV_8UC1, cv::Scalar(10 * k + 1)));
+  }
+  std::vector<std::unique_ptr<FrameSource>> sources;
+  for (const char* folder : {"/l", "/r", "/t"}) {
+    sources.push_back(MakeFrameSource("folder:" + dir + folder + "/*.png"));
+  }
+  FrameGrabber grabber({sources[0].get(), sources[1].get(), sources[2].get()});
+  ASSERT_TRUE(grabber.Open().ok());
+  const int port = FreeLoopbackPort();
+  std::thread robot([port] {
+    const int fd = ConnectLoopback(port, 100);
+    if (fd < 0) return;
+    std::string line;
+    SendLine(fd, "HELLO testbot j1 j2");
+    ReceiveLine(fd, &line);
+    SendLine(fd, "SETTLED 0 1 2");
+    ReceiveLine(fd, &line);
+    SendLine(fd, "BYE");
+    ::close(fd);
+  });
+  const std::string out = dir + "/session";
+  StepAndShootOptions options = Options(port, out);
+  options.info.cameras = {
+      {"a", "folder:l", ""}, {"b", "folder:r", ""}, {"c", "folder:t", ""}};
+  const StepAndShootResult r = RunStepAndShoot(&grabber, false, options);
+  robot.join();
+  EXPECT_EQ(r.outcome, StepAndShootResult::kOk) << r.message;
+  EXPECT_EQ(r.frames, 1);
+  // Pose 0 averages replay sets 0 and 1 of every camera.
+  const int expected[] = {5, 5, 6};
+  const char* names[] = {"a", "b", "c"};
+  for (int c = 0; c < 3; ++c) {
+    const cv::Mat image =
+        cv::imread(out + "/" + names[c] + "/000000.png", cv::IMREAD_UNCHANGED);
+    ASSERT_FALSE(image.empty()) << names[c];
+    EXPECT_EQ(image.at<uint8_t>(0, 0), expected[c]) << names[c];
+  }
+  const std::string frames = ReadFile(out + "/frames.csv");
+  EXPECT_NE(frames.find("\nframe,t_a,t_b,t_c,seq_a,seq_b,seq_c,j1,j2\n0,"),
+            std::string::npos)
+      << frames;
+}
+
 TEST(StepAndShootTest, AnUnknownJointInHelloWritesNothing) {
   const std::string dir = WriteStereoFolders(2);
   Rig rig = OpenReplay(dir);
