@@ -101,22 +101,6 @@ int RunList(const CaptureArgs& args) {
   return 0;
 }
 
-nlohmann::json StepAndShootJson(const capture::CaptureOptions& options,
-                                const capture::StepAndShootResult& r) {
-  nlohmann::json j;
-  j["out"] = options.out;
-  j["mode"] = "step_and_shoot";
-  j["frames"] = r.frames;
-  j["poses"] = r.poses;
-  j["shots_per_pose"] = options.shots;
-  j["robot"] = r.robot_name;
-  j["joint_stream"] = r.joint_stream;
-  j["seconds"] = r.seconds;
-  j["stop_reason"] = r.stop_reason;
-  j["complete"] = r.complete;
-  return j;
-}
-
 nlohmann::json JointsJson(const capture::CaptureJoints& joints) {
   if (joints.from_stream) {
     return {{"source", "stream"},
@@ -147,6 +131,24 @@ nlohmann::json CapturedCamerasJson(
                    {"dropped", c.dropped}});
   }
   return out;
+}
+
+nlohmann::json StepAndShootJson(const capture::CaptureOptions& options,
+                                const capture::CaptureResult& result) {
+  const capture::StepAndShootResult& r = result.step;
+  nlohmann::json j;
+  j["out"] = options.out;
+  j["mode"] = "step_and_shoot";
+  j["frames"] = r.frames;
+  j["poses"] = r.poses;
+  j["cameras"] = CapturedCamerasJson(result.cameras);
+  j["shots_per_pose"] = options.shots;
+  j["robot"] = r.robot_name;
+  j["joint_stream"] = r.joint_stream;
+  j["seconds"] = r.seconds;
+  j["stop_reason"] = r.stop_reason;
+  j["complete"] = r.complete;
+  return j;
 }
 
 // `frames` counts the recorded sets (one image per camera); dropped_pairs
@@ -182,10 +184,11 @@ nlohmann::json RecordingJson(const capture::CaptureOptions& options,
 }
 
 void PrintStepAndShoot(const CaptureArgs& args,
-                       const capture::StepAndShootResult& r) {
+                       const capture::CaptureResult& result) {
+  const capture::StepAndShootResult& r = result.step;
   if (!r.session_created) return;
   if (args.json) {
-    PrintJson(StepAndShootJson(args.options, r));
+    PrintJson(StepAndShootJson(args.options, result));
     return;
   }
   std::printf(
@@ -277,7 +280,7 @@ int RunCapture(const CaptureArgs& args) {
   options.before_recording = [&guard] { guard.emplace(); };
   const capture::CaptureResult result = capture::RunCaptureSession(options);
   if (result.step_and_shoot) {
-    PrintStepAndShoot(args, result.step);
+    PrintStepAndShoot(args, result);
   } else {
     PrintRecording(args, result);
   }

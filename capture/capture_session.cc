@@ -211,6 +211,11 @@ CaptureResult RunStepAndShootMode(const CaptureOptions& options, Inputs* in) {
       std::to_string(options.png_compression);
   if (options.before_recording) options.before_recording();
   result.step = RunStepAndShoot(&grabber, in->live, step);
+  for (size_t k = 0; k < step.info.cameras.size(); ++k) {
+    const SessionCamera& c = step.info.cameras[k];
+    result.cameras.push_back(
+        {c.name, c.uri, c.description, grabber.dropped(k)});
+  }
   grabber.Close();
   if (result.step.outcome == StepAndShootResult::kBadInput) {
     return Failed(result, CaptureResult::kBadInput,

@@ -98,7 +98,7 @@ struct CaptureResult {
   int64_t frames = 0;
   double seconds = 0;
   uint64_t bytes = 0;
-  std::vector<CapturedCamera> cameras;  // in rig order
+  std::vector<CapturedCamera> cameras;  // in rig order (step and shoot too)
   std::string pairing;
   int64_t dropped_sets = 0;  // the writers were slower than the cameras
   int max_queue_depth = 0;
