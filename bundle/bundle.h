@@ -119,9 +119,11 @@ struct BundleParam {
 };
 
 struct BundleResult {
-  Chain chain;       // fitted (tool row set from the tip)
-  Robot calibrated;  // chain.ToRobot(nominal)
-  Rig rig;           // refined cameras (= input without refine)
+  Chain chain;  // fitted (tool row set from the tip)
+  // chain.ToRobot(nominal) with the fit record and covariance
+  // (bundle/robot_record.h RecordBundleFit).
+  Robot calibrated;
+  Rig rig;  // refined cameras (= input without refine)
   RigMount mount = RigMount::kWorld;  // rig.mount
   // The two frames, [angle-axis rad, t mm]. mount world: rig_from_base and
   // flange_from_tool; mount flange: flange_from_rig and base_from_target
