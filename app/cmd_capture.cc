@@ -1,6 +1,7 @@
-// kincal capture: record a stereo session (left/*.png, right/*.png,
-// frames.csv, session.yaml) from two cameras or two recordings, in the layout
-// `kincal track` reads directly; `kincal capture --list` lists cameras.
+// kincal capture: record a session (one image folder per camera, named as in
+// rig.yaml, frames.csv, session.yaml) from 1..N cameras or recordings, in
+// the layout `kincal track --session` and `kincal bundle` read directly;
+// `kincal capture --list` lists cameras.
 
 #include <signal.h>
 
@@ -14,6 +15,7 @@
 #include "app/command.h"
 #include "app/front_end.h"
 #include "capture/capture_session.h"
+#include "capture/frame_grabber.h"
 #include "capture/frame_source.h"
 #include "data/error.h"
 #include "data/session.h"
@@ -26,6 +28,7 @@ using capture::Status;
 struct CaptureArgs {
   capture::CaptureOptions options;
   std::vector<std::string> cameras;  // --camera NAME=URI
+  std::string left, right;           // the two-camera spelling
   bool list = false;
   bool json = false;
 };
@@ -98,22 +101,6 @@ int RunList(const CaptureArgs& args) {
   return 0;
 }
 
-nlohmann::json StepAndShootJson(const capture::CaptureOptions& options,
-                                const capture::StepAndShootResult& r) {
-  nlohmann::json j;
-  j["out"] = options.out;
-  j["mode"] = "step_and_shoot";
-  j["frames"] = r.frames;
-  j["poses"] = r.poses;
-  j["shots_per_pose"] = options.shots;
-  j["robot"] = r.robot_name;
-  j["joint_stream"] = r.joint_stream;
-  j["seconds"] = r.seconds;
-  j["stop_reason"] = r.stop_reason;
-  j["complete"] = r.complete;
-  return j;
-}
-
 nlohmann::json JointsJson(const capture::CaptureJoints& joints) {
   if (joints.from_stream) {
     return {{"source", "stream"},
@@ -133,6 +120,41 @@ nlohmann::json JointsJson(const capture::CaptureJoints& joints) {
       {"frames_too_fast", joints.frames_too_fast}};
 }
 
+// Every camera: name, uri, description, dropped.
+nlohmann::json CapturedCamerasJson(
+    const std::vector<capture::CapturedCamera>& cameras) {
+  nlohmann::json out = nlohmann::json::array();
+  for (const capture::CapturedCamera& c : cameras) {
+    out.push_back({{"name", c.name},
+                   {"uri", c.uri},
+                   {"description", c.description},
+                   {"dropped", c.dropped}});
+  }
+  return out;
+}
+
+nlohmann::json StepAndShootJson(const capture::CaptureOptions& options,
+                                const capture::CaptureResult& result) {
+  const capture::StepAndShootResult& r = result.step;
+  nlohmann::json j;
+  j["out"] = options.out;
+  j["mode"] = "step_and_shoot";
+  j["frames"] = r.frames;
+  j["poses"] = r.poses;
+  j["cameras"] = CapturedCamerasJson(result.cameras);
+  j["shots_per_pose"] = options.shots;
+  j["robot"] = r.robot_name;
+  j["joint_stream"] = r.joint_stream;
+  j["seconds"] = r.seconds;
+  j["stop_reason"] = r.stop_reason;
+  j["complete"] = r.complete;
+  return j;
+}
+
+// `frames` counts the recorded sets (one image per camera); dropped_pairs
+// and fast_pairs count sets too (their names date from two cameras). A
+// two-camera recording also carries left, right, dropped_left and
+// dropped_right for its first and second camera.
 nlohmann::json RecordingJson(const capture::CaptureOptions& options,
                              const capture::CaptureResult& r) {
   nlohmann::json j;
@@ -141,14 +163,17 @@ nlohmann::json RecordingJson(const capture::CaptureOptions& options,
   j["seconds"] = r.seconds;
   j["fps"] = r.seconds > 0 ? r.frames / r.seconds : 0.0;
   j["bytes"] = r.bytes;
-  j["left"] = r.left_description;
-  j["right"] = r.right_description;
+  j["cameras"] = CapturedCamerasJson(r.cameras);
+  if (r.cameras.size() == 2) {
+    j["left"] = r.cameras[0].description;
+    j["right"] = r.cameras[1].description;
+    j["dropped_left"] = r.cameras[0].dropped;
+    j["dropped_right"] = r.cameras[1].dropped;
+  }
   j["pairing"] = r.pairing;
-  j["dropped_left"] = r.dropped_left;
-  j["dropped_right"] = r.dropped_right;
-  j["dropped_pairs"] = r.dropped_pairs;
+  j["dropped_pairs"] = r.dropped_sets;
   j["max_queue_depth"] = r.max_queue_depth;
-  j["fast_pairs"] = r.fast_pairs;
+  j["fast_pairs"] = r.fast_sets;
   j["length_mismatch"] = r.length_mismatch;
   j["transient_failures"] = r.transient_failures;
   j["stop_reason"] = r.stop_reason;
@@ -159,17 +184,19 @@ nlohmann::json RecordingJson(const capture::CaptureOptions& options,
 }
 
 void PrintStepAndShoot(const CaptureArgs& args,
-                       const capture::StepAndShootResult& r) {
+                       const capture::CaptureResult& result) {
+  const capture::StepAndShootResult& r = result.step;
   if (!r.session_created) return;
   if (args.json) {
-    PrintJson(StepAndShootJson(args.options, r));
+    PrintJson(StepAndShootJson(args.options, result));
     return;
   }
   std::printf(
-      "recorded %ld settled poses (%d pairs averaged each) to %s; "
+      "recorded %ld settled poses (%d %s averaged each) to %s; "
       "stopped: %s\n",
-      r.poses, args.options.shots, args.options.out.c_str(),
-      r.stop_reason.c_str());
+      r.poses, args.options.shots,
+      capture::FrameSetNoun(args.options.cameras.size()),
+      args.options.out.c_str(), r.stop_reason.c_str());
 }
 
 // The merged joint readings in words: the clock offset, how it was found
@@ -196,34 +223,38 @@ void PrintJoints(const capture::CaptureJoints& joints) {
 
 void PrintRecording(const CaptureArgs& args, const capture::CaptureResult& r) {
   if (!r.recorded) return;
-  if (r.dropped_pairs > 0) {
-    std::cerr << "kincal capture: warning: " << r.dropped_pairs
-              << " stereo pairs dropped because the disk/encoder was slower "
-                 "than the cameras (lower --png-compression, add --writers, "
-                 "or a faster disk)\n";
+  const char* noun = capture::FrameSetNoun(r.cameras.size());
+  if (r.dropped_sets > 0) {
+    std::cerr << "kincal capture: warning: " << r.dropped_sets << " " << noun
+              << " dropped because the disk/encoder was slower than the "
+                 "cameras (lower --png-compression, add --writers, or a "
+                 "faster disk)\n";
   }
   if (r.length_mismatch) {
-    std::cerr << "kincal capture: warning: left and right recordings have "
-                 "different lengths; recorded the "
-              << r.frames << " pairs both have\n";
+    std::cerr << "kincal capture: warning: the recordings have different "
+                 "lengths; recorded the "
+              << r.frames << " " << noun << " they all have\n";
   }
   if (args.json) {
     PrintJson(RecordingJson(args.options, r));
     return;
   }
+  std::string dropped;
+  for (const capture::CapturedCamera& c : r.cameras) {
+    dropped += c.name + " " + std::to_string(c.dropped) + ", ";
+  }
   const std::string& out = args.options.out;
   std::printf(
-      "recorded %lld stereo pairs in %.2f s (%.1f pairs/s) to %s\n"
-      "pairing: %s, dropped left %lld, right %lld, pairs (disk too slow) "
-      "%lld; stopped: %s\n"
+      "recorded %lld %s (%zu camera%s) in %.2f s (%.1f/s) to %s\n"
+      "pairing: %s, dropped %s%s (disk too slow) %lld; stopped: %s\n"
       "track it: kincal track --rig RIG.yaml --target TARGET.yaml "
-      "--left '%s/left/*.png' --right '%s/right/*.png' --out points.csv\n",
-      static_cast<long long>(r.frames), r.seconds,
+      "--session '%s' --out points.csv\n",
+      static_cast<long long>(r.frames), noun, r.cameras.size(),
+      r.cameras.size() == 1 ? "" : "s", r.seconds,
       r.seconds > 0 ? r.frames / r.seconds : 0.0, out.c_str(),
-      r.pairing.c_str(), static_cast<long long>(r.dropped_left),
-      static_cast<long long>(r.dropped_right),
-      static_cast<long long>(r.dropped_pairs), r.stop_reason.c_str(),
-      out.c_str(), out.c_str());
+      r.pairing.c_str(), dropped.c_str(), noun,
+      static_cast<long long>(r.dropped_sets), r.stop_reason.c_str(),
+      out.c_str());
   if (r.has_joints) PrintJoints(r.joints);
 }
 
@@ -232,26 +263,16 @@ void PrintRecording(const CaptureArgs& args, const capture::CaptureResult& r) {
 int RunCapture(const CaptureArgs& args) {
   if (args.list) return RunList(args);
   capture::CaptureOptions options = args.options;
-  if (!args.cameras.empty()) {
-    // --camera NAME=URI: the cameras named as in rig.yaml; capture records
-    // a camera pair (the version-2 spelling is --left/--right).
-    const std::vector<CameraGlob> cams =
-        CameraGlobs(args.cameras, options.left, options.right);
-    if (cams.size() != 2) {
-      throw InputError(
-          "capture records a pair of cameras: give --camera NAME=URI twice "
-          "(got " +
-          std::to_string(cams.size()) +
-          "); for one camera or more than two, record each camera's images "
-          "and give them to track / bundle as --camera NAME='GLOB' or as a "
-          "session with one folder per camera");
-    }
-    options.camera_names = {cams[0].name, cams[1].name};
-    options.left = cams[0].glob;
-    options.right = cams[1].glob;
+  // --camera NAME=URI (1..N, rig order: the names are the session's image
+  // folders and frames.csv columns) or the two-camera --left/--right.
+  if (!args.left.empty() && args.right.empty() && args.cameras.empty()) {
+    throw InputError(
+        "capture: --right is required with --left (the two-camera "
+        "spelling); for one camera give --camera NAME=URI");
   }
-  for (const std::string& name : options.camera_names) {
-    CheckSessionCameraName(name, "--camera");
+  for (const CameraGlob& c : CameraGlobs(args.cameras, args.left, args.right)) {
+    CheckSessionCameraName(c.name, c.option);
+    options.cameras.push_back({c.name, c.glob});
   }
   options.announce = !args.json;
   options.interrupted = &g_interrupted;
@@ -259,7 +280,7 @@ int RunCapture(const CaptureArgs& args) {
   options.before_recording = [&guard] { guard.emplace(); };
   const capture::CaptureResult result = capture::RunCaptureSession(options);
   if (result.step_and_shoot) {
-    PrintStepAndShoot(args, result.step);
+    PrintStepAndShoot(args, result);
   } else {
     PrintRecording(args, result);
   }
@@ -282,21 +303,27 @@ void AddCaptureCommand(CLI::App& app, Runner* run) {
   auto* list = sub->add_flag("--list", args->list,
                              "list V4L2 devices and Aravis cameras");
   AddCameraOption(sub, &args->cameras,
-                  "NAME=URI: a camera of the pair, named as in rig.yaml (its "
-                  "image folder and frames.csv columns); twice, in rig order")
+                  "NAME=URI: a camera named as in rig.yaml (its image folder "
+                  "and frames.csv columns) and its source; once per camera "
+                  "(1..N), in rig order")
+      ->type_name("NAME=URI")
       ->excludes(list);
-  sub->add_option("--left", o.left, "left source URI")->excludes(list);
-  sub->add_option("--right", o.right, "right source URI")->excludes(list);
+  sub->add_option("--left", args->left,
+                  "left source URI (with --right: the two-camera spelling of "
+                  "--camera left=URI --camera right=URI)")
+      ->excludes(list);
+  sub->add_option("--right", args->right, "right source URI")->excludes(list);
   sub->add_option("--out", o.out,
                   "session folder to create (must not exist or be empty)")
       ->excludes(list);
-  sub->add_option("--frames", o.frames, "stop after N pairs")
+  sub->add_option("--frames", o.frames,
+                  "stop after N frame sets (one image per camera)")
       ->check(CLI::PositiveNumber);
   sub->add_option("--seconds", o.seconds, "stop after S seconds")
       ->check(CLI::PositiveNumber);
   sub->add_option("--sync-tolerance-ms", o.tolerance_ms,
-                  "live cameras: largest left/right time difference of a "
-                  "pair (default 10 ms)")
+                  "live cameras: largest time difference within a frame set "
+                  "(default 10 ms)")
       ->check(CLI::Range(0.001, 1000.0));
   sub->add_option("--png-compression", o.png_compression,
                   "PNG zlib level 0-9, all lossless (default 1: fastest)")
@@ -319,29 +346,34 @@ void AddCaptureCommand(CLI::App& app, Runner* run) {
       ->check(CLI::PositiveNumber);
   sub->add_option("--robot-listen", o.robot_listen,
                   "step-and-shoot: wait for the robot on HOST:PORT (line "
-                  "protocol in docs/LAB.md) and record one averaged pair per "
-                  "settled pose, with the robot's readings");
+                  "protocol in docs/LAB.md) and record one averaged frame set "
+                  "per settled pose, with the robot's readings");
   sub->add_flag("--stream", o.stream,
                 "with --robot-listen: record continuously and fill the "
                 "joint columns from the robot's J lines (until BYE)");
   sub->add_option("--shots", o.shots,
-                  "pairs grabbed and averaged per settled pose (default 5)")
+                  "frame sets grabbed and averaged per settled pose (default "
+                  "5)")
       ->check(CLI::Range(1, 1000));
   sub->add_option("--robot-timeout", o.robot_timeout,
                   "seconds to wait for the robot (connect, each message)")
       ->check(CLI::PositiveNumber);
-  sub->add_option("--queue", o.queue_pairs,
-                  "pairs waiting for the writers; when full, new pairs are "
-                  "dropped and counted (default 32)")
+  sub->add_option("--queue", o.queue_sets,
+                  "frame sets waiting for the writers; when full, new sets "
+                  "are dropped and counted (default 32)")
       ->check(CLI::Range(1, 10000));
   sub->add_option("--writers", o.writers,
                   "writer threads encoding PNGs (default 2)")
       ->check(CLI::Range(1, 64));
   sub->add_flag("--json", args->json, "print one JSON object");
   sub->footer(HelpFooter(
-      "Example: replay two image folders as a session (no camera needed):\n  "
-      "kincal capture --left 'folder:left/*.png?fps=30' --right "
-      "'folder:right/*.png?fps=30' --out session --frames 100"));
+      "Examples (no camera needed): replay two image folders as a session,\n"
+      "  kincal capture --left 'folder:left/*.png?fps=30' --right "
+      "'folder:right/*.png?fps=30' --out session --frames 100\n"
+      "three cameras named as in rig.yaml (one folder each in the session),\n"
+      "  kincal capture --camera left='v4l2:/dev/video0' --camera "
+      "right='v4l2:/dev/video2' --camera top='v4l2:/dev/video4' --out "
+      "session --seconds 60"));
   sub->callback([run, args] { *run = [args] { return RunCapture(*args); }; });
 }
 

@@ -29,8 +29,10 @@ inline constexpr char kTrackDescription[] =
     "Needle tip in the rig frame for every stereo frame pair, from the tool's "
     "AprilTags (writes points.csv and <out>.poses.csv)";
 inline constexpr char kCaptureDescription[] =
-    "Record a stereo session (left/*.png, right/*.png, frames.csv, "
-    "session.yaml) from two cameras or two recordings; --list shows cameras. "
+    "Record a session (one image folder per camera, named as in rig.yaml; "
+    "frames.csv, session.yaml) from 1..N cameras or recordings "
+    "(--camera NAME=URI each, or --left/--right for two); --list shows "
+    "cameras. "
     "Sources: v4l2:/dev/videoN?width=..&height=..&fps=..&format=GREY|YUYV|"
     "MJPG, aravis:<camera id>?exposure_us=..&gain=..&fps=..&format=Mono8|..., "
     "folder:/path/left*.png?fps=.., video:/path/file.mp4";

@@ -3,7 +3,7 @@
 //     1280x1024 pair (PNG encode + write + rename, both sides), pairs/s;
 //   BM_EncodePng/<png level>: cv::imencode of one 1280x1024 gray image;
 //   BM_EncodePngLibpng/<png level>: the recorder's encoder, same image;
-//   BM_FolderReplay: StereoGrabber over two folders of 1280x1024 PNGs, pairs/s;
+//   BM_FolderReplay: FrameGrabber over two folders of 1280x1024 PNGs, pairs/s;
 //   BM_Convert*: one 1280x1024 camera buffer to cv::Mat.
 // The images are a smooth scene plus sensor-like noise (sigma 2 grey levels),
 // which compresses like a real camera frame (pure noise would not compress).
@@ -15,11 +15,11 @@
 #include <opencv2/imgproc.hpp>
 #include <string>
 
+#include "capture/frame_grabber.h"
 #include "capture/frame_source.h"
 #include "capture/pixel_convert.h"
 #include "capture/png_encode.h"
 #include "capture/recorder.h"
-#include "capture/stereo_grabber.h"
 
 namespace kincal::capture {
 namespace {
@@ -64,14 +64,16 @@ void RemoveDir(const std::string& dir) {
 void BM_RecordStereoPair(benchmark::State& state) {
   const int level = static_cast<int>(state.range(0));
   const int channels = static_cast<int>(state.range(1));
-  StereoFrame pair;
-  pair.left.image = SceneImage(channels, 0);
-  pair.right.image = SceneImage(channels, 1);
+  FrameSet pair;
+  pair.frames.resize(2);
+  pair.frames[0].image = SceneImage(channels, 0);
+  pair.frames[1].image = SceneImage(channels, 1);
   const std::string dir = TempDir("rec");
   SessionRecorder::Options options;
   options.png_compression = level;
   SessionRecorder recorder(options);
   SessionInfo info;
+  info.cameras = {{"left", "", ""}, {"right", "", ""}};
   if (!recorder.Open(dir + "/s", info).ok()) {
     state.SkipWithError("cannot open the session");
     return;
@@ -152,12 +154,12 @@ void BM_FolderReplay(benchmark::State& state) {
   for (auto _ : state) {
     auto l = MakeFrameSource("folder:" + dir + "/l_*.png");
     auto r = MakeFrameSource("folder:" + dir + "/r_*.png");
-    StereoGrabber grabber(l.get(), r.get());
+    FrameGrabber grabber({l.get(), r.get()});
     if (!grabber.Open().ok()) {
       state.SkipWithError("cannot open");
       break;
     }
-    StereoFrame pair;
+    FrameSet pair;
     while (grabber.Grab(&pair).ok()) ++pairs;
   }
   state.SetItemsProcessed(pairs);

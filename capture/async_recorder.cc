@@ -16,10 +16,10 @@ AsyncRecorder::AsyncRecorder(SessionRecorder* recorder,
 
 AsyncRecorder::~AsyncRecorder() { Stop(); }
 
-bool AsyncRecorder::Submit(StereoFrame pair, std::vector<double> joints) {
+bool AsyncRecorder::Submit(FrameSet set, std::vector<double> joints) {
   std::unique_lock<std::mutex> lock(mu_);
   ++submitted_;
-  const size_t capacity = std::max(1, options_.queue_pairs);
+  const size_t capacity = std::max(1, options_.queue_sets);
   if (!options_.drop_when_full) {
     space_.wait(lock, [&] {
       return queue_.size() < capacity || !error_.ok() || stopping_;
@@ -30,12 +30,13 @@ bool AsyncRecorder::Submit(StereoFrame pair, std::vector<double> joints) {
     ++dropped_;
     return false;
   }
-  const Status check = recorder_->CheckWrite(next_frame_, joints);
+  Status check = recorder_->CheckWrite(next_frame_, joints);
+  if (check.ok()) check = recorder_->CheckSet(next_frame_, set);
   if (!check.ok()) {
     error_ = check;
     return false;
   }
-  queue_.push_back(Job{next_frame_++, std::move(pair), std::move(joints)});
+  queue_.push_back(Job{next_frame_++, std::move(set), std::move(joints)});
   max_depth_ = std::max(max_depth_, static_cast<int>(queue_.size()));
   work_.notify_one();
   return true;
@@ -52,7 +53,7 @@ void AsyncRecorder::WriterLoop() {
       job = std::move(queue_.front());
       queue_.pop_front();
       fast = options_.adaptive &&
-             4 * static_cast<int>(queue_.size()) >= options_.queue_pairs;
+             4 * static_cast<int>(queue_.size()) >= options_.queue_sets;
       if (fast) ++fast_;
       space_.notify_one();
       if (!error_.ok()) continue;  // discard after a failure
@@ -63,7 +64,7 @@ void AsyncRecorder::WriterLoop() {
     }
     uint64_t bytes = 0;
     const Status s =
-        recorder_->WritePairImages(job.frame, job.pair, &bytes, fast ? 0 : -1);
+        recorder_->WriteSetImages(job.frame, job.set, &bytes, fast ? 0 : -1);
     std::lock_guard<std::mutex> lock(mu_);
     if (!s.ok()) {
       if (error_.ok()) error_ = s;
@@ -71,11 +72,12 @@ void AsyncRecorder::WriterLoop() {
       continue;
     }
     Done done;
-    done.pair.left.timestamp_s = job.pair.left.timestamp_s;
-    done.pair.right.timestamp_s = job.pair.right.timestamp_s;
-    done.pair.left.sequence = job.pair.left.sequence;
-    done.pair.right.sequence = job.pair.right.sequence;
-    done.pair.index = job.pair.index;
+    done.set.frames.resize(job.set.frames.size());
+    for (size_t c = 0; c < job.set.frames.size(); ++c) {
+      done.set.frames[c].timestamp_s = job.set.frames[c].timestamp_s;
+      done.set.frames[c].sequence = job.set.frames[c].sequence;
+    }
+    done.set.index = job.set.index;
     done.joints = std::move(job.joints);
     done.bytes = bytes;
     done_.emplace(job.frame, std::move(done));
@@ -89,7 +91,7 @@ void AsyncRecorder::CommitReady() {
   while (error_.ok()) {
     auto it = done_.find(recorder_->frames());
     if (it == done_.end()) return;
-    const Status s = recorder_->CommitRow(it->second.pair, it->second.joints,
+    const Status s = recorder_->CommitRow(it->second.set, it->second.joints,
                                           it->second.bytes);
     done_.erase(it);
     if (!s.ok()) {
@@ -112,7 +114,7 @@ Status AsyncRecorder::Stop() {
   std::lock_guard<std::mutex> lock(mu_);
   stopped_ = true;
   // Frames written after a failed one are not in the journal: remove them.
-  for (const auto& [frame, done] : done_) recorder_->RemovePairImages(frame);
+  for (const auto& [frame, done] : done_) recorder_->RemoveSetImages(frame);
   done_.clear();
   return error_;
 }
@@ -125,11 +127,11 @@ int64_t AsyncRecorder::submitted() const {
   std::lock_guard<std::mutex> lock(mu_);
   return submitted_;
 }
-int64_t AsyncRecorder::dropped_pairs() const {
+int64_t AsyncRecorder::dropped_sets() const {
   std::lock_guard<std::mutex> lock(mu_);
   return dropped_;
 }
-int64_t AsyncRecorder::fast_pairs() const {
+int64_t AsyncRecorder::fast_sets() const {
   std::lock_guard<std::mutex> lock(mu_);
   return fast_;
 }

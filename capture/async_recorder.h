@@ -1,20 +1,21 @@
 #ifndef KINCAL_CAPTURE_ASYNC_RECORDER_H_
 #define KINCAL_CAPTURE_ASYNC_RECORDER_H_
 
-// Recording at camera rate: the grab loop hands each pair to Submit, which
+// Recording at camera rate: the grab loop hands each frame set (one image
+// per camera, capture/frame_grabber.h) to Submit, which
 // never waits for the disk; a bounded queue feeds writer threads that encode
-// and write the PNGs (SessionRecorder::WritePairImages), and the rows are
+// and write the PNGs (SessionRecorder::WriteSetImages), and the rows are
 // committed to the session's journal in frame order as soon as every
 // earlier frame is on disk.
 //
 // When the disk (or the encoder) is slower than the cameras the queue fills
-// and Submit drops the pair: it is counted (dropped_pairs) and never
+// and Submit drops the set: it is counted (dropped_sets) and never
 // numbered, so frame names stay contiguous and the grab loop never blocks.
-// The guarantees of SessionRecorder hold: no half pairs (a failed pair's
+// The guarantees of SessionRecorder hold: no partial sets (a failed set's
 // images are removed), and after kill -9 the journal frames.csv.part lists
-// only frames whose two images are complete, in order.
+// only frames whose images are all complete, in order.
 //
-// After the first write failure the recorder stops accepting pairs (Submit
+// After the first write failure the recorder stops accepting sets (Submit
 // returns false), the frames committed so far stay, and the images of
 // frames written after the failed one are removed; Stop reports the error.
 
@@ -31,17 +32,18 @@
 namespace kincal::capture {
 
 struct AsyncRecorderOptions {
-  int queue_pairs = 32;  // pairs waiting for a writer (~84 MB at 1280x1024)
+  // Sets waiting for a writer (two 1280x1024 gray cameras: ~84 MB).
+  int queue_sets = 32;
   int writer_threads = 2;
-  // Live cameras: a full queue drops the pair. Replay sources (false): Submit
+  // Live cameras: a full queue drops the set. Replay sources (false): Submit
   // waits for room instead, as a recording can wait.
   bool drop_when_full = true;
   // When the queue is a quarter full or more, write at PNG level 0 (stored:
   // ~1 ms per frame instead of ~15, still lossless, larger files) until it
   // drains: the encoder then keeps up whenever the disk does. Counted in
-  // fast_pairs().
+  // fast_sets().
   bool adaptive = true;
-  // Test hook: each writer sleeps this long per pair (a slow disk).
+  // Test hook: each writer sleeps this long per set (a slow disk).
   double writer_delay_s = 0.0;
 };
 
@@ -54,28 +56,28 @@ class AsyncRecorder {
   AsyncRecorder(const AsyncRecorder&) = delete;
   AsyncRecorder& operator=(const AsyncRecorder&) = delete;
 
-  // Queues the pair (moved) with its joint values (NaN = none). False when
-  // the queue is full (the pair is dropped and counted) or after a failure
+  // Queues the set (moved) with its joint values (NaN = none). False when
+  // the queue is full (the set is dropped and counted) or after a failure
   // (see failed()). Never waits for a writer.
-  bool Submit(StereoFrame pair, std::vector<double> joints = {});
-  // Waits until every queued pair is written and committed, then joins the
+  bool Submit(FrameSet set, std::vector<double> joints = {});
+  // Waits until every queued set is written and committed, then joins the
   // writers. The first write failure, or Ok.
   Status Stop();
 
   bool failed() const;
   int64_t submitted() const;
-  int64_t dropped_pairs() const;  // queue full
+  int64_t dropped_sets() const;  // queue full
   int max_queue_depth() const;
-  int64_t fast_pairs() const;  // written at level 0 by `adaptive`
+  int64_t fast_sets() const;  // written at level 0 by `adaptive`
 
  private:
   struct Job {
     int64_t frame = 0;
-    StereoFrame pair;
+    FrameSet set;
     std::vector<double> joints;
   };
   struct Done {
-    StereoFrame pair;  // timestamps and sequences only (images released)
+    FrameSet set;  // timestamps and sequences only (images released)
     std::vector<double> joints;
     uint64_t bytes = 0;
   };

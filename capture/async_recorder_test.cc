@@ -22,26 +22,32 @@ namespace {
 using ::kincal::testing::Exists;
 using ::kincal::testing::MakeTempDir;
 
-StereoFrame Pair(int i, int width = 64, int height = 48) {
-  StereoFrame p;
-  p.left.image = cv::Mat(height, width, CV_8UC1);
-  cv::randu(p.left.image, 0, 256);
-  p.left.image.at<uint8_t>(0, 0) = static_cast<uint8_t>(i);
-  p.right.image = cv::Mat(height, width, CV_8UC1);
-  cv::randu(p.right.image, 0, 256);
-  p.right.image.at<uint8_t>(0, 0) = static_cast<uint8_t>(i);
-  p.left.timestamp_s = i / 30.0;
-  p.right.timestamp_s = i / 30.0 + 1e-4;
-  p.left.sequence = i;
-  p.right.sequence = i;
+// A left/right set: random gray images whose first pixel is i.
+FrameSet Pair(int i, int width = 64, int height = 48) {
+  FrameSet p;
+  p.frames.resize(2);
+  for (int c = 0; c < 2; ++c) {
+    Frame& f = p.frames[c];
+    f.image = cv::Mat(height, width, CV_8UC1);
+    cv::randu(f.image, 0, 256);
+    f.image.at<uint8_t>(0, 0) = static_cast<uint8_t>(i);
+    f.timestamp_s = i / 30.0 + 1e-4 * c;
+    f.sequence = i;
+  }
   p.index = i;
   return p;
 }
 
+// A deep copy (the images' pixels too).
+FrameSet Copy(const FrameSet& set) {
+  FrameSet copy = set;
+  for (Frame& f : copy.frames) f.image = f.image.clone();
+  return copy;
+}
+
 SessionInfo Info() {
   SessionInfo info;
-  info.left_uri = "fake:l";
-  info.right_uri = "fake:r";
+  info.cameras = {{"left", "fake:l", ""}, {"right", "fake:r", ""}};
   info.pairing = "timestamp";
   info.time_base = "host_monotonic";
   info.live = true;
@@ -95,21 +101,19 @@ TEST(AsyncRecorderTest, WritesEveryPairLosslesslyInOrder) {
   info.joint_names = {"j1", "j2"};
   SessionRecorder rec;
   ASSERT_TRUE(rec.Open(dir, info).ok());
-  std::vector<StereoFrame> sent;
+  std::vector<FrameSet> sent;
   {
     AsyncRecorderOptions options;
     options.writer_threads = 3;  // out-of-order completion
     AsyncRecorder writer(&rec, options);
     for (int i = 0; i < 20; ++i) {
       sent.push_back(Pair(i));
-      StereoFrame copy = sent.back();
-      copy.left.image = sent.back().left.image.clone();
-      copy.right.image = sent.back().right.image.clone();
+      FrameSet copy = Copy(sent.back());
       const double j2 = i % 3 == 0 ? NAN : 0.5 * i;  // NaN = no reading
       ASSERT_TRUE(writer.Submit(std::move(copy), {1.0 * i, j2}));
     }
     EXPECT_TRUE(writer.Stop().ok());
-    EXPECT_EQ(writer.dropped_pairs(), 0);
+    EXPECT_EQ(writer.dropped_sets(), 0);
   }
   EXPECT_EQ(rec.frames(), 20);
   SessionSummary summary;
@@ -123,7 +127,7 @@ TEST(AsyncRecorderTest, WritesEveryPairLosslesslyInOrder) {
   for (int i : {0, 7, 19}) {
     const std::string name = SessionRecorder::FrameFileName(i);
     const cv::Mat l = cv::imread(dir + "/left/" + name, cv::IMREAD_UNCHANGED);
-    EXPECT_EQ(cv::norm(l, sent[i].left.image, cv::NORM_INF), 0.0);
+    EXPECT_EQ(cv::norm(l, sent[i].frames[0].image, cv::NORM_INF), 0.0);
   }
 }
 
@@ -134,7 +138,7 @@ TEST(AsyncRecorderTest, ThrottledWriterCountsDropsAndNeverBlocks) {
   SessionRecorder rec;
   ASSERT_TRUE(rec.Open(dir, Info()).ok());
   AsyncRecorderOptions options;
-  options.queue_pairs = 3;
+  options.queue_sets = 3;
   options.writer_threads = 1;
   options.writer_delay_s = 0.2;  // 5 pairs/s at most
   AsyncRecorder writer(&rec, options);
@@ -150,19 +154,19 @@ TEST(AsyncRecorderTest, ThrottledWriterCountsDropsAndNeverBlocks) {
     std::this_thread::sleep_for(std::chrono::milliseconds(5));
   }
   ASSERT_TRUE(writer.Stop().ok());
-  EXPECT_GT(writer.dropped_pairs(), 40);
-  EXPECT_EQ(accepted + writer.dropped_pairs(), 60);
+  EXPECT_GT(writer.dropped_sets(), 40);
+  EXPECT_EQ(accepted + writer.dropped_sets(), 60);
   EXPECT_EQ(writer.submitted(), 60);
   EXPECT_EQ(rec.frames(), accepted);
   EXPECT_LE(writer.max_queue_depth(), 3);
   EXPECT_LT(longest_submit_s, 0.1);  // never waited for a writer (0.2 s)
   SessionSummary summary;
-  summary.dropped_pairs = writer.dropped_pairs();
+  summary.dropped_sets = writer.dropped_sets();
   ASSERT_TRUE(rec.Finalize(summary).ok());
   ExpectConsistentSession(dir, "frames.csv");
   EXPECT_EQ(YAML::LoadFile(dir + "/session.yaml")["pairing"]["dropped_pairs"]
                 .as<int>(),
-            writer.dropped_pairs());
+            writer.dropped_sets());
 }
 
 TEST(AsyncRecorderTest, ReplayWaitsInsteadOfDropping) {
@@ -170,14 +174,14 @@ TEST(AsyncRecorderTest, ReplayWaitsInsteadOfDropping) {
   SessionRecorder rec;
   ASSERT_TRUE(rec.Open(dir, Info()).ok());
   AsyncRecorderOptions options;
-  options.queue_pairs = 2;
+  options.queue_sets = 2;
   options.writer_threads = 1;
   options.writer_delay_s = 0.01;
   options.drop_when_full = false;
   AsyncRecorder writer(&rec, options);
   for (int i = 0; i < 15; ++i) ASSERT_TRUE(writer.Submit(Pair(i)));
   ASSERT_TRUE(writer.Stop().ok());
-  EXPECT_EQ(writer.dropped_pairs(), 0);
+  EXPECT_EQ(writer.dropped_sets(), 0);
   EXPECT_EQ(rec.frames(), 15);
 }
 
@@ -189,28 +193,26 @@ TEST(AsyncRecorderTest, BacklogIsWrittenFastAndStillLossless) {
   SessionRecorder rec(ro);
   ASSERT_TRUE(rec.Open(dir, Info()).ok());
   AsyncRecorderOptions options;
-  options.queue_pairs = 8;
+  options.queue_sets = 8;
   options.writer_threads = 1;
   options.writer_delay_s = 0.01;
   options.drop_when_full = false;
-  std::vector<StereoFrame> sent;
+  std::vector<FrameSet> sent;
   {
     AsyncRecorder writer(&rec, options);
     for (int i = 0; i < 16; ++i) {
       sent.push_back(Pair(i, 320, 240));
-      StereoFrame copy = sent.back();
-      copy.left.image = sent.back().left.image.clone();
-      copy.right.image = sent.back().right.image.clone();
+      FrameSet copy = Copy(sent.back());
       ASSERT_TRUE(writer.Submit(std::move(copy)));
     }
     ASSERT_TRUE(writer.Stop().ok());
-    EXPECT_GT(writer.fast_pairs(), 0);
-    EXPECT_LT(writer.fast_pairs(), 16);
+    EXPECT_GT(writer.fast_sets(), 0);
+    EXPECT_LT(writer.fast_sets(), 16);
   }
   for (int i = 0; i < 16; ++i) {
     const std::string name = SessionRecorder::FrameFileName(i);
     const cv::Mat r = cv::imread(dir + "/right/" + name, cv::IMREAD_UNCHANGED);
-    EXPECT_EQ(cv::norm(r, sent[i].right.image, cv::NORM_INF), 0.0) << i;
+    EXPECT_EQ(cv::norm(r, sent[i].frames[1].image, cv::NORM_INF), 0.0) << i;
   }
 }
 

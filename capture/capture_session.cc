@@ -12,16 +12,17 @@
 #include <optional>
 
 #include "capture/async_recorder.h"
+#include "capture/frame_grabber.h"
 #include "capture/frame_source.h"
 #include "capture/joint_log.h"
 #include "capture/joint_stream.h"
 #include "capture/recorder.h"
 #include "capture/robot_link.h"
-#include "capture/stereo_grabber.h"
 #include "data/error.h"
 #include "data/observation_checks.h"
 #include "data/progress.h"
 #include "data/robot.h"
+#include "data/session.h"
 #include "data/warnings.h"
 
 namespace kincal::capture {
@@ -43,12 +44,19 @@ bool IsAbsentOrEmptyDir(const std::string& dir) {
   return empty;
 }
 
-// The checked inputs: both sources (not yet open) and the joint log.
+// The checked inputs: every camera's source (not yet open, in rig order)
+// and the joint log.
 struct Inputs {
-  std::unique_ptr<FrameSource> left, right;
+  std::vector<std::unique_ptr<FrameSource>> sources;
   std::optional<JointLog> joint_log;
   bool live = false;
   Warnings warnings;
+
+  std::vector<FrameSource*> Sources() const {
+    std::vector<FrameSource*> out;
+    for (const auto& s : sources) out.push_back(s.get());
+    return out;
+  }
 };
 
 // The log's readings against the robot file: a reading outside its joint's
@@ -78,25 +86,42 @@ void CheckLogAgainstRobot(const Robot& robot, const JointLog& log,
   CheckJointUnits(robot, rows, log.source, warnings);
 }
 
+// The cameras: names that can name a folder, each once; sources that parse,
+// none given twice; all cameras or all recordings. Fills in->sources.
+void CheckCameras(const CaptureOptions& options, Inputs* in) {
+  const std::vector<CaptureCamera>& cams = options.cameras;
+  std::vector<SourceUri> uris;
+  for (size_t k = 0; k < cams.size(); ++k) {
+    CheckSessionCameraName(cams[k].name, "capture: a camera name");
+    uris.push_back(ParseSourceUri(cams[k].uri));
+    for (size_t j = 0; j < k; ++j) {
+      Require(cams[j].name != cams[k].name,
+              "capture: camera '" + cams[k].name +
+                  "' is given twice; every camera needs its own name");
+      Require(uris[j].scheme + ":" + uris[j].path !=
+                  uris[k].scheme + ":" + uris[k].path,
+              "capture: cameras '" + cams[j].name + "' and '" + cams[k].name +
+                  "' name the same source '" + uris[k].path + "'");
+    }
+  }
+  for (const SourceUri& uri : uris) in->sources.push_back(MakeFrameSource(uri));
+  for (size_t k = 1; k < cams.size(); ++k) {
+    Require(in->sources[k]->IsLive() == in->sources[0]->IsLive(),
+            "capture: cannot pair a camera with a recording (" + cams[0].name +
+                ": " + cams[0].uri + ", " + cams[k].name + ": " + cams[k].uri +
+                "): use only cameras or only recordings");
+  }
+  in->live = in->sources[0]->IsLive();
+}
+
 // Everything the user typed is checked before a camera or file is touched.
 Inputs CheckInputs(const CaptureOptions& options) {
-  Require(
-      !options.left.empty() && !options.right.empty() && !options.out.empty(),
-      "capture: --left, --right and --out are required (or use --list)");
-  const SourceUri left_uri = ParseSourceUri(options.left);
-  const SourceUri right_uri = ParseSourceUri(options.right);
-  Require(left_uri.scheme + ":" + left_uri.path !=
-              right_uri.scheme + ":" + right_uri.path,
-          "capture: --left and --right name the same source '" + left_uri.path +
-              "'");
+  Require(!options.cameras.empty() && !options.out.empty(),
+          "capture: cameras (--camera NAME=URI, or --left and --right) and "
+          "--out are required (or use --list)");
   Inputs in;
   in.warnings = Warnings(&std::cerr);
-  in.left = MakeFrameSource(left_uri);
-  in.right = MakeFrameSource(right_uri);
-  Require(in.left->IsLive() == in.right->IsLive(),
-          "capture: cannot pair a camera with a recording (--left " +
-              options.left + ", --right " + options.right +
-              "): use two cameras or two recordings");
+  CheckCameras(options, &in);
   if (!options.joints.empty()) {
     std::vector<std::string> names;
     Robot robot;
@@ -119,13 +144,12 @@ Inputs CheckInputs(const CaptureOptions& options) {
           "capture: --out " + options.out +
               " exists and is not empty; kincal never overwrites a session, "
               "choose a new folder");
-  in.live = in.left->IsLive();
   return in;
 }
 
-// Opens the pair. A missing replay file is bad input (InputError); a camera
-// that cannot be opened is the returned failure.
-Status OpenGrabber(StereoGrabber* grabber, bool live) {
+// Opens the cameras. A missing replay file is bad input (InputError); a
+// camera that cannot be opened is the returned failure.
+Status OpenGrabber(FrameGrabber* grabber, bool live) {
   const Status s = grabber->Open();
   if (!s.ok() && !live && s.kind() == Status::Kind::kNotFound) {
     throw InputError("capture: " + s.message());
@@ -134,22 +158,18 @@ Status OpenGrabber(StereoGrabber* grabber, bool live) {
 }
 
 // What session.yaml records about the cameras and their pairing.
-SessionInfo DescribeCameras(const CaptureOptions& options,
-                            const FrameSource& left, const FrameSource& right,
-                            const StereoGrabber& grabber, double tolerance_s,
-                            bool live) {
+SessionInfo DescribeCameras(const CaptureOptions& options, const Inputs& in,
+                            const FrameGrabber& grabber, double tolerance_s) {
   SessionInfo info;
-  info.camera_names = options.camera_names;
-  info.left_uri = options.left;
-  info.right_uri = options.right;
-  info.left_description = left.Describe();
-  info.right_description = right.Describe();
-  info.live = live;
+  for (size_t k = 0; k < options.cameras.size(); ++k) {
+    info.cameras.push_back({options.cameras[k].name, options.cameras[k].uri,
+                            in.sources[k]->Describe()});
+  }
+  info.live = in.live;
   info.pairing = PairingName(grabber.pairing());
-  info.tolerance_s = grabber.pairing() == StereoGrabber::Pairing::kLockStep
-                         ? 0.0
-                         : tolerance_s;
-  info.time_base = TimeBaseName(left.time_base());
+  info.tolerance_s =
+      grabber.pairing() == FrameGrabber::Pairing::kLockStep ? 0.0 : tolerance_s;
+  info.time_base = TimeBaseName(in.sources[0]->time_base());
   return info;
 }
 
@@ -176,9 +196,9 @@ CaptureResult RunStepAndShootMode(const CaptureOptions& options, Inputs* in) {
   step.recorder.png_compression = options.png_compression;
   step.announce = options.announce;
   step.interrupted = options.interrupted;
-  StereoGrabberOptions grab_options;
+  FrameGrabberOptions grab_options;
   grab_options.tolerance_s = options.tolerance_ms * 1e-3;
-  StereoGrabber grabber(in->left.get(), in->right.get(), grab_options);
+  FrameGrabber grabber(in->Sources(), grab_options);
   CaptureResult result;
   result.step_and_shoot = true;
   const Status opened = OpenGrabber(&grabber, in->live);
@@ -186,12 +206,16 @@ CaptureResult RunStepAndShootMode(const CaptureOptions& options, Inputs* in) {
     return Failed(result, CaptureResult::kFailure,
                   "capture: " + opened.ToString());
   }
-  step.info = DescribeCameras(options, *in->left, *in->right, grabber,
-                              grab_options.tolerance_s, in->live);
+  step.info = DescribeCameras(options, *in, grabber, grab_options.tolerance_s);
   step.info.settings["png_compression"] =
       std::to_string(options.png_compression);
   if (options.before_recording) options.before_recording();
   result.step = RunStepAndShoot(&grabber, in->live, step);
+  for (size_t k = 0; k < step.info.cameras.size(); ++k) {
+    const SessionCamera& c = step.info.cameras[k];
+    result.cameras.push_back(
+        {c.name, c.uri, c.description, grabber.dropped(k)});
+  }
   grabber.Close();
   if (result.step.outcome == StepAndShootResult::kBadInput) {
     return Failed(result, CaptureResult::kBadInput,
@@ -255,21 +279,21 @@ double ImageMotion(const cv::Mat& image, cv::Mat* previous_small) {
 
 // What the recording loop saw.
 struct Recording {
-  std::vector<double> frame_times;   // left timestamps of accepted pairs
-  std::vector<double> image_motion;  // per accepted pair (joint log only)
+  // The reference (first) camera's timestamps of the accepted sets.
+  std::vector<double> frame_times;
+  std::vector<double> image_motion;  // per accepted set (joint log only)
   std::string stop_reason;
   std::string failure;  // camera or writer failure, else empty
   int64_t transient_failures = 0;
   double seconds = 0;
 };
 
-// Grabs pairs and hands them to the writers until a limit, the end of the
-// recordings, the robot's BYE, Ctrl-C or a failure. Never waits for the
-// disk: a full queue drops the pair (counted by the writer).
-Recording RecordPairs(const CaptureOptions& options, bool live,
-                      bool track_motion, StereoGrabber* grabber,
-                      AsyncRecorder* writer,
-                      const JointStreamReceiver* stream) {
+// Grabs frame sets and hands them to the writers until a limit, the end of
+// the recordings, the robot's BYE, Ctrl-C or a failure. Never waits for the
+// disk: a full queue drops the set (counted by the writer).
+Recording RecordSets(const CaptureOptions& options, bool live,
+                     bool track_motion, FrameGrabber* grabber,
+                     AsyncRecorder* writer, const JointStreamReceiver* stream) {
   Recording rec;
   int64_t accepted = 0;
   cv::Mat previous_small;
@@ -280,8 +304,9 @@ Recording RecordPairs(const CaptureOptions& options, bool live,
         .count();
   };
   int consecutive_failures = 0;
-  StereoFrame pair;
-  // Progress on a terminal: pairs recorded (of --frames when given), drops.
+  FrameSet set;
+  const std::string noun = FrameSetNoun(grabber->cameras());
+  // Progress on a terminal: sets recorded (of --frames when given), drops.
   Progress progress("kincal capture", !options.announce);
   double last_progress_s = -1;
   for (;;) {
@@ -290,7 +315,7 @@ Recording RecordPairs(const CaptureOptions& options, bool live,
       progress.Stage(
           std::to_string(accepted) +
           (options.frames > 0 ? "/" + std::to_string(options.frames) : "") +
-          " pairs recorded, " + std::to_string(writer->dropped_pairs()) +
+          " " + noun + " recorded, " + std::to_string(writer->dropped_sets()) +
           " dropped, " + std::to_string(static_cast<int>(last_progress_s)) +
           " s");
     }
@@ -310,7 +335,7 @@ Recording RecordPairs(const CaptureOptions& options, bool live,
       rec.stop_reason = "interrupted";
       break;
     }
-    const Status s = grabber->Grab(&pair);
+    const Status s = grabber->Grab(&set);
     if (s.kind() == Status::Kind::kEndOfStream) {
       rec.stop_reason = "end_of_stream";
       break;
@@ -328,17 +353,17 @@ Recording RecordPairs(const CaptureOptions& options, bool live,
       break;
     }
     consecutive_failures = 0;
-    const double t_left = pair.left.timestamp_s;
+    const double t_reference = set.frames[0].timestamp_s;
     const double motion =
-        track_motion ? ImageMotion(pair.left.image, &previous_small) : 0.0;
-    if (writer->Submit(std::move(pair))) {
+        track_motion ? ImageMotion(set.frames[0].image, &previous_small) : 0.0;
+    if (writer->Submit(std::move(set))) {
       ++accepted;
-      rec.frame_times.push_back(t_left);
+      rec.frame_times.push_back(t_reference);
       rec.image_motion.push_back(motion);
     } else if (writer->failed()) {
       break;
     }
-    pair = StereoFrame();
+    set = FrameSet();
   }
   rec.seconds = elapsed();
   progress.Done();
@@ -419,46 +444,45 @@ void RecordSettings(const CaptureOptions& options, bool stream,
     info->settings["seconds"] = std::to_string(options.seconds);
   }
   info->settings["png_compression"] = std::to_string(options.png_compression);
-  info->settings["queue_pairs"] = std::to_string(options.queue_pairs);
+  info->settings["queue_pairs"] = std::to_string(options.queue_sets);
   info->settings["writers"] = std::to_string(options.writers);
 }
 
 // What session.yaml records about how the recording ended.
 SessionSummary Summarize(const Recording& rec, const std::string& failure,
                          const std::string& stream_bad_input,
-                         const StereoGrabber& grabber,
+                         const FrameGrabber& grabber,
                          const AsyncRecorder& writer) {
   SessionSummary summary;
   summary.complete = failure.empty() && stream_bad_input.empty();
   summary.stop_reason = !failure.empty()            ? failure
                         : !stream_bad_input.empty() ? stream_bad_input
                                                     : rec.stop_reason;
-  summary.dropped_left = grabber.dropped_left();
-  summary.dropped_right = grabber.dropped_right();
-  summary.dropped_pairs = writer.dropped_pairs();
+  summary.dropped = grabber.dropped();
+  summary.dropped_sets = writer.dropped_sets();
   summary.length_mismatch = grabber.length_mismatch();
   summary.seconds = rec.seconds;
   return summary;
 }
 
 // The figures of a finished recording, into `result`.
-void DescribeRecording(const Inputs& in, const StereoGrabber& grabber,
+void DescribeRecording(const SessionInfo& info, const FrameGrabber& grabber,
                        const AsyncRecorder& writer,
                        const SessionRecorder& recorder, const Recording& rec,
-                       const SessionSummary& summary,
-                       const std::string& pairing, CaptureResult* result) {
+                       const SessionSummary& summary, CaptureResult* result) {
   result->recorded = true;
   result->frames = recorder.frames();
   result->seconds = rec.seconds;
   result->bytes = recorder.bytes_written();
-  result->left_description = in.left->Describe();
-  result->right_description = in.right->Describe();
-  result->pairing = pairing;
-  result->dropped_left = grabber.dropped_left();
-  result->dropped_right = grabber.dropped_right();
-  result->dropped_pairs = writer.dropped_pairs();
+  for (size_t k = 0; k < info.cameras.size(); ++k) {
+    const SessionCamera& c = info.cameras[k];
+    result->cameras.push_back(
+        {c.name, c.uri, c.description, grabber.dropped(k)});
+  }
+  result->pairing = info.pairing;
+  result->dropped_sets = writer.dropped_sets();
   result->max_queue_depth = writer.max_queue_depth();
-  result->fast_pairs = writer.fast_pairs();
+  result->fast_sets = writer.fast_sets();
   result->length_mismatch = grabber.length_mismatch();
   result->transient_failures = rec.transient_failures;
   result->stop_reason = summary.stop_reason;
@@ -470,22 +494,22 @@ CaptureResult Conclude(CaptureResult result, const std::string& out,
                        const std::string& stream_bad_input,
                        const std::string& joint_error,
                        const std::string& failure) {
-  const std::string frames = std::to_string(result.frames);
+  const std::string frames =
+      std::to_string(result.frames) + " " + FrameSetNoun(result.cameras.size());
   if (!stream_bad_input.empty()) {
     return Failed(result, CaptureResult::kBadInput,
                   "capture: " + stream_bad_input + " (the " + frames +
-                      " recorded pairs are kept in " + out + ")");
+                      " recorded are kept in " + out + ")");
   }
   if (!joint_error.empty()) {
     return Failed(result, CaptureResult::kBadInput,
-                  joint_error + " (the " + frames +
-                      " recorded pairs are kept in " + out +
-                      ", without joint readings)");
+                  joint_error + " (the " + frames + " recorded are kept in " +
+                      out + ", without joint readings)");
   }
   if (!failure.empty()) {
     return Failed(result, CaptureResult::kFailure,
                   "capture: " + failure + " (the " + frames +
-                      " pairs recorded so far are kept in " + out + ")");
+                      " recorded so far are kept in " + out + ")");
   }
   return result;
 }
@@ -506,9 +530,9 @@ CaptureResult RunCaptureSession(const CaptureOptions& options) {
 
   CaptureResult result;
   result.warnings = in.warnings.list();
-  StereoGrabberOptions grab_options;
+  FrameGrabberOptions grab_options;
   grab_options.tolerance_s = options.tolerance_ms * 1e-3;
-  StereoGrabber grabber(in.left.get(), in.right.get(), grab_options);
+  FrameGrabber grabber(in.Sources(), grab_options);
   const Status opened = OpenGrabber(&grabber, live);
   if (!opened.ok()) {
     return Failed(result, CaptureResult::kFailure,
@@ -522,8 +546,8 @@ CaptureResult RunCaptureSession(const CaptureOptions& options) {
     if (!stream) return Failed(result, CaptureResult::kFailure, failure);
   }
 
-  SessionInfo info = DescribeCameras(options, *in.left, *in.right, grabber,
-                                     grab_options.tolerance_s, live);
+  SessionInfo info =
+      DescribeCameras(options, in, grabber, grab_options.tolerance_s);
   RecordSettings(options, stream != nullptr, &info);
   SessionRecorder::Options recorder_options;
   recorder_options.png_compression = options.png_compression;
@@ -543,13 +567,13 @@ CaptureResult RunCaptureSession(const CaptureOptions& options) {
   }
 
   AsyncRecorderOptions async_options;
-  async_options.queue_pairs = options.queue_pairs;
+  async_options.queue_sets = options.queue_sets;
   async_options.writer_threads = options.writers;
   async_options.drop_when_full = live;  // a recording can wait
   AsyncRecorder writer(&recorder, async_options);
   if (options.before_recording) options.before_recording();
-  Recording rec = RecordPairs(options, live, in.joint_log.has_value(), &grabber,
-                              &writer, stream.get());
+  Recording rec = RecordSets(options, live, in.joint_log.has_value(), &grabber,
+                             &writer, stream.get());
   grabber.Close();
   const Status written = writer.Stop();  // drains the queue
   std::string failure = rec.failure;
@@ -593,8 +617,7 @@ CaptureResult RunCaptureSession(const CaptureOptions& options) {
     failure = "finalize: " + finalized.ToString();
   }
 
-  DescribeRecording(in, grabber, writer, recorder, rec, summary, info.pairing,
-                    &result);
+  DescribeRecording(info, grabber, writer, recorder, rec, summary, &result);
   result.complete = failure.empty();
   return Conclude(result, options.out, stream_bad_input, joint_error, failure);
 }

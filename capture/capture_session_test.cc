@@ -36,8 +36,8 @@ std::string WriteStereoFolders(int n) {
 
 CaptureOptions Replay(const std::string& dir) {
   CaptureOptions options;
-  options.left = "folder:" + dir + "/l/*.png?fps=10";
-  options.right = "folder:" + dir + "/r/*.png?fps=10";
+  options.cameras = {{"left", "folder:" + dir + "/l/*.png?fps=10"},
+                     {"right", "folder:" + dir + "/r/*.png?fps=10"}};
   options.out = dir + "/session";
   options.announce = false;
   return options;
@@ -68,7 +68,7 @@ TEST(CaptureSessionTest, ReplaysTwoFoldersToTheEndIntoASession) {
   EXPECT_EQ(r.stop_reason, "end_of_stream");
   EXPECT_TRUE(r.complete);
   EXPECT_EQ(r.pairing, "lockstep");
-  EXPECT_EQ(r.dropped_pairs, 0);
+  EXPECT_EQ(r.dropped_sets, 0);
   EXPECT_FALSE(r.length_mismatch);
   EXPECT_FALSE(r.has_joints);
   EXPECT_GT(r.bytes, 0u);
@@ -78,6 +78,46 @@ TEST(CaptureSessionTest, ReplaysTwoFoldersToTheEndIntoASession) {
   EXPECT_EQ(last.at<uint8_t>(0, 0), 80);  // lossless
   EXPECT_TRUE(Exists(options.out + "/frames.csv"));
   EXPECT_TRUE(Exists(options.out + "/session.yaml"));
+}
+
+TEST(CaptureSessionTest, RecordsOneAndThreeCamerasUnderTheirNames) {
+  const std::string dir = WriteStereoFolders(4);
+  CaptureOptions three = Replay(dir);
+  three.cameras = {{"a", "folder:" + dir + "/l/*.png"},
+                   {"b", "folder:" + dir + "/r/*.png"},
+                   {"c", "folder:" + dir + "/l/00[0-2].png"}};  // shorter
+  CaptureResult r = RunCaptureSession(three);
+  EXPECT_EQ(r.outcome, CaptureResult::kOk) << r.message;
+  EXPECT_EQ(r.frames, 3);
+  EXPECT_TRUE(r.length_mismatch);
+  ASSERT_EQ(r.cameras.size(), 3u);
+  EXPECT_EQ(r.cameras[2].name, "c");
+  EXPECT_EQ(r.cameras[2].uri, three.cameras[2].uri);
+  EXPECT_EQ(r.cameras[0].dropped, 1);  // a's and b's fourth frames
+  EXPECT_EQ(r.cameras[1].dropped, 1);
+  EXPECT_EQ(r.cameras[2].dropped, 0);
+  for (const char* cam : {"a", "b", "c"}) {
+    const cv::Mat image =
+        cv::imread(three.out + "/" + cam + "/000002.png", cv::IMREAD_UNCHANGED);
+    ASSERT_FALSE(image.empty()) << cam;
+    EXPECT_EQ(image.at<uint8_t>(0, 0), 40) << cam;
+    EXPECT_FALSE(Exists(three.out + "/" + cam + "/000003.png"));
+  }
+  const std::string csv = ReadFile(three.out + "/frames.csv");
+  EXPECT_NE(csv.find("\nframe,t_a,t_b,t_c,seq_a,seq_b,seq_c\n"),
+            std::string::npos)
+      << csv;
+
+  CaptureOptions one = Replay(dir);
+  one.out = dir + "/mono";
+  one.cameras = {{"cam0", "folder:" + dir + "/r/*.png"}};
+  r = RunCaptureSession(one);
+  EXPECT_EQ(r.outcome, CaptureResult::kOk) << r.message;
+  EXPECT_EQ(r.frames, 4);
+  EXPECT_FALSE(r.length_mismatch);
+  EXPECT_TRUE(Exists(one.out + "/cam0/000003.png"));
+  EXPECT_NE(ReadFile(one.out + "/frames.csv").find("\nframe,t_cam0,seq_cam0\n"),
+            std::string::npos);
 }
 
 TEST(CaptureSessionTest, StopsAfterTheRequestedPairs) {
@@ -95,12 +135,26 @@ TEST(CaptureSessionTest, StopsAfterTheRequestedPairs) {
 TEST(CaptureSessionTest, BadInputIsRefusedBeforeAnythingIsWritten) {
   const std::string dir = WriteStereoFolders(2);
   CaptureOptions same = Replay(dir);
-  same.right = same.left;
-  EXPECT_NE(InputErrorOf(same).find("--left and --right name the same source"),
+  same.cameras[1].uri = same.cameras[0].uri;
+  EXPECT_NE(InputErrorOf(same).find(
+                "cameras 'left' and 'right' name the same source"),
             std::string::npos);
 
+  CaptureOptions twice = Replay(dir);
+  twice.cameras[1].name = "left";
+  EXPECT_NE(InputErrorOf(twice).find("camera 'left' is given twice"),
+            std::string::npos);
+
+  CaptureOptions bad_name = Replay(dir);
+  bad_name.cameras[1].name = "my cam";
+  EXPECT_NE(InputErrorOf(bad_name).find("my cam"), std::string::npos);
+
+  CaptureOptions none = Replay(dir);
+  none.cameras.clear();
+  EXPECT_NE(InputErrorOf(none).find("required"), std::string::npos);
+
   CaptureOptions mixed = Replay(dir);
-  mixed.right = "fake:cam";
+  mixed.cameras.push_back({"top", "fake:cam"});
   EXPECT_NE(InputErrorOf(mixed).find("cannot pair a camera with a recording"),
             std::string::npos);
 
@@ -110,7 +164,7 @@ TEST(CaptureSessionTest, BadInputIsRefusedBeforeAnythingIsWritten) {
             std::string::npos);
 
   CaptureOptions missing = Replay(dir);
-  missing.left = "folder:" + dir + "/none/*.png";
+  missing.cameras[0].uri = "folder:" + dir + "/none/*.png";
   EXPECT_EQ(InputErrorOf(missing).rfind("capture: ", 0), 0u);
   EXPECT_FALSE(Exists(missing.out));
 
@@ -162,7 +216,7 @@ TEST(CaptureSessionTest, AJointLogThatCannotBeMergedKeepsThePairs) {
   EXPECT_EQ(r.outcome, CaptureResult::kBadInput);
   EXPECT_NE(r.message.find("does not cover the session"), std::string::npos)
       << r.message;
-  EXPECT_NE(r.message.find("(the 4 recorded pairs are kept in " + options.out +
+  EXPECT_NE(r.message.find("(the 4 pairs recorded are kept in " + options.out +
                            ", without joint readings)"),
             std::string::npos)
       << r.message;

@@ -142,8 +142,18 @@ std::string SessionRecorder::FrameFileName(int64_t frame) {
   return buf;
 }
 
+std::vector<std::string> SessionRecorder::CameraNames() const {
+  std::vector<std::string> names;
+  for (const SessionCamera& c : info_.cameras) names.push_back(c.name);
+  return names;
+}
+
+std::string SessionRecorder::ImagePath(size_t camera, int64_t frame) const {
+  return dir_ + "/" + info_.cameras[camera].name + "/" + FrameFileName(frame);
+}
+
 std::string SessionRecorder::CsvHeader() const {
-  std::string h = SessionFramesHeader(info_.camera_names, {});
+  std::string h = SessionFramesHeader(CameraNames(), {});
   for (const std::string& j : info_.joint_names) h += "," + CsvQuote(j);
   return h + "\n";
 }
@@ -153,20 +163,22 @@ Status SessionRecorder::Open(const std::string& dir, const SessionInfo& info) {
     return Status::Error(Status::Kind::kIoError,
                          "recorder already open on " + dir_);
   }
-  if (info.camera_names.size() != 2 ||
-      info.camera_names[0] == info.camera_names[1]) {
+  if (info.cameras.empty()) {
     return Status::Error(Status::Kind::kUnsupported,
-                         "a stereo recording needs two different camera names");
+                         "a recording needs at least one camera");
   }
   std::set<std::string> names = {"frame"};
-  for (const std::string& c : info.camera_names) {
+  for (const SessionCamera& c : info.cameras) {
     try {
-      CheckSessionCameraName(c, "capture");
+      CheckSessionCameraName(c.name, "capture");
     } catch (const InputError& e) {
       return Status::Error(Status::Kind::kUnsupported, e.what());
     }
-    names.insert("t_" + c);
-    names.insert("seq_" + c);
+    if (!names.insert("t_" + c.name).second) {
+      return Status::Error(Status::Kind::kUnsupported,
+                           "camera name '" + c.name + "' given twice");
+    }
+    names.insert("seq_" + c.name);
   }
   for (const std::string& j : info.joint_names) {
     if (j.empty() || !names.insert(j).second) {
@@ -181,8 +193,10 @@ Status SessionRecorder::Open(const std::string& dir, const SessionInfo& info) {
                              ": exists and is not empty (kincal never "
                              "overwrites a session; choose a new folder)");
   }
-  for (const std::string& d : {dir, dir + "/" + info.camera_names[0],
-                               dir + "/" + info.camera_names[1]}) {
+  std::vector<std::string> folders = {dir};
+  for (const SessionCamera& c : info.cameras)
+    folders.push_back(dir + "/" + c.name);
+  for (const std::string& d : folders) {
     Status s = MakeDirs(d);
     if (!s.ok()) return s;
   }
@@ -206,14 +220,14 @@ Status SessionRecorder::Open(const std::string& dir, const SessionInfo& info) {
   return Status::Ok();
 }
 
-Status SessionRecorder::Write(const StereoFrame& pair,
+Status SessionRecorder::Write(const FrameSet& set,
                               const std::vector<double>& joints) {
   Status s = CheckWrite(frames_, joints);
   if (!s.ok()) return s;
   uint64_t bytes = 0;
-  s = WritePairImages(frames_, pair, &bytes);
+  s = WriteSetImages(frames_, set, &bytes);
   if (!s.ok()) return s;
-  return CommitRow(pair, joints, bytes);
+  return CommitRow(set, joints, bytes);
 }
 
 Status SessionRecorder::CheckWrite(int64_t frame,
@@ -237,44 +251,50 @@ Status SessionRecorder::CheckWrite(int64_t frame,
   return Status::Ok();
 }
 
-Status SessionRecorder::WritePairImages(int64_t frame, const StereoFrame& pair,
-                                        uint64_t* bytes,
-                                        int compression) const {
+Status SessionRecorder::CheckSet(int64_t frame, const FrameSet& set) const {
+  if (set.frames.size() == info_.cameras.size()) return Status::Ok();
+  return Status::Error(Status::Kind::kUnsupported,
+                       "frame " + std::to_string(frame) + ": " +
+                           std::to_string(set.frames.size()) + " images for " +
+                           std::to_string(info_.cameras.size()) + " cameras");
+}
+
+Status SessionRecorder::WriteSetImages(int64_t frame, const FrameSet& set,
+                                       uint64_t* bytes, int compression) const {
+  Status s = CheckSet(frame, set);
+  if (!s.ok()) return s;
   const int level = compression >= 0 ? compression : options_.png_compression;
-  const std::string name = FrameFileName(frame);
-  const std::string left = dir_ + "/" + info_.camera_names[0] + "/" + name;
-  const std::string right = dir_ + "/" + info_.camera_names[1] + "/" + name;
-  size_t left_bytes = 0, right_bytes = 0;
-  Status left_status =
-      WritePngAtomic(left, pair.left.image, level, &left_bytes);
-  Status right_status =
-      left_status.ok()
-          ? WritePngAtomic(right, pair.right.image, level, &right_bytes)
-          : Status::Ok();
-  if (!left_status.ok() || !right_status.ok()) {
-    RemovePairImages(frame);  // never leave half a pair
-    return left_status.ok() ? right_status : left_status;
+  uint64_t total = 0;
+  for (size_t c = 0; c < info_.cameras.size(); ++c) {
+    size_t image_bytes = 0;
+    s = WritePngAtomic(ImagePath(c, frame), set.frames[c].image, level,
+                       &image_bytes);
+    if (!s.ok()) {
+      RemoveSetImages(frame);  // never leave part of a set
+      return s;
+    }
+    total += image_bytes;
   }
-  *bytes = left_bytes + right_bytes;
+  *bytes = total;
   return Status::Ok();
 }
 
-void SessionRecorder::RemovePairImages(int64_t frame) const {
-  const std::string name = FrameFileName(frame);
-  ::unlink((dir_ + "/" + info_.camera_names[0] + "/" + name).c_str());
-  ::unlink((dir_ + "/" + info_.camera_names[1] + "/" + name).c_str());
+void SessionRecorder::RemoveSetImages(int64_t frame) const {
+  for (size_t c = 0; c < info_.cameras.size(); ++c) {
+    ::unlink(ImagePath(c, frame).c_str());
+  }
 }
 
-Status SessionRecorder::CommitRow(const StereoFrame& pair,
+Status SessionRecorder::CommitRow(const FrameSet& set,
                                   const std::vector<double>& joints,
                                   uint64_t bytes) {
   Status s = CheckWrite(frames_, joints);
+  if (s.ok()) s = CheckSet(frames_, set);
   if (!s.ok()) return s;
-  std::string row = std::to_string(frames_) + "," +
-                    FormatFixed(pair.left.timestamp_s, 6) + "," +
-                    FormatFixed(pair.right.timestamp_s, 6) + "," +
-                    std::to_string(pair.left.sequence) + "," +
-                    std::to_string(pair.right.sequence);
+  // frame, t_<camera>..., seq_<camera>... (SessionFramesHeader's order).
+  std::string row = std::to_string(frames_);
+  for (const Frame& f : set.frames) row += "," + FormatFixed(f.timestamp_s, 6);
+  for (const Frame& f : set.frames) row += "," + std::to_string(f.sequence);
   for (double v : joints) {
     row += ",";
     if (v == v) {  // NaN = no reading: empty cell
@@ -287,7 +307,7 @@ Status SessionRecorder::CommitRow(const StereoFrame& pair,
   row += "\n";
   if (std::fputs(row.c_str(), journal_) < 0 || std::fflush(journal_) != 0) {
     const int err = errno;
-    RemovePairImages(frames_);
+    RemoveSetImages(frames_);
     return IoError(dir_ + "/frames.csv.part", "write failed", err);
   }
   rows_.push_back(std::move(row));
@@ -309,9 +329,9 @@ Status SessionRecorder::SetJointColumns(
                              std::to_string(rows_.size()) + " frames");
   }
   std::set<std::string> seen = {"frame"};
-  for (const std::string& c : info_.camera_names) {
-    seen.insert("t_" + c);
-    seen.insert("seq_" + c);
+  for (const SessionCamera& c : info_.cameras) {
+    seen.insert("t_" + c.name);
+    seen.insert("seq_" + c.name);
   }
   for (const std::string& n : names) {
     if (n.empty() || !seen.insert(n).second) {
@@ -377,8 +397,8 @@ std::string SessionRecorder::SessionYaml(const SessionSummary* summary) const {
   y << YAML::Key << "command" << YAML::Value << CommandLine();
   y << YAML::Key << "frames" << YAML::Value << frames_;
   y << YAML::Key << "images" << YAML::Value << YAML::BeginMap;
-  for (const std::string& c : info_.camera_names) {
-    y << YAML::Key << c << YAML::Value << c + "/*.png";
+  for (const SessionCamera& c : info_.cameras) {
+    y << YAML::Key << c.name << YAML::Value << c.name + "/*.png";
   }
   y << YAML::Key << "format" << YAML::Value << "png";
   y << YAML::Key << "png_compression" << YAML::Value
@@ -386,12 +406,10 @@ std::string SessionRecorder::SessionYaml(const SessionSummary* summary) const {
   y << YAML::EndMap;
   y << YAML::Key << "frames_csv" << YAML::Value << "frames.csv";
   y << YAML::Key << "sources" << YAML::Value << YAML::BeginMap;
-  for (int side = 0; side < 2; ++side) {
-    y << YAML::Key << info_.camera_names[side] << YAML::Value << YAML::BeginMap;
-    y << YAML::Key << "uri" << YAML::Value
-      << (side == 0 ? info_.left_uri : info_.right_uri);
-    y << YAML::Key << "description" << YAML::Value
-      << (side == 0 ? info_.left_description : info_.right_description);
+  for (const SessionCamera& c : info_.cameras) {
+    y << YAML::Key << c.name << YAML::Value << YAML::BeginMap;
+    y << YAML::Key << "uri" << YAML::Value << c.uri;
+    y << YAML::Key << "description" << YAML::Value << c.description;
     y << YAML::EndMap;
   }
   y << YAML::EndMap;
@@ -401,9 +419,15 @@ std::string SessionRecorder::SessionYaml(const SessionSummary* summary) const {
   y << YAML::Key << "mode" << YAML::Value << info_.pairing;
   y << YAML::Key << "tolerance_s" << YAML::Value << info_.tolerance_s;
   if (summary != nullptr) {
-    y << YAML::Key << "dropped_left" << YAML::Value << summary->dropped_left;
-    y << YAML::Key << "dropped_right" << YAML::Value << summary->dropped_right;
-    y << YAML::Key << "dropped_pairs" << YAML::Value << summary->dropped_pairs;
+    // Per camera: frames in no set; then the sets the writers could not
+    // keep up with (dropped_pairs, the name it has had since two cameras).
+    y << YAML::Key << "dropped" << YAML::Value << YAML::BeginMap;
+    for (size_t c = 0; c < info_.cameras.size(); ++c) {
+      y << YAML::Key << info_.cameras[c].name << YAML::Value
+        << (c < summary->dropped.size() ? summary->dropped[c] : 0);
+    }
+    y << YAML::EndMap;
+    y << YAML::Key << "dropped_pairs" << YAML::Value << summary->dropped_sets;
     y << YAML::Key << "length_mismatch" << YAML::Value
       << summary->length_mismatch;
   }

@@ -9,19 +9,23 @@
 #include <string>
 #include <vector>
 
-#include "capture/stereo_grabber.h"
+#include "capture/frame_grabber.h"
 
 namespace kincal::capture {
 
+// One camera of a session.
+struct SessionCamera {
+  // As in rig.yaml: the camera's image folder and frames.csv columns
+  // (t_<name>, seq_<name>; data/session.h).
+  std::string name;
+  std::string uri;          // the source (capture/frame_source.h)
+  std::string description;  // FrameSource::Describe()
+};
+
 // What session.yaml records about how a session was made.
 struct SessionInfo {
-  // The two cameras' names: their image folders and frames.csv columns
-  // (t_<name>, seq_<name>), as in rig.yaml (data/session.h).
-  std::vector<std::string> camera_names = {"left", "right"};
-  std::string left_uri;
-  std::string right_uri;
-  std::string left_description;
-  std::string right_description;
+  // 1..N cameras in rig order; FrameSet::frames follows this order.
+  std::vector<SessionCamera> cameras;
   bool live = false;
   std::string pairing;  // "lockstep" / "timestamp"
   double tolerance_s = 0;
@@ -37,28 +41,30 @@ struct SessionInfo {
 struct SessionSummary {
   std::string stop_reason;  // "frames", "seconds", "end_of_stream", ...
   bool complete = true;     // false after a failure
-  int64_t dropped_left = 0;
-  int64_t dropped_right = 0;
-  int64_t dropped_pairs = 0;  // queue full: disk/encoder slower than cameras
+  // Per camera (SessionInfo::cameras order): frames left out of every set.
+  std::vector<int64_t> dropped;
+  int64_t dropped_sets = 0;  // queue full: disk/encoder slower than cameras
   bool length_mismatch = false;
   double seconds = 0;  // wall time of the recording
 };
 
-// Writes a session folder that `kincal track` reads directly:
+// Writes a session folder (../shared/spec/formats.md v3, "Recorded session
+// with N cameras") that `kincal track --session` and the bundle read:
 //
-//   DIR/left/000000.png, 000001.png, ...    lossless PNG, one per pair
-//   DIR/right/000000.png, ...               same names: sorted, they pair
-//   DIR/frames.csv                          frame,t_left,t_right,seq_left,
-//                                           seq_right[,joint columns]
-//   (left and right are SessionInfo::camera_names, the rig's names)
-//   DIR/session.yaml                        sources, settings, command line,
-//                                           start time, how it ended
+//   DIR/<camera>/000000.png, 000001.png, ...  one folder per camera, named
+//                                             as in rig.yaml; lossless PNG,
+//                                             the same names in every folder
+//   DIR/frames.csv     frame,t_<c1>,...,t_<cN>,seq_<c1>,...,seq_<cN>
+//                      [,joint columns] (a left/right rig: version 2's
+//                      frame,t_left,t_right,seq_left,seq_right)
+//   DIR/session.yaml   sources, settings, command line, start time, how it
+//                      ended
 //
 // Images are written as they come (each to a ".part" file renamed when
 // complete, so no truncated PNG is ever matched by left/*.png); rows go to
 // frames.csv.part as they come, and Finalize writes frames.csv and
 // session.yaml atomically. Every failure (disk full, folder removed) is a
-// Status; after a failed Write the pair is not on disk.
+// Status; after a failed Write no image of the set is on disk.
 class SessionRecorder {
  public:
   struct Options {
@@ -71,24 +77,28 @@ class SessionRecorder {
   SessionRecorder(const SessionRecorder&) = delete;
   SessionRecorder& operator=(const SessionRecorder&) = delete;
 
-  // Creates DIR (and parents), DIR/left and DIR/right, and a first
-  // session.yaml (status: recording). DIR must not exist or be empty.
+  // Creates DIR (and parents), one folder per camera, and a first
+  // session.yaml (status: recording). DIR must not exist or be empty;
+  // kUnsupported without a camera, or for a camera name that cannot name a
+  // folder (data/session.h) or is given twice.
   Status Open(const std::string& dir, const SessionInfo& info);
-  // Writes one pair as frame frames(); `joints` has one value per
-  // SessionInfo::joint_names entry (kUnsupported otherwise); NaN = no
-  // reading (an empty cell).
-  Status Write(const StereoFrame& pair, const std::vector<double>& joints = {});
+  // Writes one set (one frame per camera, in SessionInfo::cameras order) as
+  // frame frames(); `joints` has one value per SessionInfo::joint_names
+  // entry (kUnsupported otherwise); NaN = no reading (an empty cell).
+  Status Write(const FrameSet& set, const std::vector<double>& joints = {});
 
   // Write in two steps, for writer threads (capture/async_recorder.h):
-  // WritePairImages encodes and writes the two images of frame `frame`
-  // (thread-safe, const: touches only those two files; on failure neither
-  // is left on disk); CommitRow then appends the row of frame frames() to
-  // the journal, whose images must be on disk (one thread, frame order).
+  // WriteSetImages encodes and writes the images of frame `frame`
+  // (thread-safe, const: touches only those files; on failure none is left
+  // on disk); CommitRow then appends the row of frame frames() to the
+  // journal, whose images must be on disk (one thread, frame order).
   Status CheckWrite(int64_t frame, const std::vector<double>& joints) const;
+  // kUnsupported unless `set` holds one frame per camera.
+  Status CheckSet(int64_t frame, const FrameSet& set) const;
   // `compression` overrides Options::png_compression when >= 0.
-  Status WritePairImages(int64_t frame, const StereoFrame& pair,
-                         uint64_t* bytes, int compression = -1) const;
-  Status CommitRow(const StereoFrame& pair, const std::vector<double>& joints,
+  Status WriteSetImages(int64_t frame, const FrameSet& set, uint64_t* bytes,
+                        int compression = -1) const;
+  Status CommitRow(const FrameSet& set, const std::vector<double>& joints,
                    uint64_t bytes);
   // Joint readings merged after recording (capture --joints): adds the
   // columns `names` with one row of values per recorded frame (NaN = no
@@ -101,7 +111,7 @@ class SessionRecorder {
     info_.settings[key] = value;
   }
   // Removes frame `frame`'s images (written but never committed).
-  void RemovePairImages(int64_t frame) const;
+  void RemoveSetImages(int64_t frame) const;
   // Writes frames.csv and session.yaml (atomically) and removes the journal.
   Status Finalize(const SessionSummary& summary);
 
@@ -117,6 +127,9 @@ class SessionRecorder {
  private:
   std::string SessionYaml(const SessionSummary* summary) const;
   std::string CsvHeader() const;
+  std::vector<std::string> CameraNames() const;
+  // DIR/<camera>/<frame>.png
+  std::string ImagePath(size_t camera, int64_t frame) const;
 
   Options options_;
   std::string dir_;

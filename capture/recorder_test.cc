@@ -20,28 +20,29 @@ namespace {
 using ::kincal::testing::Exists;
 using ::kincal::testing::MakeTempDir;
 
-// A pair with distinct random-looking content per frame and side.
-StereoFrame Pair(int i) {
-  StereoFrame p;
-  p.left.image = cv::Mat(24, 32, CV_8UC1);
-  cv::randu(p.left.image, 0, 256);
-  p.left.image.at<uint8_t>(0, 0) = static_cast<uint8_t>(i);
-  p.right.image = cv::Mat(24, 32, CV_8UC3);
-  cv::randu(p.right.image, 0, 256);
-  p.left.timestamp_s = 100.0 + i / 30.0;
-  p.right.timestamp_s = 100.0005 + i / 30.0;
-  p.left.sequence = 7 + i;
-  p.right.sequence = 9 + i;
-  p.index = i;
-  return p;
+// A set of `cameras` frames with distinct random-looking content per frame
+// and camera: camera 0 gray, the others BGR; camera c's frame i at
+// 100 + i / 30 + 0.0005 c s, sequence 7 + 2 c + i.
+FrameSet Set(int i, int cameras = 2) {
+  FrameSet set;
+  set.frames.resize(cameras);
+  for (int c = 0; c < cameras; ++c) {
+    Frame& f = set.frames[c];
+    f.image = cv::Mat(24, 32, c == 0 ? CV_8UC1 : CV_8UC3);
+    cv::randu(f.image, 0, 256);
+    f.image.at<uint8_t>(0, 0) = static_cast<uint8_t>(i);
+    f.timestamp_s = 100.0 + 0.0005 * c + i / 30.0;
+    f.sequence = 7 + 2 * c + i;
+  }
+  set.index = i;
+  return set;
 }
+FrameSet Pair(int i) { return Set(i, 2); }
 
 SessionInfo Info() {
   SessionInfo info;
-  info.left_uri = "folder:/x/left*.png";
-  info.right_uri = "folder:/x/right*.png";
-  info.left_description = "left cam";
-  info.right_description = "right cam";
+  info.cameras = {{"left", "folder:/x/left*.png", "left cam"},
+                  {"right", "folder:/x/right*.png", "right cam"}};
   info.pairing = "lockstep";
   info.time_base = "media";
   info.settings["frames"] = "3";
@@ -58,7 +59,7 @@ TEST(RecorderTest, WritesASessionThatTrackReadsAndIsLossless) {
   EXPECT_TRUE(Exists(dir + "/session.yaml"));  // written at start
   EXPECT_EQ(YAML::LoadFile(dir + "/session.yaml")["status"].as<std::string>(),
             "recording");
-  std::vector<StereoFrame> pairs;
+  std::vector<FrameSet> pairs;
   for (int i = 0; i < 3; ++i) {
     pairs.push_back(Pair(i));
     ASSERT_TRUE(rec.Write(pairs.back(), {1.5 * i, -20.25}).ok());
@@ -81,15 +82,21 @@ TEST(RecorderTest, WritesASessionThatTrackReadsAndIsLossless) {
     const cv::Mat r = cv::imread(right[i], cv::IMREAD_UNCHANGED);
     ASSERT_EQ(l.type(), CV_8UC1);
     ASSERT_EQ(r.type(), CV_8UC3);
-    EXPECT_EQ(cv::norm(l, pairs[i].left.image, cv::NORM_INF), 0);
-    EXPECT_EQ(cv::norm(r, pairs[i].right.image, cv::NORM_INF), 0);
+    EXPECT_EQ(cv::norm(l, pairs[i].frames[0].image, cv::NORM_INF), 0);
+    EXPECT_EQ(cv::norm(r, pairs[i].frames[1].image, cv::NORM_INF), 0);
   }
   EXPECT_TRUE(GlobSorted(dir + "/*/*.part").empty());
   EXPECT_FALSE(Exists(dir + "/frames.csv.part"));
 
-  // frames.csv: provenance comment, header, one row per pair.
+  // frames.csv: provenance comment, header (version 2's, byte for byte),
+  // one row per pair.
   const std::string csv = ReadFile(dir + "/frames.csv");
-  EXPECT_EQ(csv.rfind("# kincal capture --test\n", 0), 0u);
+  EXPECT_EQ(csv.rfind("# kincal capture --test\n"
+                      "frame,t_left,t_right,seq_left,seq_right,j1,j2\n"
+                      "0,100.000000,100.000500,7,9,0,-20.25\n",
+                      0),
+            0u)
+      << csv;
   const auto lines = TokenizeCsv(csv, "frames.csv");
   ASSERT_EQ(lines.size(), 4u);
   const std::vector<std::string> header = {
@@ -114,10 +121,76 @@ TEST(RecorderTest, WritesASessionThatTrackReadsAndIsLossless) {
   EXPECT_EQ(y["sources"]["left"]["uri"].as<std::string>(),
             "folder:/x/left*.png");
   EXPECT_EQ(y["pairing"]["mode"].as<std::string>(), "lockstep");
+  EXPECT_EQ(y["pairing"]["dropped"]["right"].as<int>(), 0);
   EXPECT_EQ(y["joints"][1].as<std::string>(), "j2");
   EXPECT_EQ(y["stop_reason"].as<std::string>(), "end_of_stream");
   EXPECT_EQ(y["settings"]["frames"].as<std::string>(), "3");
   EXPECT_EQ(y["started_utc"].as<std::string>().size(), 20u);
+}
+
+TEST(RecorderTest, ThreeCamerasGetAFolderAndTwoColumnsEach) {
+  SetCommandLine("kincal capture --three");
+  const std::string dir = MakeTempDir("rec3") + "/s";
+  SessionInfo info = Info();
+  info.cameras.push_back({"top", "folder:/x/top*.png", "top cam"});
+  info.joint_names = {"j1"};
+  SessionRecorder rec;
+  ASSERT_TRUE(rec.Open(dir, info).ok());
+  std::vector<FrameSet> sets;
+  for (int i = 0; i < 2; ++i) {
+    sets.push_back(Set(i, 3));
+    ASSERT_TRUE(rec.Write(sets.back(), {0.5 * i}).ok());
+  }
+  // A set without the third camera's frame is refused and writes nothing.
+  EXPECT_EQ(rec.Write(Pair(2), {1.0}).kind(), Status::Kind::kUnsupported);
+  SessionSummary summary;
+  summary.dropped = {0, 2, 5};
+  ASSERT_TRUE(rec.Finalize(summary).ok());
+
+  const char* names[] = {"left", "right", "top"};
+  for (int c = 0; c < 3; ++c) {
+    const auto files = GlobSorted(dir + "/" + names[c] + "/*");
+    ASSERT_EQ(files.size(), 2u) << names[c];
+    EXPECT_EQ(files[1], dir + "/" + names[c] + "/000001.png");
+    const cv::Mat image = cv::imread(files[1], cv::IMREAD_UNCHANGED);
+    EXPECT_EQ(cv::norm(image, sets[1].frames[c].image, cv::NORM_INF), 0);
+  }
+  EXPECT_EQ(ReadFile(dir + "/frames.csv"),
+            "# kincal capture --three\n"
+            "frame,t_left,t_right,t_top,seq_left,seq_right,seq_top,j1\n"
+            "0,100.000000,100.000500,100.001000,7,9,11,0\n"
+            "1,100.033333,100.033833,100.034333,8,10,12,0.5\n");
+  const YAML::Node y = YAML::LoadFile(dir + "/session.yaml");
+  EXPECT_EQ(y["sources"]["top"]["uri"].as<std::string>(), "folder:/x/top*.png");
+  EXPECT_EQ(y["images"]["top"].as<std::string>(), "top/*.png");
+  EXPECT_EQ(y["pairing"]["dropped"]["top"].as<int>(), 5);
+  EXPECT_EQ(y["pairing"]["dropped"]["right"].as<int>(), 2);
+}
+
+TEST(RecorderTest, OneCameraAndCameraNamesAreChecked) {
+  SessionInfo info = Info();
+  info.cameras.resize(1);
+  const std::string dir = MakeTempDir("rec1") + "/s";
+  SessionRecorder rec;
+  ASSERT_TRUE(rec.Open(dir, info).ok());
+  ASSERT_TRUE(rec.Write(Set(0, 1)).ok());
+  ASSERT_TRUE(rec.Finalize(SessionSummary()).ok());
+  EXPECT_EQ(TokenizeCsv(ReadFile(dir + "/frames.csv"), "f")[0].fields.size(),
+            3u);  // frame, t_left, seq_left
+  EXPECT_EQ(GlobSorted(dir + "/left/*.png").size(), 1u);
+
+  for (const std::vector<std::string>& names :
+       std::vector<std::vector<std::string>>{
+           {}, {"a", "a"}, {"a", "b/c"}, {".."}}) {
+    SessionInfo bad = Info();
+    bad.cameras.clear();
+    for (const std::string& n : names) bad.cameras.push_back({n, "", ""});
+    SessionRecorder r;
+    const std::string d = MakeTempDir("rec_names") + "/s";
+    EXPECT_EQ(r.Open(d, bad).kind(), Status::Kind::kUnsupported)
+        << names.size();
+    EXPECT_FALSE(Exists(d));
+  }
 }
 
 TEST(RecorderTest, RefusesANonEmptyFolder) {

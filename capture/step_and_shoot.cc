@@ -24,13 +24,13 @@ void AppendValues(const std::vector<double>& q, std::string* row) {
 
 }  // namespace
 
-StereoFrame AveragePairs(const std::vector<StereoFrame>& pairs) {
-  StereoFrame out = pairs.back();
-  for (int side = 0; side < 2; ++side) {
+FrameSet AverageSets(const std::vector<FrameSet>& sets) {
+  FrameSet out = sets.back();
+  for (size_t c = 0; c < out.frames.size(); ++c) {
     cv::Mat sum;
     double t = 0;
-    for (const StereoFrame& p : pairs) {
-      const Frame& f = side == 0 ? p.left : p.right;
+    for (const FrameSet& set : sets) {
+      const Frame& f = set.frames[c];
       cv::Mat f32;
       f.image.convertTo(f32, CV_32F);
       if (sum.empty()) {
@@ -40,9 +40,9 @@ StereoFrame AveragePairs(const std::vector<StereoFrame>& pairs) {
       }
       t += f.timestamp_s;
     }
-    Frame& o = side == 0 ? out.left : out.right;
-    sum.convertTo(o.image, CV_8U, 1.0 / pairs.size());
-    o.timestamp_s = t / pairs.size();
+    Frame& o = out.frames[c];
+    sum.convertTo(o.image, CV_8U, 1.0 / sets.size());
+    o.timestamp_s = t / sets.size();
   }
   return out;
 }
@@ -110,19 +110,19 @@ Status ReadMessageLine(const StepAndShootOptions& options, RobotLink* link,
   return s;
 }
 
-// `shots` pairs taken after `settled_at` (live sources; replay: the next
-// pairs).
-Status GrabSettledPairs(StereoGrabber* grabber, bool live, int shots,
-                        double settled_at, std::vector<StereoFrame>* pairs) {
-  while (static_cast<int>(pairs->size()) < shots) {
-    StereoFrame pair;
-    const Status s = grabber->Grab(&pair);
+// `shots` sets whose every frame was taken after `settled_at` (live
+// sources; replay: the next sets).
+Status GrabSettledSets(FrameGrabber* grabber, bool live, int shots,
+                       double settled_at, std::vector<FrameSet>* sets) {
+  while (static_cast<int>(sets->size()) < shots) {
+    FrameSet set;
+    const Status s = grabber->Grab(&set);
     if (!s.ok()) return s;
-    if (live &&
-        std::max(pair.left.timestamp_s, pair.right.timestamp_s) < settled_at) {
-      continue;  // taken before the robot had settled
-    }
-    pairs->push_back(std::move(pair));
+    const bool before =
+        std::any_of(set.frames.begin(), set.frames.end(),
+                    [&](const Frame& f) { return f.timestamp_s < settled_at; });
+    if (live && before) continue;  // taken before the robot had settled
+    sets->push_back(std::move(set));
   }
   return Status();
 }
@@ -148,23 +148,23 @@ PoseLoop StartPoseLoop(const std::vector<std::string>& names) {
   return loop;
 }
 
-// SETTLED: grab, average and record one pair with the readings, answer
+// SETTLED: grab, average and record one set with the readings, answer
 // DONE. False (with loop->failure set) when the loop must stop.
 bool ShootPose(const RobotMessage& m, const std::vector<double>& q,
-               StereoGrabber* grabber, bool live,
+               FrameGrabber* grabber, bool live,
                const StepAndShootOptions& options, RobotLink* link,
                SessionRecorder* recorder, PoseLoop* loop,
                StepAndShootResult* result, long* last_pose) {
-  std::vector<StereoFrame> shots;
-  Status s = GrabSettledPairs(grabber, live, options.shots, MonotonicSeconds(),
-                              &shots);
+  std::vector<FrameSet> shots;
+  Status s =
+      GrabSettledSets(grabber, live, options.shots, MonotonicSeconds(), &shots);
   if (!s.ok()) {
     loop->failure =
         "grab at pose " + std::to_string(m.pose) + ": " + s.ToString();
     link->WriteLine("ERROR camera: " + s.message());
     return false;
   }
-  s = recorder->Write(AveragePairs(shots), q);
+  s = recorder->Write(AverageSets(shots), q);
   if (!s.ok()) {
     loop->failure = "write: " + s.ToString();
     link->WriteLine("ERROR recording: " + s.message());
@@ -186,7 +186,7 @@ bool ShootPose(const RobotMessage& m, const std::vector<double>& q,
 
 // Reads the robot's messages until BYE, Ctrl-C, a malformed message or a
 // failure: J lines go to joints.csv, each SETTLED records one pose.
-PoseLoop RecordPoses(StereoGrabber* grabber, bool live,
+PoseLoop RecordPoses(FrameGrabber* grabber, bool live,
                      const StepAndShootOptions& options,
                      const std::vector<int>& order, RobotLink* link,
                      SessionRecorder* recorder, StepAndShootResult* result) {
@@ -251,7 +251,7 @@ PoseLoop RecordPoses(StereoGrabber* grabber, bool live,
 
 }  // namespace
 
-StepAndShootResult RunStepAndShoot(StereoGrabber* grabber, bool live,
+StepAndShootResult RunStepAndShoot(FrameGrabber* grabber, bool live,
                                    const StepAndShootOptions& options) {
   StepAndShootResult result;
   RobotLink link;
@@ -295,8 +295,7 @@ StepAndShootResult RunStepAndShoot(StereoGrabber* grabber, bool live,
   summary.stop_reason = !failure.empty()          ? failure
                         : !loop.bad_input.empty() ? loop.bad_input
                                                   : result.stop_reason;
-  summary.dropped_left = grabber->dropped_left();
-  summary.dropped_right = grabber->dropped_right();
+  summary.dropped = grabber->dropped();
   summary.seconds = result.seconds;
   const Status fin = recorder.Finalize(summary);
   if (!fin.ok() && failure.empty()) failure = "finalize: " + fin.ToString();

@@ -4,17 +4,18 @@
 // Step and shoot with a live robot link (capture/robot_link.h; protocol and
 // robot programs in docs/LAB.md): wait for the robot, check its HELLO
 // against the robot's joint names (nothing is written before it passes),
-// create the session, and at every SETTLED grab `shots` pairs taken after
-// the message arrived (live sources; replay: the next pairs), average them,
-// record one pair with the readings and answer DONE. J readings go to
+// create the session, and at every SETTLED grab `shots` frame sets (one
+// image per camera) taken after the message arrived (live sources; replay:
+// the next sets), average them, record one set with the readings and answer
+// DONE. J readings go to
 // SESSION/joints.csv, one observations.csv row per recorded pose.
 
 #include <atomic>
 #include <string>
 #include <vector>
 
+#include "capture/frame_grabber.h"
 #include "capture/recorder.h"
-#include "capture/stereo_grabber.h"
 
 namespace kincal::capture {
 
@@ -45,12 +46,13 @@ struct StepAndShootResult {
   double seconds = 0;
 };
 
-// The mean of the pairs (8-bit, rounded) with their mean timestamps.
-StereoFrame AveragePairs(const std::vector<StereoFrame>& pairs);
+// The mean of the sets per camera (8-bit, rounded) with their mean
+// timestamps; the sets hold the same cameras.
+FrameSet AverageSets(const std::vector<FrameSet>& sets);
 
 // `grabber` must be open. Never throws for robot or camera faults: they are
 // the result's outcome, with the session kept when it was created.
-StepAndShootResult RunStepAndShoot(StereoGrabber* grabber, bool live,
+StepAndShootResult RunStepAndShoot(FrameGrabber* grabber, bool live,
                                    const StepAndShootOptions& options);
 
 }  // namespace kincal::capture

@@ -25,21 +25,25 @@ using ::kincal::testing::MakeTempDir;
 using ::kincal::testing::ReceiveLine;
 using ::kincal::testing::SendLine;
 
-TEST(StepAndShootTest, AveragePairsRoundsTheMeanAndAveragesTimes) {
-  std::vector<StereoFrame> pairs(2);
-  pairs[0].left.image = cv::Mat(2, 2, CV_8UC1, cv::Scalar(10));
-  pairs[1].left.image = cv::Mat(2, 2, CV_8UC1, cv::Scalar(13));
-  pairs[0].right.image = cv::Mat(2, 2, CV_8UC1, cv::Scalar(100));
-  pairs[1].right.image = cv::Mat(2, 2, CV_8UC1, cv::Scalar(100));
-  pairs[0].left.timestamp_s = 1.0;
-  pairs[1].left.timestamp_s = 2.0;
-  pairs[0].right.timestamp_s = 1.5;
-  pairs[1].right.timestamp_s = 2.5;
-  const StereoFrame mean = AveragePairs(pairs);
-  EXPECT_EQ(mean.left.image.at<uint8_t>(0, 0), 12);  // 11.5 rounds up
-  EXPECT_EQ(mean.right.image.at<uint8_t>(1, 1), 100);
-  EXPECT_DOUBLE_EQ(mean.left.timestamp_s, 1.5);
-  EXPECT_DOUBLE_EQ(mean.right.timestamp_s, 2.0);
+TEST(StepAndShootTest, AverageSetsRoundsTheMeanAndAveragesTimes) {
+  std::vector<FrameSet> sets(2);
+  const double values[2][3] = {{10, 100, 0}, {13, 100, 255}};
+  for (int s = 0; s < 2; ++s) {
+    sets[s].frames.resize(3);
+    for (int c = 0; c < 3; ++c) {
+      sets[s].frames[c].image =
+          cv::Mat(2, 2, CV_8UC1, cv::Scalar(values[s][c]));
+      sets[s].frames[c].timestamp_s = 1.0 + s + 0.5 * c;
+    }
+  }
+  const FrameSet mean = AverageSets(sets);
+  ASSERT_EQ(mean.frames.size(), 3u);
+  EXPECT_EQ(mean.frames[0].image.at<uint8_t>(0, 0), 12);  // 11.5 rounds up
+  EXPECT_EQ(mean.frames[1].image.at<uint8_t>(1, 1), 100);
+  EXPECT_EQ(mean.frames[2].image.at<uint8_t>(1, 0), 128);  // 127.5
+  EXPECT_DOUBLE_EQ(mean.frames[0].timestamp_s, 1.5);
+  EXPECT_DOUBLE_EQ(mean.frames[1].timestamp_s, 2.0);
+  EXPECT_DOUBLE_EQ(mean.frames[2].timestamp_s, 2.5);
 }
 
 // Two folders of `n` gray frames each (value 10 k for frame k).
@@ -59,15 +63,15 @@ std::string WriteStereoFolders(int n) {
 
 struct Rig {
   std::unique_ptr<FrameSource> left, right;
-  std::unique_ptr<StereoGrabber> grabber;
+  std::unique_ptr<FrameGrabber> grabber;
 };
 
 Rig OpenReplay(const std::string& dir) {
   Rig rig;
   rig.left = MakeFrameSource("folder:" + dir + "/l/*.png");
   rig.right = MakeFrameSource("folder:" + dir + "/r/*.png");
-  rig.grabber = std::make_unique<StereoGrabber>(rig.left.get(), rig.right.get(),
-                                                StereoGrabberOptions());
+  rig.grabber = std::make_unique<FrameGrabber>(
+      std::vector<FrameSource*>{rig.left.get(), rig.right.get()});
   return rig;
 }
 
@@ -80,6 +84,8 @@ StepAndShootOptions Options(int port, const std::string& out) {
   options.timeout_s = 10;
   options.out = out;
   options.announce = false;
+  options.info.cameras = {{"left", "folder:l", "l"},
+                          {"right", "folder:r", "r"}};
   return options;
 }
 
@@ -124,6 +130,56 @@ TEST(StepAndShootTest, RecordsOneAveragedPairPerSettledPoseUntilBye) {
       cv::imread(out + "/left/000000.png", cv::IMREAD_UNCHANGED);
   ASSERT_FALSE(first.empty());
   EXPECT_EQ(first.at<uint8_t>(0, 0), 5);
+}
+
+TEST(StepAndShootTest, ThreeCamerasRecordOneAveragedSetPerPose) {
+  // Folders l and r as above, and a third camera "t" (value 10 k + 1).
+  const std::string dir = WriteStereoFolders(4);
+  ::mkdir((dir + "/t").c_str(), 0755);
+  for (int k = 0; k < 4; ++k) {
+    char name[32];
+    std::snprintf(name, sizeof(name), "/t/%03d.png", k);
+    cv::imwrite(dir + name, cv::Mat(8, 8, CV_8UC1, cv::Scalar(10 * k + 1)));
+  }
+  std::vector<std::unique_ptr<FrameSource>> sources;
+  for (const char* folder : {"/l", "/r", "/t"}) {
+    sources.push_back(MakeFrameSource("folder:" + dir + folder + "/*.png"));
+  }
+  FrameGrabber grabber({sources[0].get(), sources[1].get(), sources[2].get()});
+  ASSERT_TRUE(grabber.Open().ok());
+  const int port = FreeLoopbackPort();
+  std::thread robot([port] {
+    const int fd = ConnectLoopback(port, 100);
+    if (fd < 0) return;
+    std::string line;
+    SendLine(fd, "HELLO testbot j1 j2");
+    ReceiveLine(fd, &line);
+    SendLine(fd, "SETTLED 0 1 2");
+    ReceiveLine(fd, &line);
+    SendLine(fd, "BYE");
+    ::close(fd);
+  });
+  const std::string out = dir + "/session";
+  StepAndShootOptions options = Options(port, out);
+  options.info.cameras = {
+      {"a", "folder:l", ""}, {"b", "folder:r", ""}, {"c", "folder:t", ""}};
+  const StepAndShootResult r = RunStepAndShoot(&grabber, false, options);
+  robot.join();
+  EXPECT_EQ(r.outcome, StepAndShootResult::kOk) << r.message;
+  EXPECT_EQ(r.frames, 1);
+  // Pose 0 averages replay sets 0 and 1 of every camera.
+  const int expected[] = {5, 5, 6};
+  const char* names[] = {"a", "b", "c"};
+  for (int c = 0; c < 3; ++c) {
+    const cv::Mat image =
+        cv::imread(out + "/" + names[c] + "/000000.png", cv::IMREAD_UNCHANGED);
+    ASSERT_FALSE(image.empty()) << names[c];
+    EXPECT_EQ(image.at<uint8_t>(0, 0), expected[c]) << names[c];
+  }
+  const std::string frames = ReadFile(out + "/frames.csv");
+  EXPECT_NE(frames.find("\nframe,t_a,t_b,t_c,seq_a,seq_b,seq_c,j1,j2\n0,"),
+            std::string::npos)
+      << frames;
 }
 
 TEST(StepAndShootTest, AnUnknownJointInHelloWritesNothing) {

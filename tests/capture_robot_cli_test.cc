@@ -107,6 +107,8 @@ TEST(CaptureRobotCli, StepAndShootRecordsEverySettledPose) {
   const auto j = nlohmann::json::parse(r.out);
   EXPECT_EQ(j["poses"], 4);
   EXPECT_EQ(j["stop_reason"], "robot_bye");
+  ASSERT_EQ(j["cameras"].size(), 2u);
+  EXPECT_EQ(j["cameras"][1]["name"], "right");
   const auto lines = Frames(s.out);
   ASSERT_EQ(lines.size(), 5u);
   EXPECT_EQ(lines[0].fields[5].text, "j1");
