@@ -14,6 +14,7 @@
 #include <set>
 #include <sstream>
 
+#include "bundle/robot_record.h"
 #include "calib/holdout.h"
 #include "calib/identifiability.h"
 #include "data/error.h"
@@ -785,9 +786,70 @@ void DropOutlierTags(State* st, const std::vector<Obs>& train,
   }
 }
 
-// sigma0 (px) of the final fit and each accepted parameter's value and
-// sigma (interface units; NaN where the covariance is not available), from
-// the covariance of the free blocks scaled by sigma0^2.
+// One coordinate of a parameter block (the covariance's rows).
+struct Coordinate {
+  const double* block = nullptr;
+  int size = 0;   // the block's size
+  int index = 0;  // inside the block
+};
+
+// The covariance among `coords` (unscaled): Ceres' covariance (dense SVD,
+// pseudo-inverse) of their blocks, every pair once. False when Ceres cannot
+// compute it.
+bool CoordinateCovariance(ceres::Problem* problem,
+                          const std::vector<Coordinate>& coords,
+                          int num_threads, Eigen::MatrixXd* out) {
+  std::vector<Coordinate> blocks;  // distinct blocks, first-seen order
+  std::vector<int> block_of;
+  for (const Coordinate& c : coords) {
+    size_t k = 0;
+    while (k < blocks.size() && blocks[k].block != c.block) ++k;
+    if (k == blocks.size()) blocks.push_back(c);
+    block_of.push_back(static_cast<int>(k));
+  }
+  std::vector<std::pair<const double*, const double*>> pairs;
+  for (size_t i = 0; i < blocks.size(); ++i) {
+    for (size_t j = i; j < blocks.size(); ++j) {
+      pairs.push_back({blocks[i].block, blocks[j].block});
+    }
+  }
+  ceres::Covariance::Options co;
+  co.algorithm_type = ceres::DENSE_SVD;
+  co.null_space_rank = -1;
+  co.num_threads = num_threads;
+  ceres::Covariance cov(co);
+  if (pairs.empty() || !cov.Compute(pairs, problem)) return false;
+  // Block pair (i <= j), row-major size_i x size_j.
+  std::map<std::pair<int, int>, std::vector<double>> pair_cov;
+  for (size_t i = 0; i < blocks.size(); ++i) {
+    for (size_t j = i; j < blocks.size(); ++j) {
+      std::vector<double>& c =
+          pair_cov[{static_cast<int>(i), static_cast<int>(j)}];
+      c.resize(blocks[i].size * blocks[j].size);
+      if (!cov.GetCovarianceBlock(blocks[i].block, blocks[j].block, c.data())) {
+        return false;
+      }
+    }
+  }
+  const int n = static_cast<int>(coords.size());
+  out->resize(n, n);
+  for (int a = 0; a < n; ++a) {
+    for (int b = 0; b < n; ++b) {
+      const int i = block_of[a], j = block_of[b];
+      (*out)(a, b) =
+          i <= j ? pair_cov[{i, j}]
+                           [coords[a].index * blocks[j].size + coords[b].index]
+                 : pair_cov[{j, i}]
+                           [coords[b].index * blocks[i].size + coords[a].index];
+    }
+  }
+  return out->allFinite();
+}
+
+// sigma0 (px) of the final fit, each accepted parameter's value and sigma
+// (interface units; NaN where the covariance is not available) and their
+// covariance with the two frames (BundleResult::covariance): the covariance
+// of the free blocks scaled by sigma0^2.
 void EstimateCovariance(State* st, const std::vector<Obs>& train,
                         const std::vector<PoseInput>& inputs,
                         const Freedom& fit, const BundleOptions& opt,
@@ -795,7 +857,6 @@ void EstimateCovariance(State* st, const std::vector<Obs>& train,
                         const std::vector<ParamInfo>& candidates,
                         const std::vector<std::string>& accepted,
                         BundleResult* res) {
-  const int nj = st->chain.num_joints();
   Built b = Build(st, train, inputs, fit, opt, rig);
   int nfree = 12;
   for (const auto& r : fit.row_free) nfree += static_cast<int>(r.size());
@@ -804,86 +865,41 @@ void EstimateCovariance(State* st, const std::vector<Obs>& train,
   b.problem->Evaluate(ceres::Problem::EvaluateOptions(), &cost, nullptr,
                       nullptr, nullptr);
   res->sigma0_px = std::sqrt(2 * cost / std::max(1, b.residuals - nfree));
-  ceres::Covariance::Options co;
-  co.algorithm_type = ceres::DENSE_SVD;
-  co.null_space_rank = -1;
-  co.num_threads = opt.num_threads;
-  ceres::Covariance cov(co);
-  std::vector<std::pair<const double*, const double*>> pairs;
-  for (int j = 0; j < nj; ++j) {
-    if (!fit.row_free[j].empty()) {
-      pairs.push_back({st->chain.rows[j].p.data(), st->chain.rows[j].p.data()});
-    }
-    if (fit.with_errors && !fit.error_free[j].empty()) {
-      pairs.push_back(
-          {st->chain.joint_errors[j].data(), st->chain.joint_errors[j].data()});
-    }
-  }
-  const bool have_cov = !pairs.empty() && cov.Compute(pairs, b.problem.get());
-  const double s2 = res->sigma0_px * res->sigma0_px;
+  // The accepted parameters in candidate order, then the frames A and B.
+  std::vector<ParamInfo> params;
+  std::vector<Coordinate> coords;
   for (const ParamInfo& p : candidates) {
     if (std::find(accepted.begin(), accepted.end(), p.name) == accepted.end()) {
       continue;
     }
+    params.push_back(p);
+    coords.push_back(p.kind == ParamKind::kRow
+                         ? Coordinate{st->chain.rows[p.block].p.data(),
+                                      kRowBlockSize, p.index}
+                         : Coordinate{st->chain.joint_errors[p.block].data(),
+                                      kJointErrorBlockSize, p.index});
+  }
+  for (int k = 0; k < 6; ++k) coords.push_back({st->rig_side.data(), 6, k});
+  for (int k = 0; k < 6; ++k) coords.push_back({st->tool_side.data(), 6, k});
+  Eigen::MatrixXd cov;
+  const bool have_cov =
+      !params.empty() &&
+      CoordinateCovariance(b.problem.get(), coords, opt.num_threads, &cov);
+  if (have_cov) res->covariance = cov * (res->sigma0_px * res->sigma0_px);
+  ModelState ms;
+  ms.chain = st->chain;
+  for (size_t k = 0; k < params.size(); ++k) {
+    const ParamInfo& p = params[k];
     BundleParam bp;
     bp.name = p.name;
-    ModelState ms;
-    ms.chain = st->chain;
     bp.value = p.ToInterface(ParamValue(ms, p));
     bp.sigma = std::numeric_limits<double>::quiet_NaN();
     if (have_cov) {
-      const int size =
-          p.kind == ParamKind::kRow ? kRowBlockSize : kJointErrorBlockSize;
-      const double* blk = p.kind == ParamKind::kRow
-                              ? st->chain.rows[p.block].p.data()
-                              : st->chain.joint_errors[p.block].data();
-      std::vector<double> c(size * size);
-      if (cov.GetCovarianceBlock(blk, blk, c.data())) {
-        const double var = c[p.index * size + p.index] * s2;
-        bp.sigma = std::abs(p.ToInterface(std::sqrt(std::max(0.0, var))));
-      }
+      const double var = std::max(0.0, res->covariance(k, k));
+      bp.sigma = std::abs(p.ToInterface(std::sqrt(var)));
     }
     res->params.push_back(bp);
   }
-}
-
-// What the calibrated robot file records of the fit (data/robot.h
-// FitRecord): the nominal rows, the frames' joint travel, the measuring
-// frame (the rig on a stand: rig_from_base; the fixed target with the
-// cameras on the flange: target_from_base) and the held-out tip RMS. No
-// covariance: the bundle's is over pixels and cameras and is not propagated to
-// the robot yet.
-void RecordFit(const Robot& nominal, const std::vector<BundleFrame>& frames,
-               BundleResult* res) {
-  Robot& cal = res->calibrated;
-  cal.SetNominal(nominal);
-  FitRecord& rec = cal.fitted_on;
-  const size_t n = nominal.joints.size();
-  rec.joint_range.assign(n, {std::numeric_limits<double>::infinity(),
-                             -std::numeric_limits<double>::infinity()});
-  for (const BundleFrame& f : frames) {
-    if (f.q_reading.size() != n) continue;
-    ++rec.poses;
-    for (size_t j = 0; j < n; ++j) {
-      rec.joint_range[j][0] = std::min(rec.joint_range[j][0], f.q_reading[j]);
-      rec.joint_range[j][1] = std::max(rec.joint_range[j][1], f.q_reading[j]);
-    }
-  }
-  if (rec.poses == 0) {
-    rec.joint_range.clear();
-    return;
-  }
-  const std::array<double, 6> block =
-      res->mount == RigMount::kFlange
-          ? PoseBlockFromRigid3(
-                Rigid3FromPoseBlock(res->base_from_target.data()).Inverse())
-          : res->rig_from_base;
-  rec.has_frame = true;
-  for (int k = 0; k < 3; ++k) {
-    rec.frame[k] = block[k] * 180.0 / M_PI;
-    rec.frame[k + 3] = block[k + 3];
-  }
-  rec.heldout_rms_mm = res->heldout_tip_rms_mm;
 }
 
 // The solved state into the result: the tool row (to the tip, or to the rig
@@ -984,11 +1000,13 @@ void NameIdentifiable(const Chain& chain,
         fn[k]);
   }
   for (const std::string& a : accepted) res->identifiable.push_back(a);
+  const std::vector<int> position_index =
+      ToolRowPositionIndices(chain.convention);
   for (const ParamInfo& p : GeometryParams(chain)) {
     if (p.block != chain.tool_row()) continue;
-    const bool position = chain.convention == Convention::kMdh
-                              ? p.index >= 1 && p.index <= 3
-                              : p.index < 3;
+    const bool position =
+        std::find(position_index.begin(), position_index.end(), p.index) !=
+        position_index.end();
     (position ? res->identifiable : res->unidentifiable).push_back(p.name);
   }
 }
@@ -1087,7 +1105,9 @@ BundleResult RunBundle(const Robot& nominal, const Rig& rig,
   HeldOutTips(frames, target, opt, &res);
   ExtensionEffects(ext, &res);
   NameIdentifiable(st.chain, scan.accepted, &res);
-  RecordFit(nominal, frames, &res);
+  std::vector<int> fitted;  // training frames with corners in the fit
+  for (const Obs& o : train) fitted.push_back(o.index);
+  RecordBundleFit(nominal, frames, fitted, target, &res);
   res.seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start)
           .count();

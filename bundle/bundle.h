@@ -119,9 +119,11 @@ struct BundleParam {
 };
 
 struct BundleResult {
-  Chain chain;       // fitted (tool row set from the tip)
-  Robot calibrated;  // chain.ToRobot(nominal)
-  Rig rig;           // refined cameras (= input without refine)
+  Chain chain;  // fitted (tool row set from the tip)
+  // chain.ToRobot(nominal) with the fit record and covariance
+  // (bundle/robot_record.h RecordBundleFit).
+  Robot calibrated;
+  Rig rig;  // refined cameras (= input without refine)
   RigMount mount = RigMount::kWorld;  // rig.mount
   // The two frames, [angle-axis rad, t mm]. mount world: rig_from_base and
   // flange_from_tool; mount flange: flange_from_rig and base_from_target
@@ -131,6 +133,13 @@ struct BundleResult {
   std::array<double, 6> flange_from_rig{};
   std::array<double, 6> base_from_target{};
   std::vector<BundleParam> params;  // free parameters with sigma
+  // Their covariance (Ceres, dense SVD, scaled by sigma0_px^2; params[].sigma
+  // is its diagonal), internal units (mm, rad, the families' units): rows
+  // and columns 0 .. params.size() - 1 in params' order, then the fitted
+  // frames' pose blocks [angle-axis rad, t mm] A = rig_from_base |
+  // rig_from_flange (6) and B = flange_from_tool | base_from_target (6);
+  // empty when Ceres cannot compute it.
+  Eigen::MatrixXd covariance;
   std::vector<std::string> identifiable, unidentifiable;
   std::vector<std::string> relations;  // why each is unidentifiable
   int frames = 0;                      // frames given

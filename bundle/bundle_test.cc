@@ -92,9 +92,10 @@ TEST(Bundle, ExactCornersGiveTheTrueTips) {
   // The record compensate reads: nominal rows, travel, the rig as frame.
   ASSERT_TRUE(r.calibrated.HasNominal());
   EXPECT_EQ(r.calibrated.nominal_joints[1].a_mm, s.nominal.joints[1].a_mm);
-  EXPECT_EQ(r.calibrated.fitted_on.poses, 60);
+  EXPECT_EQ(r.calibrated.fitted_on.poses, r.train_frames);
   ASSERT_EQ(r.calibrated.fitted_on.joint_range.size(), s.nominal.joints.size());
-  EXPECT_LE(r.calibrated.fitted_on.joint_range[2][0], s.frames[0].q_reading[2]);
+  EXPECT_LE(r.calibrated.fitted_on.joint_range[2][0],
+            s.frames[r.train[0]].q_reading[2]);
   EXPECT_TRUE(r.calibrated.fitted_on.has_frame);
   EXPECT_EQ(r.calibrated.fitted_on.frame[3], r.rig_from_base[3]);
 }

@@ -95,14 +95,18 @@ FitRecord MakeFitRecord(const FitRecordInput& input) {
   }
   rec.heldout_rms_mm = input.heldout_rms_mm;
   rec.systematic_rms_mm = input.systematic_rms_mm;
-  const FitSummary* fit = input.fit;
-  if (fit == nullptr ||
-      fit->covariance.rows() != static_cast<int>(fit->params.size())) {
+  const std::vector<ParamInfo>* params =
+      input.fit != nullptr ? &input.fit->params : input.params;
+  const Eigen::MatrixXd* cov =
+      input.fit != nullptr ? &input.fit->covariance : input.covariance;
+  if (params == nullptr || cov == nullptr ||
+      cov->rows() != static_cast<int>(params->size()) ||
+      cov->cols() != cov->rows()) {
     return rec;
   }
   std::vector<int> keep;
-  for (size_t k = 0; k < fit->params.size(); ++k) {
-    if (fit->params[k].kind != ParamKind::kPoint) {
+  for (size_t k = 0; k < params->size(); ++k) {
+    if ((*params)[k].kind != ParamKind::kPoint) {
       keep.push_back(static_cast<int>(k));
     }
   }
@@ -110,7 +114,7 @@ FitRecord MakeFitRecord(const FitRecordInput& input) {
     // Only the rows whose fitted coefficients the covariance names.
     for (auto& jb : PeriodicBases(input.state->chain)) {
       const bool named = std::any_of(keep.begin(), keep.end(), [&](int k) {
-        const ParamInfo& q = fit->params[k];
+        const ParamInfo& q = (*params)[k];
         return q.kind == ParamKind::kJointError && q.index >= kTransmission0 &&
                input.state->chain.rows[q.block].name == jb.first;
       });
@@ -120,13 +124,13 @@ FitRecord MakeFitRecord(const FitRecordInput& input) {
   const int p = static_cast<int>(keep.size());
   rec.covariance.resize(p, p);
   for (int a = 0; a < p; ++a) {
-    const ParamInfo& pa = fit->params[keep[a]];
+    const ParamInfo& pa = (*params)[keep[a]];
     rec.covariance_params.push_back(pa.name);
     for (int b = 0; b < p; ++b) {
-      const ParamInfo& pb = fit->params[keep[b]];
+      const ParamInfo& pb = (*params)[keep[b]];
       // Internal -> interface: ToInterface is linear (rad -> deg).
-      rec.covariance(a, b) = fit->covariance(keep[a], keep[b]) *
-                             pa.ToInterface(1.0) * pb.ToInterface(1.0);
+      rec.covariance(a, b) =
+          (*cov)(keep[a], keep[b]) * pa.ToInterface(1.0) * pb.ToInterface(1.0);
     }
   }
   if (!rec.covariance.allFinite()) {

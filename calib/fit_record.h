@@ -41,6 +41,10 @@ struct FitRecordInput {
   const Observations* obs = nullptr;  // the rows the model was fitted on
   std::vector<int> rows;              // their indices; empty = all rows
   const FitSummary* fit = nullptr;    // covariance source; may be null
+  // Without a FitSummary (fit null): the parameters and their covariance in
+  // internal units, in `params`' order (the bundle's); both may be null.
+  const std::vector<ParamInfo>* params = nullptr;
+  const Eigen::MatrixXd* covariance = nullptr;
   const ModelState* state = nullptr;  // its measuring frame; may be null
   double heldout_rms_mm = std::numeric_limits<double>::quiet_NaN();
   double systematic_rms_mm = std::numeric_limits<double>::quiet_NaN();

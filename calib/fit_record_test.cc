@@ -68,6 +68,40 @@ TEST(FitRecordTest, TravelTemperatureFrameAndCovarianceInInterfaceUnits) {
   EXPECT_EQ(rec.heldout_rms_mm, 0.05);
 }
 
+// Without a FitSummary (the bundle's case): the parameters and their
+// covariance given directly give the same record; a covariance of another
+// size gives none.
+TEST(FitRecordTest, ParamsAndCovarianceWithoutAFitSummary) {
+  const Observations obs = TwoRows();
+  ParamInfo angle;
+  angle.name = "j2.theta";
+  angle.angle = true;
+  ParamInfo frame;
+  frame.name = "frame.x";
+  frame.kind = ParamKind::kFrame;
+  const std::vector<ParamInfo> params = {angle, frame};
+  Eigen::MatrixXd cov(2, 2);
+  cov << 4e-6, 1e-3, 1e-3, 0.25;  // rad^2, rad mm, mm^2
+  FitRecordInput in;
+  in.obs = &obs;
+  in.rows = {1};
+  in.params = &params;
+  in.covariance = &cov;
+  const FitRecord rec = MakeFitRecord(in);
+  EXPECT_EQ(rec.poses, 1);
+  EXPECT_EQ(rec.joint_range[0][0], -5.0);
+  EXPECT_EQ(rec.joint_range[0][1], -5.0);
+  ASSERT_EQ(rec.covariance_params,
+            (std::vector<std::string>{"j2.theta", "frame.x"}));
+  const double deg = 180.0 / M_PI;
+  EXPECT_NEAR(rec.covariance(0, 0), 4e-6 * deg * deg, 1e-12);
+  EXPECT_NEAR(rec.covariance(1, 0), 1e-3 * deg, 1e-12);
+  EXPECT_EQ(rec.covariance(1, 1), 0.25);
+  const Eigen::MatrixXd wrong = Eigen::MatrixXd::Identity(3, 3);
+  in.covariance = &wrong;
+  EXPECT_TRUE(MakeFitRecord(in).covariance_params.empty());
+}
+
 TEST(FitRecordTest, WideGapsInTheTravelAreRecorded) {
   Observations obs;
   obs.joint_names = {"j1"};
