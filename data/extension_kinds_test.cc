@@ -23,10 +23,8 @@ TEST(ExtensionKinds, AnyFourierCoefficientMakesATransmissionPeriodic) {
 }
 
 TEST(ExtensionKinds, SineSeriesOverTheTravelIsNotPeriodic) {
-  EXPECT_FALSE(IsPeriodicTransmission(Transmission({{"lo", -170},
-                                                    {"hi", 170},
-                                                    {"s1", 0.01},
-                                                    {"s24", 0.02}})));
+  EXPECT_FALSE(IsPeriodicTransmission(
+      Transmission({{"lo", -170}, {"hi", 170}, {"s1", 0.01}, {"s24", 0.02}})));
   EXPECT_FALSE(IsPeriodicTransmission(Transmission({{"lo", 0}, {"hi", 1}})));
   // Outside a1 .. a32 / b1 .. b32: not a Fourier coefficient.
   EXPECT_FALSE(
