@@ -4,3 +4,8 @@
 kincal_test(e2e_track_render_test
   SOURCES ${CMAKE_CURRENT_LIST_DIR}/track_render_test.cc
   DEPS kincal_bundle_synthetic kincal_bundle kincal_vision kincal_synth)
+
+# Refined tag corners keep the tag's size (no inward or outward bias).
+kincal_test(e2e_corner_scale_test
+  SOURCES ${CMAKE_CURRENT_LIST_DIR}/corner_scale_test.cc
+  DEPS kincal_vision kincal_synth)

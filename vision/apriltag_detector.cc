@@ -340,8 +340,10 @@ bool NearOtherTag(const Eigen::Vector2d& a, const Eigen::Vector2d& b,
 
 // Profiles across one side (corner a to b, outward normal n) at sample
 // points along its middle 80 %, each with its pattern; samples near the
-// image border are skipped, and those reaching another tag unless too few
-// would remain.
+// image border are skipped, and unless too few would remain, those reaching
+// another tag and those whose pattern changes within along_px along the
+// side (a data bit's edge, the square's corner: the blur mixes the
+// neighbouring pattern into the line's profile, which the 1-D model lacks).
 struct SideProfiles {
   std::vector<Eigen::Vector2d> base;
   std::vector<EdgeProfile> profiles;
@@ -349,9 +351,21 @@ struct SideProfiles {
   double cell = 0;
 };
 
+// Whether two profiles' patterns agree: the same classes, each break
+// within `tolerance_px`.
+bool SamePattern(const EdgeProfile& a, const EdgeProfile& b,
+                 double tolerance_px) {
+  if (a.classes != b.classes) return false;
+  for (size_t i = 0; i < a.breaks.size(); ++i) {
+    if (std::abs(a.breaks[i] - b.breaks[i]) > tolerance_px) return false;
+  }
+  return true;
+}
+
 SideProfiles ProfilesOfSide(const cv::Mat& gray, const PatternView& view,
                             const Eigen::Vector2d& a, const Eigen::Vector2d& b,
                             const Eigen::Vector2d& n, double cell, double cells,
+                            double along_px,
                             const std::vector<NeighbourTag>& others) {
   SideProfiles out;
   out.cell = cell;
@@ -376,13 +390,26 @@ SideProfiles ProfilesOfSide(const cv::Mat& gray, const PatternView& view,
     }
     // Pattern beyond the window as far as a wide blur reaches into it.
     PatternAlong(view, p, n, -reach - 6.0, reach + 6.0, &prof);
-    near.push_back(NearOtherTag(lo, hi, others, cells));
-    out.near_other_tag += near.back() ? 1 : 0;
+    // The model is the pattern along this one line: where the pattern
+    // changes within the blur's reach along the side (a data bit's edge,
+    // the square's corner), the image mixes the neighbouring pattern in.
+    bool varies = false;
+    EdgeProfile here;
+    PatternAlong(view, p, n, -reach - 1.0, reach + 1.0, &here);
+    for (const double s_px : {-along_px, along_px}) {
+      EdgeProfile beside;
+      PatternAlong(view, p + s_px * dir, n, -reach - 1.0, reach + 1.0, &beside);
+      varies = varies || !SamePattern(here, beside, 0.25 * cell);
+    }
+    near.push_back(NearOtherTag(lo, hi, others, cells) || varies);
+    out.near_other_tag += near.back() && !varies ? 1 : 0;
     out.base.push_back(p);
     out.profiles.push_back(std::move(prof));
   }
-  const int clear = static_cast<int>(out.base.size()) - out.near_other_tag;
-  if (out.near_other_tag > 0 && clear >= std::max(4, samples / 3)) {
+  int left_out = 0;
+  for (const bool b : near) left_out += b ? 1 : 0;
+  const int clear = static_cast<int>(out.base.size()) - left_out;
+  if (left_out > 0 && clear >= std::max(4, samples / 3)) {
     SideProfiles kept = out;
     kept.base.clear();
     kept.profiles.clear();
@@ -444,12 +471,20 @@ bool FitSide(const cv::Mat& gray, const SideProfiles& side,
     const EdgeProfileFit f = FitEdgeProfile(prof, sigma);
     if (!f.ok) continue;
     double shift = f.shift_px;
-    // A sharp side whose neighbouring edges (one cell away) stay out of
-    // the area rule's window even blurred: the rule is exact there.
+    // A sharp side (sigma < 0.8 px, its neighbouring edges one cell away):
+    // the area rule, referenced to the model. The area under a step is the
+    // same under any symmetric blur and under pixel integration, which the
+    // Gaussian model is not for a sharp edge; the tails of the neighbouring
+    // edges (the white border's outer edge, the data bits) that reach the
+    // window are in the model's area as in the image's, so they cancel:
+    //   e = e_model + rule(image) - rule(model)
+    // with rule() the area rule over [e_model - w, e_model + w], each with
+    // its own plateaus read at the window's ends (the image sampled at
+    // 0.25 px: the trapezoid rule is then exact on the bilinear interpolant
+    // of a pixel-integrated step; the model on a 0.02 px grid). The rule
+    // alone read the white plateau darkened by the border's outer edge and
+    // pulled every side inwards: a tag-scale bias.
     if (sigma < 0.8 && w >= 0.8 && 0.55 * side.cell >= 2.5 * sigma) {
-      // A sharp edge: the area rule, its levels the plateaus at the
-      // window's ends (sampled at 0.25 px: the trapezoid rule is then
-      // exact on the bilinear interpolant of a pixel-integrated step).
       EdgeProfile fine;
       for (double o = shift - w - 0.25; o <= shift + w + 0.25; o += 0.25) {
         const Eigen::Vector2d q = side.base[i] + o * n;
@@ -464,7 +499,25 @@ bool FitSide(const cv::Mat& gray, const SideProfiles& side,
       const double inside = 0.5 * (fine.values[0] + fine.values[1]);
       const double outside = 0.5 * (fine.values[m - 1] + fine.values[m - 2]);
       if (std::abs(outside - inside) < 5.0) continue;
-      shift = AreaRuleShift(fine, inside, outside, shift, w);
+      // The model's area on a fine grid (its edge is as sharp as sigma).
+      EdgeProfile model;
+      const int steps = static_cast<int>(std::ceil(2 * w / 0.02));
+      for (int k = 0; k <= steps; ++k) {
+        model.offsets.push_back(shift - w + 2 * w * k / steps);
+      }
+      model.values =
+          EdgeProfileModel(prof, model.offsets, f.shift_px, sigma, f.levels);
+      // The model's plateaus where the image's were read.
+      const std::vector<double> ends =
+          EdgeProfileModel(prof,
+                           {fine.offsets[0], fine.offsets[1],
+                            fine.offsets[m - 2], fine.offsets[m - 1]},
+                           f.shift_px, sigma, f.levels);
+      const double model_inside = 0.5 * (ends[0] + ends[1]);
+      const double model_outside = 0.5 * (ends[2] + ends[3]);
+      if (std::abs(model_outside - model_inside) < 5.0) continue;
+      shift = f.shift_px + AreaRuleShift(fine, inside, outside, shift, w) -
+              AreaRuleShift(model, model_inside, model_outside, shift, w);
       if (std::abs(shift - f.shift_px) > 0.5) continue;
     }
     pts.push_back(side.base[i] + shift * n);
@@ -533,8 +586,9 @@ bool RefineCornersByEdges(const cv::Mat& gray, const cv::Mat& tag_image,
       const Eigen::Vector2d dir = (b - a).normalized();
       Eigen::Vector2d n(-dir.y(), dir.x());
       if (n.dot((a + b) / 2 - centroid) < 0) n = -n;
-      const SideProfiles side =
-          ProfilesOfSide(gray, view, a, b, n, cell, cells, others);
+      const SideProfiles side = ProfilesOfSide(
+          gray, view, a, b, n, cell, cells,
+          pass == 0 ? 1.0 : std::max(1.0, 2.0 * sigma[k]), others);
       if (pass == 0) sigma[k] = SideBlur(side.profiles);
       if (!FitSide(gray, side, n, sigma[k], &lines[k], &quality[k])) {
         return false;

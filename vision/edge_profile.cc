@@ -117,6 +117,21 @@ double AreaRuleShift(const EdgeProfile& p, double inside, double outside,
   return b - normalised;
 }
 
+std::vector<double> EdgeProfileModel(const EdgeProfile& profile,
+                                     const std::vector<double>& offsets,
+                                     double shift_px, double sigma_px,
+                                     const std::array<double, 3>& levels) {
+  const Eigen::Vector3d l(levels[0], levels[1], levels[2]);
+  std::vector<double> values;
+  values.reserve(offsets.size());
+  Eigen::Vector3d b, db;
+  for (const double o : offsets) {
+    Basis(profile, o, shift_px, sigma_px, &b, &db);
+    values.push_back(b.dot(l));
+  }
+  return values;
+}
+
 double FastPhi(double x) {
   static const PhiTable table;
   if (x <= -kPhiRange) return 0.0;

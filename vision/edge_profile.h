@@ -59,6 +59,13 @@ EdgeProfileFit FitEdgeProfile(const EdgeProfile& profile, double sigma_px,
 double AreaRuleShift(const EdgeProfile& profile, double inside, double outside,
                      double centre, double w);
 
+// The model's gray levels at `offsets` for the pattern of `profile`, shift
+// e, blur sigma and the levels (black, white, outside) of a fit.
+std::vector<double> EdgeProfileModel(const EdgeProfile& profile,
+                                     const std::vector<double>& offsets,
+                                     double shift_px, double sigma_px,
+                                     const std::array<double, 3>& levels);
+
 // Standard normal CDF from a table (|error| < 2e-5), for the model's speed.
 double FastPhi(double x);
 

@@ -57,6 +57,26 @@ TEST(EdgeProfile, RecoversTheShiftUnderWideBlurWithNeighbours) {
   }
 }
 
+TEST(EdgeProfile, ModelReproducesTheProfileItWasFittedTo) {
+  std::mt19937_64 rng(5);
+  const EdgeProfile p = Synthetic(0.3, 3.0, 0.9, 30, 220, 60, 0, &rng);
+  const EdgeProfileFit f = FitEdgeProfile(p, 0.9);
+  ASSERT_TRUE(f.ok);
+  const std::vector<double> m =
+      EdgeProfileModel(p, p.offsets, f.shift_px, 0.9, f.levels);
+  ASSERT_EQ(m.size(), p.values.size());
+  for (size_t i = 0; i < m.size(); ++i) {
+    EXPECT_NEAR(m[i], p.values[i], 0.01) << p.offsets[i];
+  }
+  // A different shift moves the model's edge: the value at the edge
+  // changes by about the slope times the shift.
+  const std::vector<double> moved =
+      EdgeProfileModel(p, {0.3}, f.shift_px + 0.1, 0.9, f.levels);
+  EXPECT_GT(std::abs(moved[0] -
+                     EdgeProfileModel(p, {0.3}, f.shift_px, 0.9, f.levels)[0]),
+            5.0);
+}
+
 TEST(EdgeProfile, LevelsDoNotMoveTheEdge) {
   std::mt19937_64 rng(4);
   // A dim, low-contrast tag (paper at 60, black at 20) in a bright
