@@ -231,4 +231,26 @@ void WarnPoseCoverage(const Robot& nominal, const Observations& obs,
   }
 }
 
+void RefuseBlindCameras(const std::vector<int>& tag_counts,
+                        const std::vector<std::string>& cameras,
+                        const std::vector<std::string>& images,
+                        const std::string& rig_file,
+                        const std::string& frames) {
+  KINCAL_CHECK(
+      cameras.size() == tag_counts.size() && images.size() == tag_counts.size(),
+      "one name and one image source per camera");
+  if (std::count(tag_counts.begin(), tag_counts.end(), 0) ==
+      static_cast<long>(tag_counts.size())) {
+    return;
+  }
+  for (size_t c = 0; c < tag_counts.size(); ++c) {
+    if (tag_counts[c] > 0) continue;
+    throw InputError("camera '" + cameras[c] + "' of " + rig_file + " (" +
+                     images[c] + ") never shows a tag of the target in " +
+                     frames +
+                     ": check that these are its images and that it looks "
+                     "at the target, or leave the camera out of the rig");
+  }
+}
+
 }  // namespace kincal::app

@@ -101,6 +101,20 @@ inline void AddWarnings(const Warnings& warnings, nlohmann::json* j) {
 void WarnPoseCoverage(const Robot& nominal, const Observations& obs,
                       Warnings* warnings);
 
+// Refuses (InputError) a camera whose images never show a tag of the target
+// while another camera's do (spec v3): wrong folder, wrong camera, or a
+// camera looking elsewhere. Per camera c (rig order): `tag_counts[c]`, its
+// frames (or corners) with a target tag; `cameras[c]`, its name; `images[c]`,
+// where its images are (folder or option). `rig_file` and `frames` (the
+// frames looked through, e.g. "the 12 frames with joint readings of S") are
+// for the message, which names the camera, its images and the fix. Nothing
+// when no camera shows a tag: the tool was not there, or the caller's own
+// check says more.
+void RefuseBlindCameras(const std::vector<int>& tag_counts,
+                        const std::vector<std::string>& cameras,
+                        const std::vector<std::string>& images,
+                        const std::string& rig_file, const std::string& frames);
+
 // A command's warnings list: each warning goes to stderr as it is found (in
 // JSON mode too, so that a later refusal still shows it) and into the JSON
 // result through AddWarnings.

@@ -378,10 +378,9 @@ void PrintSummary(const BundleArgs& args, const BundleRun& run) {
               args.out.c_str(), run.seconds, run.obs.seconds, r.seconds);
 }
 
-// A camera whose images never show a tag of the target while another
-// camera's do (spec v3): bad input naming the camera, before any solve.
-void RefuseBlindCameras(const BundleArgs& args, const Rig& rig,
-                        const SessionObservations& obs) {
+// Per camera of the rig, the target corners it sees in `obs`.
+std::vector<int> CornersPerCamera(const Rig& rig,
+                                  const SessionObservations& obs) {
   std::vector<int> corners(rig.cameras.size(), 0);
   for (const BundleFrame& f : obs.frames) {
     for (const auto& c : f.corners) {
@@ -390,21 +389,7 @@ void RefuseBlindCameras(const BundleArgs& args, const Rig& rig,
       }
     }
   }
-  // No camera with a tag at all: the start's own message (too few tracked
-  // frames) says more than naming a camera.
-  if (std::count(corners.begin(), corners.end(), 0) ==
-      static_cast<long>(corners.size())) {
-    return;
-  }
-  for (size_t c = 0; c < corners.size(); ++c) {
-    if (corners[c] > 0) continue;
-    throw InputError("camera '" + rig.cameras[c].intrinsics.name + "' of " +
-                     args.rig + " never shows a tag of the target in the " +
-                     std::to_string(obs.frames.size()) +
-                     " frames with joint readings of " + args.session +
-                     ": check its image folder and that it looks at the "
-                     "target, or leave the camera out of the rig");
-  }
+  return corners;
 }
 
 int RunBundleCommand(BundleArgs args) {
@@ -438,7 +423,16 @@ int RunBundleCommand(BundleArgs args) {
     progress.Update(done, total, "frames (detecting tags)");
   };
   run.obs = ObserveSession(session, rig, target, oo);
-  RefuseBlindCameras(args, rig, run.obs);
+  // No camera with a tag at all: the start's own message (too few tracked
+  // frames) says more than naming a camera.
+  std::vector<std::string> folders;
+  for (const std::string& f : session.folders) {
+    folders.push_back(args.session + "/" + f);
+  }
+  RefuseBlindCameras(CornersPerCamera(rig, run.obs), rig.CameraNames(), folders,
+                     args.rig,
+                     "the " + std::to_string(run.obs.frames.size()) +
+                         " frames with joint readings of " + args.session);
   progress.Stage("solving the bundle (" +
                  std::to_string(run.obs.frames.size()) + " frames)");
   run.result = RunBundle(robot, rig, target, run.obs.frames, args.options);

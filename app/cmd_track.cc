@@ -530,26 +530,6 @@ void RefuseImpossibleDepth(const TrackArgs& args, const Rig& rig,
                    " frames), closer than any lens focuses: " + pair + units);
 }
 
-// A camera whose images never show a tag of the target while another
-// camera's do is bad input (spec v3): wrong folder, wrong camera, or a
-// camera looking elsewhere. Images without any tag in every camera are
-// read as they are (the tool was not there: found = 0).
-void RefuseBlindCameras(const Rig& rig, const FrameSets& sets,
-                        const Tracked& tracked) {
-  if (std::count(tracked.tag_frames.begin(), tracked.tag_frames.end(), 0) ==
-      static_cast<long>(tracked.tag_frames.size())) {
-    return;
-  }
-  for (size_t c = 0; c < tracked.tag_frames.size(); ++c) {
-    if (tracked.tag_frames[c] > 0) continue;
-    throw InputError(
-        "camera '" + rig.cameras[c].intrinsics.name + "' (" + sets.option[c] +
-        ") never shows a tag of the target in " + std::to_string(sets.size()) +
-        " frames: check that these are its images and that it looks at the "
-        "target, or leave the camera out of the rig");
-  }
-}
-
 int RunTrack(const TrackArgs& args) {
   const auto start = std::chrono::steady_clock::now();
   const Rig rig = ReadRigYaml(args.rig);
@@ -557,7 +537,11 @@ int RunTrack(const TrackArgs& args) {
   const FrameSets pairs = ListFrameSets(args, rig);
   Merge merge = PrepareMerge(args, pairs);
   const Tracked tracked = TrackFrames(args, rig, target, pairs, &merge);
-  RefuseBlindCameras(rig, pairs, tracked);
+  // Images without any tag in every camera are read as they are (the tool
+  // was not there: found = 0).
+  RefuseBlindCameras(tracked.tag_frames, rig.CameraNames(), pairs.option,
+                     args.rig,
+                     "the " + std::to_string(pairs.size()) + " frames");
   RefuseSwappedCameras(args, rig, target, pairs, tracked);
   RefuseImpossibleDepth(args, rig, tracked);
   WriteFileAtomic(args.out, tracked.points);

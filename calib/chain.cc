@@ -5,6 +5,7 @@
 #include <limits>
 
 #include "data/error.h"
+#include "data/extension_kinds.h"
 
 namespace kincal {
 namespace {
@@ -113,16 +114,14 @@ Chain Chain::FromRobot(const Robot& robot) {
         const auto it = e.values.find("s" + std::to_string(k + 1));
         if (it != e.values.end()) err[kTransmission0 + k] = it->second * unit;
       }
-      std::vector<double> fourier(kPeriodicTerms, 0.0);
-      bool periodic = false;
-      for (int h = 1; h <= kPeriodicHarmonics; ++h) {
-        const auto a = e.values.find("a" + std::to_string(h));
-        const auto b = e.values.find("b" + std::to_string(h));
-        if (a != e.values.end()) fourier[2 * h - 2] = a->second * unit;
-        if (b != e.values.end()) fourier[2 * h - 1] = b->second * unit;
-        periodic = periodic || a != e.values.end() || b != e.values.end();
-      }
-      if (periodic) {
+      if (IsPeriodicTransmission(e)) {
+        std::vector<double> fourier(kPeriodicTerms, 0.0);
+        for (int h = 1; h <= kPeriodicHarmonics; ++h) {
+          const auto a = e.values.find("a" + std::to_string(h));
+          const auto b = e.values.find("b" + std::to_string(h));
+          if (a != e.values.end()) fourier[2 * h - 2] = a->second * unit;
+          if (b != e.values.end()) fourier[2 * h - 1] = b->second * unit;
+        }
         c.rows[j].periodic_basis = FourierBasis(fourier);
         std::fill(err.begin() + kTransmission0, err.end(), 0.0);
         err[kTransmission0] = 1.0;

@@ -212,8 +212,6 @@ void WarnAboutTheModel(const Robot& robot, const Chain& chain,
   }
 }
 
-// The recorded measuring frame (fitted_on.frame: rotation vector deg, mm)
-// as a pose block (rad, mm).
 // The recorded measuring frames as a state's frame blocks (rad, mm): one, or
 // one per series with their labels so the covariance's frame.<series>.*
 // resolve.
@@ -397,9 +395,6 @@ CompensateResult Compensate(const Robot& robot,
         "(fitted_on.frame); calibrate or diagnose it with a current kincal, "
         "or give the targets in the base frame");
   }
-  ModelState frames;
-  SetRecordedFrames(robot.fitted_on, &frames);
-  const int frame = SeriesFrameIndex(robot.fitted_on, options.series);
   CompensateResult result;
   WarnAboutTheFrame(robot.fitted_on, options, &result.warnings);
   WarnAboutTheModel(robot, chain, &result.warnings);
@@ -415,7 +410,8 @@ CompensateResult Compensate(const Robot& robot,
     CompensateTarget target = t;
     IkResult controller;
     if (options.targets_in_measuring_frame && !t.from_joints) {
-      target.target = FromMeasuringFrame(frames, frame, t.target);
+      target.target = FromMeasuringFrame(uncertainty.recorded_frames(),
+                                         uncertainty.frame_index(), t.target);
     }
     if (t.from_joints) {
       target.target = ProgramTarget(nominal, t.seed);

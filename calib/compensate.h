@@ -116,6 +116,11 @@ class TipUncertainty {
                  const std::string& series = "");
   // mm, 3D; NaN when the robot carries no covariance.
   double SigmaMm(const std::vector<double>& q, const IkContext& context) const;
+  // The recorded measuring frames (fitted_on.frame or series_frames, as the
+  // state's frame blocks: rad, mm) and the index of the one targets are
+  // located through.
+  const ModelState& recorded_frames() const { return state_; }
+  int frame_index() const { return frame_; }
 
  private:
   const Eigen::MatrixXd* covariance_;

@@ -7,6 +7,7 @@
 #include "calib/identifiability.h"
 #include "calib/paper_method.h"
 #include "data/error.h"
+#include "data/minimize.h"
 
 namespace kincal {
 
@@ -110,8 +111,8 @@ SensitivityCurve TraceCurve(const std::vector<Measurement>& ms,
   const auto [lo, hi] = std::minmax_element(c.eps_mm.begin(), c.eps_mm.end());
   c.flat = *hi - *lo < options.flat_tolerance_mm;
   int best = static_cast<int>(lo - c.eps_mm.begin());
-  double a = c.offsets[std::max(best - 1, 0)];
-  double b = c.offsets[std::min(best + 1, options.steps - 1)];
+  const double a = c.offsets[std::max(best - 1, 0)];
+  const double b = c.offsets[std::min(best + 1, options.steps - 1)];
   c.valley_mm = *lo;
   c.valley_offset = c.offsets[best];
   if (c.flat) {
@@ -119,25 +120,11 @@ SensitivityCurve TraceCurve(const std::vector<Measurement>& ms,
     c.valley_mm = c.eps_mm[half];
     return c;
   }
-  const double g = (std::sqrt(5.0) - 1) / 2;
-  double x1 = b - g * (b - a), x2 = a + g * (b - a);
-  double f1 = EpsAt(state, ms, p, x0 + x1 * unit);
-  double f2 = EpsAt(state, ms, p, x0 + x2 * unit);
-  for (int it = 0; it < 40; ++it) {
-    if (f1 < f2) {
-      b = x2, x2 = x1, f2 = f1;
-      x1 = b - g * (b - a);
-      f1 = EpsAt(state, ms, p, x0 + x1 * unit);
-    } else {
-      a = x1, x1 = x2, f1 = f2;
-      x2 = a + g * (b - a);
-      f2 = EpsAt(state, ms, p, x0 + x2 * unit);
-    }
-  }
-  const double xm = f1 < f2 ? x1 : x2, fm = std::min(f1, f2);
-  if (fm < c.valley_mm) {
-    c.valley_mm = fm;
-    c.valley_offset = xm;
+  const GoldenSectionResult m = GoldenSectionMinimize(
+      [&](double x) { return EpsAt(state, ms, p, x0 + x * unit); }, a, b, 40);
+  if (m.f < c.valley_mm) {
+    c.valley_mm = m.f;
+    c.valley_offset = m.x;
   }
   return c;
 }

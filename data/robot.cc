@@ -8,6 +8,7 @@
 
 #include "data/atomic_file.h"
 #include "data/error.h"
+#include "data/extension_kinds.h"
 #include "data/provenance.h"
 #include "data/yaml_util.h"
 
@@ -470,17 +471,11 @@ void ReadPeriodicBases(const YamlReader& r, const YAML::Node& node,
   for (const auto& entry : node) {
     const std::string joint = r.String(entry.first, "periodic_basis key");
     const std::string what = "covariance.periodic_basis." + joint;
-    const bool periodic = std::any_of(
-        robot->extensions.begin(), robot->extensions.end(),
-        [&](const Extension& e) {
-          if (e.joint != joint || e.cause != "transmission") return false;
-          for (const auto& [key, value] : e.values) {
-            if ((key[0] == 'a' || key[0] == 'b') && key.size() > 1) {
-              return true;
-            }
-          }
-          return false;
-        });
+    const bool periodic =
+        std::any_of(robot->extensions.begin(), robot->extensions.end(),
+                    [&](const Extension& e) {
+                      return e.joint == joint && IsPeriodicTransmission(e);
+                    });
     if (!periodic) {
       r.Fail(entry.first, what +
                               ": no periodic transmission (a1.., b1..) of "

@@ -6,6 +6,8 @@
 #include <random>
 #include <utility>
 
+#include "data/minimize.h"
+
 namespace kincal {
 namespace {
 
@@ -32,26 +34,9 @@ double SegmentBoxDistance(const Segment& s, const ObstacleBox& box) {
   const Eigen::Vector3d b = box_from_base * (s.b - box.center);
   const Eigen::Vector3d h = 0.5 * box.size;
   auto f = [&](double t) { return PointBoxDistance(a + t * (b - a), h); };
-  const double g = 0.5 * (std::sqrt(5.0) - 1);
-  double lo = 0, hi = 1;
-  double x1 = hi - g * (hi - lo), x2 = lo + g * (hi - lo);
-  double f1 = f(x1), f2 = f(x2);
-  for (int it = 0; it < 80 && hi - lo > 1e-12; ++it) {
-    if (f1 <= f2) {
-      hi = x2;
-      x2 = x1;
-      f2 = f1;
-      x1 = hi - g * (hi - lo);
-      f1 = f(x1);
-    } else {
-      lo = x1;
-      x1 = x2;
-      f1 = f2;
-      x2 = lo + g * (hi - lo);
-      f2 = f(x2);
-    }
-  }
-  return std::min({f(0.0), f(1.0), f1, f2});
+  // 58 iterations: the bracket to 1e-12 of the segment.
+  const GoldenSectionResult m = GoldenSectionMinimize(f, 0.0, 1.0, 58);
+  return std::min({f(0.0), f(1.0), m.f});
 }
 
 // Closest points of two segments (Ericson, Real-Time Collision Detection,

@@ -2,8 +2,9 @@
 // with one folder per camera of a three-camera and a one-camera rig, run
 // through build/bin/kincal track with --session and --camera NAME=GLOB, the
 // tips compared with the rendered truth; a camera that never sees the
-// target, and camcal's cameras that share no board view, are refused
-// naming the camera (exit 2, nothing written).
+// target (track, and bundle on a rendered robot session), and camcal's
+// cameras that share no board view, are refused naming the camera (exit 2,
+// nothing written).
 
 #include <gtest/gtest.h>
 
@@ -186,7 +187,46 @@ TEST_F(CamerasCli, CameraThatNeverSeesTheTargetIsNamed) {
   EXPECT_EQ(r.exit_code, 2) << r.out;
   EXPECT_NE(r.err.find("camera 'top'"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("never shows a tag"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("(" + s + "/top)"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("leave the camera out of the rig"), std::string::npos)
+      << r.err;
   EXPECT_FALSE(testing::Exists(dir_ + "/blind.csv"));
+}
+
+// bundle refuses the same way before any solve: a session whose right
+// camera's images show no tag (overwritten with grey of the same size).
+TEST_F(CamerasCli, BundleNamesACameraThatNeverSeesTheTarget) {
+  const std::string s = dir_ + "/sim";
+  RunResult r = RunKincal("simulate --robot " + testing::SourceDir() +
+                          "/data/robots/bh7.yaml --out " + s +
+                          " --poses 12 --noise 0 --seed 3 --render "
+                          "--render-width 640 --render-height 512");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  int blanked = 0;
+  for (const auto& e :
+       std::filesystem::directory_iterator(s + "/session/right")) {
+    const cv::Mat image = cv::imread(e.path().string(), cv::IMREAD_UNCHANGED);
+    ASSERT_FALSE(image.empty()) << e.path();
+    cv::imwrite(e.path().string(),
+                cv::Mat(image.size(), image.type(), cv::Scalar::all(128)));
+    ++blanked;
+  }
+  ASSERT_EQ(blanked, 12);
+  const std::string out = dir_ + "/sim_cal.yaml";
+  r = RunKincal("bundle --robot " + s + "/robot.yaml --rig " + s +
+                "/rig.yaml --target " + s + "/target.yaml --session " + s +
+                "/session --out " + out + " --quiet");
+  EXPECT_EQ(r.exit_code, 2) << r.out << r.err;
+  EXPECT_NE(r.err.find("camera 'right'"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("never shows a tag"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("(" + s + "/session/right)"), std::string::npos)
+      << r.err;
+  EXPECT_NE(r.err.find("joint readings of " + s + "/session"),
+            std::string::npos)
+      << r.err;
+  EXPECT_NE(r.err.find("leave the camera out of the rig"), std::string::npos)
+      << r.err;
+  EXPECT_FALSE(testing::Exists(out));
 }
 
 TEST_F(CamerasCli, CameraOptionsNameTheProblem) {
