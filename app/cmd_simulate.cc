@@ -1,8 +1,10 @@
 // kincal simulate: a seeded synthetic session for any robot file.
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <iostream>
+#include <limits>
 #include <memory>
 #include <random>
 
@@ -40,6 +42,9 @@ struct SimulateArgs {
   // rig on the flange, a fixed board in the world (FlangeScene).
   std::string render_mount = "world";
   RenderOptions render_options;
+  // --render-light: a distant light at this angle from the reference
+  // camera's axis (turned about its y axis); NaN = even light.
+  double render_light_deg = std::numeric_limits<double>::quiet_NaN();
 };
 
 // Cameras on the flange: where the rig sits on the tool and the board in
@@ -347,6 +352,15 @@ int RunSimulate(SimulateArgs args) {
   Rig rendered_rig = rig;
   if (args.render) {
     args.render_options.motion_angle_deg = 30.0;
+    if (std::isfinite(args.render_light_deg)) {
+      const double a = args.render_light_deg * M_PI / 180.0;
+      args.render_options.light_in_rig =
+          Eigen::Vector3d(std::sin(a), 0.0, std::cos(a));
+    }
+    if (args.render_options.shadow_tag >= 0) {
+      args.render_options.shadow_angle_deg = 30.0;
+      args.render_options.shadow_offset = 0.1;
+    }
 #ifndef KINCAL_FRONT_END
     args.render_options.Check();
 #endif
@@ -362,6 +376,16 @@ int RunSimulate(SimulateArgs args) {
       rig_distance = PlaceRigAndScaleTool(nominal, rig, &opt, &target);
       rendered_rig = RigWithCameras(rig, args.render_cameras, rig_distance);
     }
+#ifndef KINCAL_FRONT_END
+    if (args.render_options.shadow_tag >=
+        static_cast<int>(target.tags.size())) {
+      throw InputError(
+          "--render-shadow " + std::to_string(args.render_options.shadow_tag) +
+          ": the rendered target has " + std::to_string(target.tags.size()) +
+          " tags; give an index 0.." + std::to_string(target.tags.size() - 1) +
+          " (or -1 for no shadow)");
+    }
+#endif
   }
   const SimulatedSession s = Simulate(nominal, opt);
   const nlohmann::json truth = TruthJson(s, opt, args.mode, scene);
@@ -480,6 +504,24 @@ void AddSimulateCommand(CLI::App& app, Runner* run) {
                   "JPEG-compress the images at this quality (1..100; 0 = "
                   "lossless)")
       ->capture_default_str();
+  sub->add_option("--render-light", args->render_light_deg,
+                  "light the tags by a distant light travelling at this "
+                  "angle (deg) from the reference camera's axis, turned "
+                  "about its y axis: each tag's paper gets ambient + (1 - "
+                  "ambient) cos (Lambert), so tags turned away are dim "
+                  "(default: even light)")
+      ->check(CLI::Range(-89.0, 89.0));
+  sub->add_option("--render-ambient", args->render_options.ambient,
+                  "with --render-light: the share of the light every tag "
+                  "gets whatever its angle")
+      ->capture_default_str();
+  sub->add_option("--render-shadow", args->render_options.shadow_tag,
+                  "a shadow edge (gain 0.35, at 30 deg) across this tag of "
+                  "the target (index in target.yaml; -1 = none)")
+      ->capture_default_str();
+  sub->add_flag("--render-bayer", args->render_options.bayer,
+                "a colour sensor: RGGB photosites with their own gains and "
+                "noise, demosaiced to gray by OpenCV");
   sub->add_flag("--json", args->json, "print a JSON summary");
   sub->footer(HelpFooter(
       "Example: a BH-7 session with a hidden 0.15 deg backlash in j3, 240 "

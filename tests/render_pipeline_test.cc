@@ -170,4 +170,35 @@ TEST(RenderPipelineTest,
   EXPECT_NE(r.err.find("poses_leave_robot_undetermined"), std::string::npos);
 }
 
+// The light-aware renders from the command line: a side light, a shadow
+// edge across one tag and a Bayer sensor change the images (the same poses
+// and seed), and a shadow on a tag the target does not have is refused.
+TEST(RenderPipelineTest, LightShadowAndBayerOptions) {
+  const std::string dir = MakeTempDir("render_light");
+  const std::string common = "simulate --robot " + SourceDir() +
+                             "/data/robots/bh7.yaml --poses 3 --noise 0 "
+                             "--seed 21 --render --render-width 640 "
+                             "--render-height 512 --render-noise 1.5 --out ";
+  RunResult r = RunKincal(common + dir + "/even");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  int k = 0;
+  for (const std::string extra :
+       {"--render-light 60", "--render-shadow 1", "--render-bayer"}) {
+    const std::string out = dir + "/lit" + std::to_string(k++);
+    r = RunKincal(common + out + " " + extra);
+    ASSERT_EQ(r.exit_code, 0) << extra << ": " << r.err;
+    int differ = 0;
+    for (int f = 0; f < 3; ++f) {
+      const std::string name =
+          "/session/left/00000" + std::to_string(f) + ".png";
+      differ += ReadFile(dir + "/even" + name) != ReadFile(out + name) ? 1 : 0;
+    }
+    EXPECT_GT(differ, 0) << extra << " left every image as it was";
+  }
+  r = RunKincal(common + dir + "/bad --render-shadow 9");
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_NE(r.err.find("--render-shadow 9"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("4 tags"), std::string::npos) << r.err;
+}
+
 }  // namespace kincal::testing

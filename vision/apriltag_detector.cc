@@ -11,6 +11,7 @@ extern "C" {
 #include <sstream>
 
 #include "data/error.h"
+#include "data/minimize.h"
 #include "vision/edge_profile.h"
 #include "vision/image_lines.h"
 #include "vision/tag_family.h"
@@ -437,26 +438,9 @@ double SideBlur(const std::vector<EdgeProfile>& profiles) {
     }
     return sum;
   };
-  double a = std::log(0.3), b = std::log(3.0);
-  const double g = 0.5 * (std::sqrt(5.0) - 1);
-  double x1 = b - g * (b - a), x2 = a + g * (b - a);
-  double f1 = cost(x1), f2 = cost(x2);
-  for (int it = 0; it < 8; ++it) {
-    if (f1 < f2) {
-      b = x2;
-      x2 = x1;
-      f2 = f1;
-      x1 = b - g * (b - a);
-      f1 = cost(x1);
-    } else {
-      a = x1;
-      x1 = x2;
-      f1 = f2;
-      x2 = a + g * (b - a);
-      f2 = cost(x2);
-    }
-  }
-  return std::exp(0.5 * (a + b));
+  const GoldenSectionResult r =
+      GoldenSectionMinimize(cost, std::log(0.3), std::log(3.0), 8);
+  return std::exp(0.5 * (r.lo + r.hi));
 }
 
 // Edge points of one side: the profiles' shifts along the normal.
