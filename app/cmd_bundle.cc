@@ -314,6 +314,7 @@ nlohmann::json SummaryJson(const BundleArgs& args, const Target& target,
   j["heldout_tip_rms_mm"] = r.heldout_tip_rms_mm;
   j["heldout_tips"] = r.heldout_tips;
   j["sigma0_px"] = r.sigma0_px;
+  j["huber_px"] = r.huber_px;
   j["worst_frames"] = WorstFramesJson(r, target, run.obs.frames);
   j["identifiable"] = r.identifiable;
   j["unidentifiable"] = r.unidentifiable;
@@ -503,9 +504,11 @@ void AddBundleCommand(CLI::App& app, Runner* run) {
                   "held out once; JSON kfold (pooled held-out RMS)")
       ->check(CLI::Range(2, 20));
   sub->add_option("--huber", args->options.huber_px,
-                  "per-corner Huber scale, px")
+                  "per-corner Huber scale, px; 0 = automatic (3 sigma of "
+                  "the corners after a first fit, at least 0.05 px; JSON "
+                  "huber_px)")
       ->capture_default_str()
-      ->check(CLI::PositiveNumber);
+      ->check(CLI::NonNegativeNumber);
   sub->add_flag("--refine-cameras", args->options.refine_cameras,
                 "also refine intrinsics and the right camera's pose, with "
                 "priors at rig.yaml (see --prior-*)");

@@ -341,6 +341,18 @@ std::vector<double> CornerErrors(State* st, const std::vector<Obs>& obs,
   return out;
 }
 
+// The automatic Huber scale (BundleOptions::huber_px = 0) from the corner
+// errors of a first fit.
+constexpr double kAutoHuberSigmas = 3.0;
+constexpr double kMinAutoHuberPx = 0.05;
+double AutoHuberPx(std::vector<double> errors) {
+  if (errors.empty()) return 1.0;
+  std::nth_element(errors.begin(), errors.begin() + errors.size() / 2,
+                   errors.end());
+  const double sigma = errors[errors.size() / 2] / 1.1774;
+  return std::max(kMinAutoHuberPx, kAutoHuberSigmas * sigma);
+}
+
 double Rms(const std::vector<double>& v) {
   if (v.empty()) return 0.0;
   double s = 0;
@@ -1016,8 +1028,11 @@ void NameIdentifiable(const Chain& chain,
 BundleResult RunBundle(const Robot& nominal, const Rig& rig,
                        const Target& target,
                        const std::vector<BundleFrame>& frames,
-                       const BundleOptions& opt) {
+                       const BundleOptions& options) {
   const auto start = std::chrono::steady_clock::now();
+  BundleOptions opt = options;  // the automatic Huber scale is set below
+  const bool auto_huber = !(opt.huber_px > 0);
+  if (auto_huber) opt.huber_px = 1.0;  // for the fits before the first estimate
   BundleResult res;
   res.frames = static_cast<int>(frames.size());
   res.rig = rig;
@@ -1076,17 +1091,23 @@ BundleResult RunBundle(const Robot& nominal, const Rig& rig,
   Freedom& fit = scan.fit;
   fit.cameras = opt.refine_cameras;
 
-  // The joint fit; then drop outlier tags and refit.
+  // The joint fit; then drop outlier tags, set the automatic Huber scale
+  // from the remaining corners, and refit.
   ceres::Solver::Summary summary;
   for (int round = 0; round < 2; ++round) {
     Built b = Build(&st, train, res.inputs, fit, opt, rig);
     summary = Solve(b.problem.get(), opt);
     if (round == 1) break;
     DropOutlierTags(&st, train, res.inputs, with_errors, opt, rig, &dropped);
-    if (dropped.empty()) break;
+    if (dropped.empty() && !auto_huber) break;
     res.dropped_tags = static_cast<int>(dropped.size());
     train = MakeObs(frames, target, res.train, dropped);
+    if (auto_huber) {
+      opt.huber_px =
+          AutoHuberPx(CornerErrors(&st, train, res.inputs, with_errors, rig));
+    }
   }
+  res.huber_px = opt.huber_px;
   res.termination = summary.message;
   res.iterations = static_cast<int>(summary.iterations.size());
   EstimateCovariance(&st, train, res.inputs, fit, opt, rig, candidates,

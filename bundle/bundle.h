@@ -80,7 +80,12 @@ struct BundleOptions {
   // of a seeded partition into `folds` parts (holdout_fraction is ignored).
   int folds = 0;
   int fold = 0;
-  double huber_px = 1.0;  // per-corner Huber scale
+  // Per-corner Huber scale, px; 0 = automatic: after the first joint fit,
+  // kAutoHuberSigmas times the corners' noise (their median error / 1.1774,
+  // the median of a 2-D Gaussian error's norm being 1.1774 sigma), at least
+  // kMinAutoHuberPx, and the fit redone. A fixed scale of 1 px let
+  // corners 40 sigma off pull the robot on renders with 0.03 px corners.
+  double huber_px = 0.0;
   // Tag observations whose RMS after the first fit exceeds
   // max(outlier_px, outlier_ratio * median) are dropped, then the fit redone.
   double outlier_px = 1.0;
@@ -158,6 +163,7 @@ struct BundleResult {
   // |model tip - tracked tip|, mm.
   std::vector<double> heldout_corner_px, heldout_tip_mm;
   double sigma0_px = 0.0;           // noise estimate per pixel coordinate
+  double huber_px = 0.0;            // the Huber scale of the final fit
   std::vector<int> train, heldout;  // indices into the frames given
   std::vector<PoseInput> inputs;    // per frame given (s, tau for errors)
   std::string termination;
