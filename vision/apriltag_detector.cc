@@ -296,13 +296,13 @@ struct PatternView {
 };
 
 // The pattern along q(o) = p + o n for o in [lo, hi]: breaks found on a
-// 0.1 px scan, each refined by bisection to 1e-3 px.
+// `step` px scan (shorter than any cell: the refinement needs cells of 1.5
+// px), each refined by bisection to 1e-3 px.
 void PatternAlong(const PatternView& view, const Eigen::Vector2d& p,
                   const Eigen::Vector2d& n, double lo, double hi,
-                  EdgeProfile* profile) {
+                  EdgeProfile* profile, double step = 0.1) {
   profile->breaks.clear();
   profile->classes.clear();
-  const double step = 0.1;
   int prev = view.ClassAt(p + lo * n);
   profile->classes.push_back(prev);
   for (double o = lo + step; o <= hi; o += step) {
@@ -396,10 +396,11 @@ SideProfiles ProfilesOfSide(const cv::Mat& gray, const PatternView& view,
     // the square's corner), the image mixes the neighbouring pattern in.
     bool varies = false;
     EdgeProfile here;
-    PatternAlong(view, p, n, -reach - 1.0, reach + 1.0, &here);
+    PatternAlong(view, p, n, -reach - 1.0, reach + 1.0, &here, 0.5);
     for (const double s_px : {-along_px, along_px}) {
       EdgeProfile beside;
-      PatternAlong(view, p + s_px * dir, n, -reach - 1.0, reach + 1.0, &beside);
+      PatternAlong(view, p + s_px * dir, n, -reach - 1.0, reach + 1.0, &beside,
+                   0.5);
       varies = varies || !SamePattern(here, beside, 0.25 * cell);
     }
     near.push_back(NearOtherTag(lo, hi, others, cells) || varies);
@@ -465,7 +466,7 @@ bool FitSide(const cv::Mat& gray, const SideProfiles& side,
     // with rule() the area rule over [e_model - w, e_model + w], each with
     // its own plateaus read at the window's ends (the image sampled at
     // 0.25 px: the trapezoid rule is then exact on the bilinear interpolant
-    // of a pixel-integrated step; the model on a 0.02 px grid). The rule
+    // of a pixel-integrated step; the model's area in closed form). The rule
     // alone read the white plateau darkened by the border's outer edge and
     // pulled every side inwards: a tag-scale bias.
     if (sigma < 0.8 && w >= 0.8 && 0.55 * side.cell >= 2.5 * sigma) {
@@ -483,15 +484,7 @@ bool FitSide(const cv::Mat& gray, const SideProfiles& side,
       const double inside = 0.5 * (fine.values[0] + fine.values[1]);
       const double outside = 0.5 * (fine.values[m - 1] + fine.values[m - 2]);
       if (std::abs(outside - inside) < 5.0) continue;
-      // The model's area on a fine grid (its edge is as sharp as sigma).
-      EdgeProfile model;
-      const int steps = static_cast<int>(std::ceil(2 * w / 0.02));
-      for (int k = 0; k <= steps; ++k) {
-        model.offsets.push_back(shift - w + 2 * w * k / steps);
-      }
-      model.values =
-          EdgeProfileModel(prof, model.offsets, f.shift_px, sigma, f.levels);
-      // The model's plateaus where the image's were read.
+      // The model's plateaus where the image's were read, and its area.
       const std::vector<double> ends =
           EdgeProfileModel(prof,
                            {fine.offsets[0], fine.offsets[1],
@@ -500,8 +493,13 @@ bool FitSide(const cv::Mat& gray, const SideProfiles& side,
       const double model_inside = 0.5 * (ends[0] + ends[1]);
       const double model_outside = 0.5 * (ends[2] + ends[3]);
       if (std::abs(model_outside - model_inside) < 5.0) continue;
+      const double model_area = EdgeProfileModelArea(
+          prof, shift - w, shift + w, f.shift_px, sigma, f.levels);
+      const double model_rule =
+          shift + w -
+          (model_area - model_inside * 2 * w) / (model_outside - model_inside);
       shift = f.shift_px + AreaRuleShift(fine, inside, outside, shift, w) -
-              AreaRuleShift(model, model_inside, model_outside, shift, w);
+              model_rule;
       if (std::abs(shift - f.shift_px) > 0.5) continue;
     }
     pts.push_back(side.base[i] + shift * n);

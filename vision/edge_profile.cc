@@ -132,6 +132,25 @@ std::vector<double> EdgeProfileModel(const EdgeProfile& profile,
   return values;
 }
 
+double EdgeProfileModelArea(const EdgeProfile& profile, double lo, double hi,
+                            double shift_px, double sigma_px,
+                            const std::array<double, 3>& levels) {
+  // m(o) = L_0 + sum_i (L_{i+1} - L_i) Phi((o - e - b_i) / sigma), L_i the
+  // level of the i-th class along the line.
+  const auto g = [](double x) {
+    return x * 0.5 * std::erfc(-x / std::sqrt(2.0)) +
+           0.3989422804014327 * std::exp(-0.5 * x * x);
+  };
+  double area = levels[profile.classes.front()] * (hi - lo);
+  for (size_t i = 0; i < profile.breaks.size(); ++i) {
+    const double step =
+        levels[profile.classes[i + 1]] - levels[profile.classes[i]];
+    const double c = shift_px + profile.breaks[i];
+    area += step * sigma_px * (g((hi - c) / sigma_px) - g((lo - c) / sigma_px));
+  }
+  return area;
+}
+
 double FastPhi(double x) {
   static const PhiTable table;
   if (x <= -kPhiRange) return 0.0;

@@ -66,6 +66,13 @@ std::vector<double> EdgeProfileModel(const EdgeProfile& profile,
                                      double shift_px, double sigma_px,
                                      const std::array<double, 3>& levels);
 
+// The integral of that model over [lo, hi] (closed form: with
+// G(x) = x Phi(x) + phi(x), the integral of Phi((o - c) / sigma) is
+// sigma G((o - c) / sigma)).
+double EdgeProfileModelArea(const EdgeProfile& profile, double lo, double hi,
+                            double shift_px, double sigma_px,
+                            const std::array<double, 3>& levels);
+
 // Standard normal CDF from a table (|error| < 2e-5), for the model's speed.
 double FastPhi(double x);
 

@@ -77,6 +77,25 @@ TEST(EdgeProfile, ModelReproducesTheProfileItWasFittedTo) {
             5.0);
 }
 
+TEST(EdgeProfile, ModelAreaIsTheIntegralOfTheModel) {
+  std::mt19937_64 rng(5);
+  const EdgeProfile p = Synthetic(0.3, 3.0, 0.6, 30, 220, 60, 0, &rng);
+  const std::array<double, 3> levels = {30, 220, 60};
+  for (const double shift : {-0.4, 0.0, 0.25}) {
+    // Midpoint rule on a 1e-4 px grid.
+    const double lo = -1.7, hi = 2.1, h = 1e-4;
+    std::vector<double> o;
+    for (double x = lo + h / 2; x < hi; x += h) o.push_back(x);
+    double numeric = 0;
+    for (double v : EdgeProfileModel(p, o, shift, 0.6, levels)) {
+      numeric += v * h;
+    }
+    EXPECT_NEAR(EdgeProfileModelArea(p, lo, hi, shift, 0.6, levels), numeric,
+                0.01)
+        << shift;
+  }
+}
+
 TEST(EdgeProfile, LevelsDoNotMoveTheEdge) {
   std::mt19937_64 rng(4);
   // A dim, low-contrast tag (paper at 60, black at 20) in a bright
