@@ -341,15 +341,19 @@ std::vector<double> CornerErrors(State* st, const std::vector<Obs>& obs,
   return out;
 }
 
+// The upper median (element size / 2 in order) of a non-empty `v`.
+double UpperMedian(std::vector<double> v) {
+  std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
+  return v[v.size() / 2];
+}
+
 // The automatic Huber scale (BundleOptions::huber_px = 0) from the corner
 // errors of a first fit.
 constexpr double kAutoHuberSigmas = 3.0;
 constexpr double kMinAutoHuberPx = 0.05;
-double AutoHuberPx(std::vector<double> errors) {
+double AutoHuberPx(const std::vector<double>& errors) {
   if (errors.empty()) return 1.0;
-  std::nth_element(errors.begin(), errors.begin() + errors.size() / 2,
-                   errors.end());
-  const double sigma = errors[errors.size() / 2] / 1.1774;
+  const double sigma = UpperMedian(errors) / 1.1774;
   return std::max(kMinAutoHuberPx, kAutoHuberSigmas * sigma);
 }
 
@@ -709,10 +713,7 @@ double TrackedPixelNoise(const std::vector<BundleFrame>& frames,
     if (frames[i].tracked) tracked_rms.push_back(frames[i].tracked_rms_px);
   }
   if (tracked_rms.empty()) return 0.1;
-  std::nth_element(tracked_rms.begin(),
-                   tracked_rms.begin() + tracked_rms.size() / 2,
-                   tracked_rms.end());
-  return std::max(0.02, tracked_rms[tracked_rms.size() / 2]);
+  return std::max(0.02, UpperMedian(std::move(tracked_rms)));
 }
 
 struct IdentifiabilityScan {
@@ -787,11 +788,8 @@ void DropOutlierTags(State* st, const std::vector<Obs>& train,
   }
   std::vector<double> rms;
   for (auto& [key, v] : per_tag) rms.push_back(std::sqrt(v.first / v.second));
-  std::vector<double> sorted = rms;
-  std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2,
-                   sorted.end());
   const double limit =
-      std::max(opt.outlier_px, opt.outlier_ratio * sorted[sorted.size() / 2]);
+      std::max(opt.outlier_px, opt.outlier_ratio * UpperMedian(rms));
   size_t t = 0;
   for (auto& [key, v] : per_tag) {
     if (rms[t++] > limit) dropped->insert(key);

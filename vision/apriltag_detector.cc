@@ -495,11 +495,9 @@ bool FitSide(const cv::Mat& gray, const SideProfiles& side,
       if (std::abs(model_outside - model_inside) < 5.0) continue;
       const double model_area = EdgeProfileModelArea(
           prof, shift - w, shift + w, f.shift_px, sigma, f.levels);
-      const double model_rule =
-          shift + w -
-          (model_area - model_inside * 2 * w) / (model_outside - model_inside);
       shift = f.shift_px + AreaRuleShift(fine, inside, outside, shift, w) -
-              model_rule;
+              AreaRuleShiftFromArea(model_area, model_inside, model_outside,
+                                    shift, w);
       if (std::abs(shift - f.shift_px) > 0.5) continue;
     }
     pts.push_back(side.base[i] + shift * n);

@@ -113,8 +113,12 @@ double AreaRuleShift(const EdgeProfile& p, double inside, double outside,
     const double v_hi = p.values[i] + slope * (hi - o0);
     area += 0.5 * (v_lo + v_hi) * (hi - lo);
   }
-  const double normalised = (area - inside * (b - a)) / (outside - inside);
-  return b - normalised;
+  return AreaRuleShiftFromArea(area, inside, outside, centre, w);
+}
+
+double AreaRuleShiftFromArea(double area, double inside, double outside,
+                             double centre, double w) {
+  return centre + w - (area - inside * 2 * w) / (outside - inside);
 }
 
 std::vector<double> EdgeProfileModel(const EdgeProfile& profile,

@@ -58,6 +58,9 @@ EdgeProfileFit FitEdgeProfile(const EdgeProfile& profile, double sigma_px,
 // stay outside the window.
 double AreaRuleShift(const EdgeProfile& profile, double inside, double outside,
                      double centre, double w);
+// The same rule from the area over [centre - w, centre + w] already known.
+double AreaRuleShiftFromArea(double area, double inside, double outside,
+                             double centre, double w);
 
 // The model's gray levels at `offsets` for the pattern of `profile`, shift
 // e, blur sigma and the levels (black, white, outside) of a fit.
