@@ -40,6 +40,20 @@ void TargetLayoutOptions::Check() const {
   pose.Check();
 }
 
+void PivotTipOptions::Check() const {
+  if (min_views < 3) throw InputError("pivot min_views: expected at least 3");
+  if (!(min_tilt_deg >= 0) || !(min_conditioning > 0)) {
+    throw InputError(
+        "pivot min_tilt_deg must be >= 0 and min_conditioning > 0");
+  }
+  if (!(outlier_mm > 0) || !(outlier_ratio > 1)) {
+    throw InputError(
+        "pivot outlier_mm must be > 0 and outlier_ratio > 1 (a pose is left "
+        "out beyond max(outlier_mm, outlier_ratio * median residual))");
+  }
+  pose.Check();
+}
+
 namespace {
 
 // Reprojection of one tag corner through the layout:
@@ -719,6 +733,7 @@ std::vector<int> RejectPivotOutliers(const PivotTipOptions& options,
 PivotTipResult MeasurePivotTip(const Rig& rig, const TargetLayoutResult& layout,
                                const std::vector<LayoutFrame>& frames,
                                const PivotTipOptions& options) {
+  options.Check();
   PivotPoses p;
   for (const LayoutFrame& f : frames) {
     const ToolPoseResult r =

@@ -147,6 +147,8 @@ struct PivotTipOptions {
   double outlier_mm = 0.05;
   double outlier_ratio = 4.0;
   ToolPoseOptions pose;
+
+  void Check() const;  // InputError naming the bad option
 };
 
 struct PivotTipResult {

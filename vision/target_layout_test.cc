@@ -244,6 +244,16 @@ TEST(TargetLayout, RejectsBadOptions) {
   o = Options();
   o.family = "tag99";
   EXPECT_THROW(MeasureTargetLayout(rig, {}, o), InputError);
+  const TargetLayoutResult layout;
+  PivotTipOptions pivot;
+  pivot.outlier_ratio = 0.5;
+  EXPECT_THROW(MeasurePivotTip(rig, layout, {}, pivot), InputError);
+  pivot = PivotTipOptions();
+  pivot.outlier_mm = 0;
+  EXPECT_THROW(MeasurePivotTip(rig, layout, {}, pivot), InputError);
+  pivot = PivotTipOptions();
+  pivot.min_views = 2;
+  EXPECT_THROW(MeasurePivotTip(rig, layout, {}, pivot), InputError);
 }
 
 // A pivot session (20 poses tilted +-10 and +-20 deg about the tip, 0.05
