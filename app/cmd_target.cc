@@ -123,6 +123,7 @@ void Print(const TargetArgs& args, const TargetLayoutResult& layout,
       j["pivot_tilt_deg"] = Number(pivot->pivot.tilt_range_deg);
       j["pivot_in_rig"] = Vec3(pivot->pivot.pivot_in_rig);
       j["tip_layout_sigma_mm"] = Vec3(pivot->layout_sigma_mm);
+      j["pivot_frames_rejected"] = pivot->frames_rejected;
     }
     j["seconds"] = seconds;
     AddWarnings(warnings, &j);
@@ -141,9 +142,10 @@ void Print(const TargetArgs& args, const TargetLayoutResult& layout,
   if (pivot) {
     std::printf(
         "  tip (%.3f, %.3f, %.3f) mm, sigma up to %.3f mm, pivot RMS %.3f mm "
-        "over %d views\n",
+        "over %d views (%zu off the pivot left out)\n",
         target.tip_in_tool.x(), target.tip_in_tool.y(), target.tip_in_tool.z(),
-        target.tip_sigma_mm.maxCoeff(), pivot->pivot.rms_mm, pivot->views);
+        target.tip_sigma_mm.maxCoeff(), pivot->pivot.rms_mm, pivot->views,
+        pivot->frames_rejected.size());
   }
   std::printf("  wrote %s\n", args.out.c_str());
 }

@@ -229,6 +229,23 @@ TEST(TargetCli, RandomHoldersMonteCarlo) {
   for (double z : {RmsOf(z_t), RmsOf(z_r), RmsOf(z_tip)}) EXPECT_LT(z, 2.0);
 }
 
+// The blurriest holder of target_bench's widened effects (seed 5: 4 tags,
+// blur 0.89 px, noise 2.2): its tip was 0.228 mm off with the unweighted
+// pivot fit that kept a pose 0.4 mm off the pivot (one bad tag observation
+// turning it 0.18 deg); measured 0.090 mm now. The issue asks 0.1 mm.
+TEST(TargetCli, BlurryHolderTipWithinATenth) {
+  const McTrial t = RunTargetTrial(5, LayoutCovariance::kTagObservations);
+  std::printf(
+      "seed 5 (blur %.2f px): max tag error %.4f mm %.4f deg, tip %.4f mm "
+      "(sigma %.4f), %d pivot views\n",
+      t.effects.blur_sigma_px, t.max_t_mm, t.max_r_deg, t.tip_mm,
+      t.tip_sigma_mm, t.pivot_views);
+  EXPECT_GT(t.effects.blur_sigma_px, 0.85);
+  EXPECT_LT(t.max_t_mm, 0.05);
+  EXPECT_LT(t.max_r_deg, 0.05);
+  EXPECT_LT(t.tip_mm, 0.1);
+}
+
 // A hand-held session of the example tool (40 views) and a pivot session
 // (the tip fixed, tilted +-20 deg about two axes): the tip in the measured
 // tool frame against the truth carried into that frame.
@@ -261,6 +278,10 @@ TEST(TargetCli, PivotSessionGivesTheTip) {
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const auto j = nlohmann::json::parse(r.out);
   ASSERT_TRUE(j.contains("pivot_rms_mm"));
+  ASSERT_TRUE(j["pivot_frames_rejected"].is_array());
+  EXPECT_EQ(j["pivot_views"].get<int>() +
+                static_cast<int>(j["pivot_frames_rejected"].size()),
+            16);
   const Target measured = ReadTargetYaml(dir + "/t.yaml");
   ASSERT_TRUE(measured.has_tip && measured.has_tip_sigma);
   const TargetTag* true_ref = truth.FindTag(j["reference_tag"].get<int>());

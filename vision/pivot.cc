@@ -3,6 +3,7 @@
 #include <Eigen/Dense>
 #include <cmath>
 #include <sstream>
+#include <stdexcept>
 
 #include "data/error.h"
 
@@ -27,6 +28,51 @@ Eigen::MatrixXd PoseClusteredCovariance(const Eigen::MatrixXd& A,
     meat += score * score.transpose();
   }
   return ata_inv * meat * ata_inv;
+}
+
+Eigen::Matrix3d Skew(const Eigen::Vector3d& v) {
+  Eigen::Matrix3d m;
+  m << 0, -v.z(), v.y(), v.z(), 0, -v.x(), -v.y(), v.x(), 0;
+  return m;
+}
+
+// W_i = (B_i C_i B_i^T)^-1, B_i = [-[R_i tip]x  I]: how pose i's errors
+// (covariance C_i, order (a, dt)) move its residual R_i tip + t_i - pivot.
+std::vector<Eigen::Matrix3d> PoseWeights(
+    const std::vector<Rigid3>& rig_from_tool, const Eigen::Vector3d& tip,
+    const std::vector<Eigen::Matrix<double, 6, 6>>& covariances) {
+  std::vector<Eigen::Matrix3d> weights;
+  for (size_t i = 0; i < rig_from_tool.size(); ++i) {
+    Eigen::Matrix<double, 3, 6> b;
+    b.leftCols<3>() = -Skew(rig_from_tool[i].R * tip);
+    b.rightCols<3>() = Eigen::Matrix3d::Identity();
+    const Eigen::Matrix3d c = b * covariances[i] * b.transpose();
+    weights.push_back(c.ldlt().solve(Eigen::Matrix3d::Identity()));
+  }
+  // Only the weights' shape matters: scaled to a mean trace of 3 so that
+  // residuals keep their size in mm on average.
+  double trace = 0;
+  for (const Eigen::Matrix3d& w : weights) trace += w.trace();
+  for (Eigen::Matrix3d& w : weights) w *= 3.0 * weights.size() / trace;
+  return weights;
+}
+
+// The stacked system [R_i  -I] x = -t_i, each 3-row block multiplied by
+// L_i^T, W_i = L_i L_i^T, so that plain least squares on it is the fit
+// weighted by W_i.
+void WeightedSystem(const std::vector<Rigid3>& rig_from_tool,
+                    const std::vector<Eigen::Matrix3d>& weights,
+                    Eigen::MatrixXd* A, Eigen::VectorXd* b) {
+  const int n = static_cast<int>(rig_from_tool.size());
+  A->resize(3 * n, 6);
+  b->resize(3 * n);
+  for (int i = 0; i < n; ++i) {
+    const Eigen::Matrix3d lt =
+        Eigen::LLT<Eigen::Matrix3d>(weights[i]).matrixL().transpose();
+    A->block<3, 3>(3 * i, 0) = lt * rig_from_tool[i].R;
+    A->block<3, 3>(3 * i, 3) = -lt;
+    b->segment<3>(3 * i) = -lt * rig_from_tool[i].t;
+  }
 }
 
 }  // namespace
@@ -56,13 +102,18 @@ double PivotTiltRangeDeg(const std::vector<Rigid3>& rig_from_tool) {
   return (along.maxCoeff() - along.minCoeff()) * 180.0 / M_PI;
 }
 
-PivotResult PivotCalibration(const std::vector<Rigid3>& rig_from_tool,
-                             double min_conditioning,
-                             double min_tilt_range_deg) {
+PivotResult PivotCalibration(
+    const std::vector<Rigid3>& rig_from_tool, double min_conditioning,
+    double min_tilt_range_deg,
+    const std::vector<Eigen::Matrix<double, 6, 6>>& pose_covariances) {
   const int n = static_cast<int>(rig_from_tool.size());
   if (n < 3) {
     throw InputError("pivot calibration: expected at least 3 tool poses, got " +
                      std::to_string(n));
+  }
+  if (!pose_covariances.empty() &&
+      static_cast<int>(pose_covariances.size()) != n) {
+    throw std::invalid_argument("PivotCalibration: one covariance per pose");
   }
   const double tilt = PivotTiltRangeDeg(rig_from_tool);
   if (tilt < min_tilt_range_deg) {
@@ -73,18 +124,15 @@ PivotResult PivotCalibration(const std::vector<Rigid3>& rig_from_tool,
           "divot, at least +-15 deg in two directions";
     throw InputError(os.str());
   }
-  Eigen::MatrixXd A(3 * n, 6);
-  Eigen::VectorXd b(3 * n);
-  for (int i = 0; i < n; ++i) {
-    A.block<3, 3>(3 * i, 0) = rig_from_tool[i].R;
-    A.block<3, 3>(3 * i, 3) = -Eigen::Matrix3d::Identity();
-    b.segment<3>(3 * i) = -rig_from_tool[i].t;
-  }
+  PivotResult r;
+  r.weights.assign(n, Eigen::Matrix3d::Identity());
+  Eigen::MatrixXd A;
+  Eigen::VectorXd b;
+  WeightedSystem(rig_from_tool, r.weights, &A, &b);
   Eigen::JacobiSVD<Eigen::MatrixXd> svd(
       A, Eigen::ComputeThinU | Eigen::ComputeThinV);
-  const Eigen::VectorXd s = svd.singularValues();
-  PivotResult r;
-  r.conditioning = s(s.size() - 1) / s(0);
+  r.conditioning =
+      svd.singularValues()(5) / std::max(svd.singularValues()(0), 1e-300);
   if (!(r.conditioning >= min_conditioning)) {
     std::ostringstream os;
     os << "pivot calibration: the " << n
@@ -93,7 +141,14 @@ PivotResult PivotCalibration(const std::vector<Rigid3>& rig_from_tool,
        << "): tilt the tool about two different axes while pivoting";
     throw InputError(os.str());
   }
-  const Eigen::VectorXd x = svd.solve(b);
+  Eigen::VectorXd x = svd.solve(b);
+  // The weights depend on the tip: a few rounds from the unweighted one.
+  for (int round = 0; round < 3 && !pose_covariances.empty(); ++round) {
+    r.weights = PoseWeights(rig_from_tool, x.head<3>(), pose_covariances);
+    WeightedSystem(rig_from_tool, r.weights, &A, &b);
+    svd.compute(A, Eigen::ComputeThinU | Eigen::ComputeThinV);
+    x = svd.solve(b);
+  }
   r.tip_in_tool = x.head<3>();
   r.pivot_in_rig = x.tail<3>();
   double sum = 0;
@@ -106,7 +161,8 @@ PivotResult PivotCalibration(const std::vector<Rigid3>& rig_from_tool,
   r.rms_mm = std::sqrt(sum / n);
   r.tilt_range_deg = tilt;
   if (3 * n > 6) {
-    // (A^T A)^-1 = V S^-2 V^T.
+    // (A^T A)^-1 = V S^-2 V^T of the (weighted) system.
+    const Eigen::VectorXd s = svd.singularValues();
     const Eigen::MatrixXd V = svd.matrixV();
     const Eigen::VectorXd inv_s2 = s.array().square().inverse();
     const Eigen::MatrixXd ata_inv = V * inv_s2.asDiagonal() * V.transpose();
@@ -121,23 +177,32 @@ PivotResult PivotCalibration(const std::vector<Rigid3>& rig_from_tool,
 }
 
 Eigen::MatrixXd PivotTipJacobian(const std::vector<Rigid3>& rig_from_tool,
-                                 const Eigen::Vector3d& tip_in_tool) {
+                                 const Eigen::Vector3d& tip_in_tool,
+                                 const std::vector<Eigen::Matrix3d>& weights) {
   const int n = static_cast<int>(rig_from_tool.size());
-  Eigen::MatrixXd A(3 * n, 6);
+  const std::vector<Eigen::Matrix3d> w =
+      weights.empty()
+          ? std::vector<Eigen::Matrix3d>(n, Eigen::Matrix3d::Identity())
+          : weights;
+  // A^T W, and the tip's rows of -(A^T W A)^-1 A^T W.
+  Eigen::MatrixXd atw(6, 3 * n);
   for (int i = 0; i < n; ++i) {
-    A.block<3, 3>(3 * i, 0) = rig_from_tool[i].R;
-    A.block<3, 3>(3 * i, 3) = -Eigen::Matrix3d::Identity();
+    atw.block<3, 3>(0, 3 * i) = rig_from_tool[i].R.transpose() * w[i];
+    atw.block<3, 3>(3, 3 * i) = -w[i];
   }
-  // Rows of the tip in -(A^T A)^-1 A^T.
-  const Eigen::MatrixXd solve =
-      -(A.transpose() * A).ldlt().solve(A.transpose()).topRows(3);
+  Eigen::MatrixXd ata = Eigen::MatrixXd::Zero(6, 6);
+  for (int i = 0; i < n; ++i) {
+    Eigen::Matrix<double, 3, 6> a;
+    a.leftCols<3>() = rig_from_tool[i].R;
+    a.rightCols<3>() = -Eigen::Matrix3d::Identity();
+    ata += atw.middleCols<3>(3 * i) * a;
+  }
+  const Eigen::MatrixXd solve = -ata.ldlt().solve(atw).topRows(3);
   Eigen::MatrixXd jacobian(3, 6 * n);
   for (int i = 0; i < n; ++i) {
-    const Eigen::Vector3d arm = rig_from_tool[i].R * tip_in_tool;
-    Eigen::Matrix3d skew;
-    skew << 0, -arm.z(), arm.y(), arm.z(), 0, -arm.x(), -arm.y(), arm.x(), 0;
     const Eigen::Matrix3d block = solve.middleCols<3>(3 * i);
-    jacobian.middleCols<3>(6 * i) = -block * skew;
+    jacobian.middleCols<3>(6 * i) =
+        -block * Skew(rig_from_tool[i].R * tip_in_tool);
     jacobian.middleCols<3>(6 * i + 3) = block;
   }
   return jacobian;

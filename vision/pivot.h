@@ -38,6 +38,9 @@ struct PivotResult {
   // rotations about the second principal axis of their spread (the smaller
   // of the two largest; a needle turned about one axis only has ~0).
   double tilt_range_deg = 0;
+  // Per pose 3x3 weight of its residual (identity without pose
+  // covariances); the covariances above are those of the weighted fit.
+  std::vector<Eigen::Matrix3d> weights;
 };
 
 // Tilt range of a set of tool poses, as PivotResult::tilt_range_deg.
@@ -47,17 +50,31 @@ double PivotTiltRangeDeg(const std::vector<Rigid3>& rig_from_tool);
 // than 3 poses, rotations that leave the offset undetermined
 // (conditioning < min_conditioning, e.g. all about one axis), or a tilt
 // range below min_tilt_range_deg (the message says how to record instead).
-PivotResult PivotCalibration(const std::vector<Rigid3>& rig_from_tool,
-                             double min_conditioning = 1e-3,
-                             double min_tilt_range_deg = 0);
+//
+// pose_covariances (optional, one 6x6 per pose in the order (a, dt) of
+// PivotTipJacobian; only their shape matters, any common scale): the fit is
+// then weighted by how each pose errs, W_i = (B_i C_i B_i^T)^-1 with
+// B_i = [-[R_i tip]x  I] the residual's change with pose i (iterated from
+// the unweighted tip): a camera pose errs mostly by a turn about the tags
+// with a matching shift, which moves the tip 100 mm away by far more than
+// it moves the tags, so the weights lean on where the tags went rather
+// than on how they turned. Stored in PivotResult::weights.
+PivotResult PivotCalibration(
+    const std::vector<Rigid3>& rig_from_tool, double min_conditioning = 1e-3,
+    double min_tilt_range_deg = 0,
+    const std::vector<Eigen::Matrix<double, 6, 6>>& pose_covariances = {});
 
 // How the least-squares tip moves with the tool poses: d tip_in_tool /
 // d (a_i, dt_i), 3 x 6n, for pose i corrected as (exp([a_i]x) R_i, t_i +
 // dt_i) (rotation vector a_i on the left, rad; dt_i in mm). With the pivot's
 // residuals small, dx = -(A^T A)^-1 A^T de, where de_i = -[R_i tip]x a_i +
 // dt_i is the change of pose i's residual at the fitted (tip, pivot).
-Eigen::MatrixXd PivotTipJacobian(const std::vector<Rigid3>& rig_from_tool,
-                                 const Eigen::Vector3d& tip_in_tool);
+// weights: PivotResult::weights of a weighted fit (empty: unweighted), then
+// dx = -(A^T W A)^-1 A^T W de.
+Eigen::MatrixXd PivotTipJacobian(
+    const std::vector<Rigid3>& rig_from_tool,
+    const Eigen::Vector3d& tip_in_tool,
+    const std::vector<Eigen::Matrix3d>& weights = {});
 
 }  // namespace kincal
 

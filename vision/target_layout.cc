@@ -40,6 +40,20 @@ void TargetLayoutOptions::Check() const {
   pose.Check();
 }
 
+void PivotTipOptions::Check() const {
+  if (min_views < 3) throw InputError("pivot min_views: expected at least 3");
+  if (!(min_tilt_deg >= 0) || !(min_conditioning > 0)) {
+    throw InputError(
+        "pivot min_tilt_deg must be >= 0 and min_conditioning > 0");
+  }
+  if (!(outlier_mm > 0) || !(outlier_ratio > 1)) {
+    throw InputError(
+        "pivot outlier_mm must be > 0 and outlier_ratio > 1 (a pose is left "
+        "out beyond max(outlier_mm, outlier_ratio * median residual))");
+  }
+  pose.Check();
+}
+
 namespace {
 
 // Reprojection of one tag corner through the layout:
@@ -630,9 +644,9 @@ TargetLayoutResult MeasureTargetLayout(const Rig& rig,
   return result;
 }
 
-Eigen::MatrixXd ToolPoseLayoutJacobian(const Rig& rig,
-                                       const TargetLayoutResult& layout,
-                                       const ToolPoseResult& pose) {
+Eigen::MatrixXd ToolPoseLayoutJacobian(
+    const Rig& rig, const TargetLayoutResult& layout,
+    const ToolPoseResult& pose, Eigen::Matrix<double, 6, 6>* information) {
   const int tags = static_cast<int>(layout.tags.size());
   Matrix6d h = Matrix6d::Zero();
   Eigen::MatrixXd cross = Eigen::MatrixXd::Zero(6, 6 * tags);
@@ -667,40 +681,92 @@ Eigen::MatrixXd ToolPoseLayoutJacobian(const Rig& rig,
       cross.middleCols<6>(6 * index) += jf.transpose() * jt;
     }
   }
+  if (information) *information = h;
   return -h.ldlt().solve(cross);
 }
+
+namespace {
+
+// The tool poses of the pivot frames: rig_from_tool, its covariance up to
+// scale (the inverse of the pose fit's J^T J), how it moves with the layout
+// (ToolPoseLayoutJacobian) and the session frame number.
+struct PivotPoses {
+  std::vector<Rigid3> poses;
+  std::vector<Eigen::Matrix<double, 6, 6>> covariances;
+  std::vector<Eigen::MatrixXd> layout_jacobians;
+  std::vector<int> frames;
+};
+
+// The pivot frames whose tool pose misses the common pivot: the worst pose
+// is left out while its pivot residual exceeds max(options.outlier_mm,
+// options.outlier_ratio * median residual), the pivot refitted each time,
+// and never below options.min_views poses. One pose off by a bad tag
+// observation pulls the tip by its residual times its leverage. Returns
+// the session frame numbers left out.
+std::vector<int> RejectPivotOutliers(const PivotTipOptions& options,
+                                     PivotPoses* poses) {
+  std::vector<int> rejected;
+  while (static_cast<int>(poses->poses.size()) > options.min_views) {
+    const PivotResult fit = PivotCalibration(
+        poses->poses, options.min_conditioning, 0, poses->covariances);
+    std::vector<double> sorted = fit.residuals_mm;
+    std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2,
+                     sorted.end());
+    const double limit = std::max(
+        options.outlier_mm, options.outlier_ratio * sorted[sorted.size() / 2]);
+    const auto worst =
+        std::max_element(fit.residuals_mm.begin(), fit.residuals_mm.end());
+    if (*worst <= limit) break;
+    const auto i = worst - fit.residuals_mm.begin();
+    rejected.push_back(poses->frames[i]);
+    poses->poses.erase(poses->poses.begin() + i);
+    poses->covariances.erase(poses->covariances.begin() + i);
+    poses->layout_jacobians.erase(poses->layout_jacobians.begin() + i);
+    poses->frames.erase(poses->frames.begin() + i);
+  }
+  std::sort(rejected.begin(), rejected.end());
+  return rejected;
+}
+
+}  // namespace
 
 PivotTipResult MeasurePivotTip(const Rig& rig, const TargetLayoutResult& layout,
                                const std::vector<LayoutFrame>& frames,
                                const PivotTipOptions& options) {
-  std::vector<Rigid3> poses;
-  std::vector<Eigen::MatrixXd> pose_jacobians;
+  options.Check();
+  PivotPoses p;
   for (const LayoutFrame& f : frames) {
     const ToolPoseResult r =
         EstimateToolPose(rig, layout.target, f.detections, options.pose);
     if (!r.found) continue;
-    poses.push_back(r.rig_from_tool);
-    pose_jacobians.push_back(ToolPoseLayoutJacobian(rig, layout, r));
+    Matrix6d information;
+    p.layout_jacobians.push_back(
+        ToolPoseLayoutJacobian(rig, layout, r, &information));
+    p.poses.push_back(r.rig_from_tool);
+    p.covariances.push_back(PseudoInverse(information));
+    p.frames.push_back(f.frame);
   }
-  if (static_cast<int>(poses.size()) < options.min_views) {
-    throw InputError("the tool was found in " + std::to_string(poses.size()) +
+  if (static_cast<int>(p.poses.size()) < options.min_views) {
+    throw InputError("the tool was found in " + std::to_string(p.poses.size()) +
                      " of " + std::to_string(frames.size()) +
                      " frames (at least " + std::to_string(options.min_views) +
                      " needed): record the tool pivoting about its tip with "
                      "its tags in view");
   }
   PivotTipResult out;
-  out.pivot =
-      PivotCalibration(poses, options.min_conditioning, options.min_tilt_deg);
-  out.views = static_cast<int>(poses.size());
+  out.frames_rejected = RejectPivotOutliers(options, &p);
+  out.pivot = PivotCalibration(p.poses, options.min_conditioning,
+                               options.min_tilt_deg, p.covariances);
+  out.views = static_cast<int>(p.poses.size());
   // d tip / d layout = sum over frames of d tip / d pose_i * d pose_i / d
   // layout; the layout's covariance through it adds to the pivot's.
   const Eigen::MatrixXd tip_from_poses =
-      PivotTipJacobian(poses, out.pivot.tip_in_tool);
+      PivotTipJacobian(p.poses, out.pivot.tip_in_tool, out.pivot.weights);
   Eigen::MatrixXd tip_from_layout =
       Eigen::MatrixXd::Zero(3, layout.covariance.cols());
-  for (size_t i = 0; i < poses.size(); ++i) {
-    tip_from_layout += tip_from_poses.middleCols<6>(6 * i) * pose_jacobians[i];
+  for (size_t i = 0; i < p.poses.size(); ++i) {
+    tip_from_layout +=
+        tip_from_poses.middleCols<6>(6 * i) * p.layout_jacobians[i];
   }
   const Eigen::Matrix3d layout_cov =
       tip_from_layout * layout.covariance * tip_from_layout.transpose();

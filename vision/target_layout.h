@@ -126,9 +126,12 @@ TargetLayoutResult MeasureTargetLayout(const Rig& rig,
 // pose's correction (exp([a]x) R, t + dt), columns the tags' corrections as
 // in TargetLayoutResult::covariance. Implicit function theorem:
 // -(Jp^T Jp)^-1 Jp^T Jl at the fitted pose.
-Eigen::MatrixXd ToolPoseLayoutJacobian(const Rig& rig,
-                                       const TargetLayoutResult& layout,
-                                       const ToolPoseResult& pose);
+// information (optional): the pose fit's Jp^T Jp (6 x 6, same order), whose
+// inverse is the pose's covariance up to the corner variance.
+Eigen::MatrixXd ToolPoseLayoutJacobian(
+    const Rig& rig, const TargetLayoutResult& layout,
+    const ToolPoseResult& pose,
+    Eigen::Matrix<double, 6, 6>* information = nullptr);
 
 struct PivotTipOptions {
   // Pivot frames with a tool pose needed at least.
@@ -136,12 +139,22 @@ struct PivotTipOptions {
   // Tilt range needed in the second direction (PivotResult::tilt_range_deg).
   double min_tilt_deg = 15.0;
   double min_conditioning = 1e-3;
+  // A pivot frame whose tool pose misses the pivot by more than
+  // max(outlier_mm, outlier_ratio * the median pose's residual) is left out
+  // (worst first, the pivot refitted each time, keeping min_views poses):
+  // one bad tag observation in a frame turns its pose by a few hundredths
+  // of a degree, which the tip's 100 mm lever makes tenths of a mm.
+  double outlier_mm = 0.05;
+  double outlier_ratio = 4.0;
   ToolPoseOptions pose;
+
+  void Check() const;  // InputError naming the bad option
 };
 
 struct PivotTipResult {
   PivotResult pivot;  // tip_sigma_mm there: the pivot residuals' part only
-  int views = 0;      // pivot frames with a tool pose
+  int views = 0;      // pivot frames with a tool pose, outliers left out
+  std::vector<int> frames_rejected;  // session frame numbers left out
   // 1-sigma of tip_in_tool per tool axis (mm): the pivot residuals' part and
   // the layout's covariance carried through the tool poses of every pivot
   // frame (ToolPoseLayoutJacobian, PivotTipJacobian).

@@ -2,8 +2,10 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <functional>
 #include <random>
 
 #include "data/error.h"
@@ -44,15 +46,16 @@ Rigid3 ToolPose(int i, std::mt19937_64* rng) {
 }
 
 // Corners of every tag facing a camera (within 75 deg) and inside its
-// image, with Gaussian pixel noise.
-std::vector<LayoutFrame> Frames(const Rig& rig,
-                                const std::vector<std::pair<int, Rigid3>>& tags,
-                                int n, double noise_px, int seed) {
+// image, with Gaussian pixel noise, at n tool poses pose(i, rng).
+std::vector<LayoutFrame> FramesAt(
+    const Rig& rig, const std::vector<std::pair<int, Rigid3>>& tags, int n,
+    const std::function<Rigid3(int, std::mt19937_64*)>& pose, double noise_px,
+    int seed) {
   std::mt19937_64 rng(seed);
   std::normal_distribution<double> noise(0, noise_px);
   std::vector<LayoutFrame> frames;
   for (int i = 0; i < n; ++i) {
-    const Rigid3 rig_from_tool = ToolPose(i, &rng);
+    const Rigid3 rig_from_tool = pose(i, &rng);
     LayoutFrame f;
     f.frame = i;
     for (const Camera& cam : rig.cameras) {
@@ -83,6 +86,13 @@ std::vector<LayoutFrame> Frames(const Rig& rig,
     frames.push_back(f);
   }
   return frames;
+}
+
+// n random tool poses (ToolPose), as FramesAt.
+std::vector<LayoutFrame> Frames(const Rig& rig,
+                                const std::vector<std::pair<int, Rigid3>>& tags,
+                                int n, double noise_px, int seed) {
+  return FramesAt(rig, tags, n, ToolPose, noise_px, seed);
 }
 
 TargetLayoutOptions Options() {
@@ -234,6 +244,68 @@ TEST(TargetLayout, RejectsBadOptions) {
   o = Options();
   o.family = "tag99";
   EXPECT_THROW(MeasureTargetLayout(rig, {}, o), InputError);
+  const TargetLayoutResult layout;
+  PivotTipOptions pivot;
+  pivot.outlier_ratio = 0.5;
+  EXPECT_THROW(MeasurePivotTip(rig, layout, {}, pivot), InputError);
+  pivot = PivotTipOptions();
+  pivot.outlier_mm = 0;
+  EXPECT_THROW(MeasurePivotTip(rig, layout, {}, pivot), InputError);
+  pivot = PivotTipOptions();
+  pivot.min_views = 2;
+  EXPECT_THROW(MeasurePivotTip(rig, layout, {}, pivot), InputError);
+}
+
+// A pivot session (20 poses tilted +-10 and +-20 deg about the tip, 0.05
+// px) in which one frame's corners are 0.8 px off in one camera (a frame
+// the cameras did not take at the same instant: the tags agree with each
+// other, so the pose fit keeps them): that pose misses the pivot and is
+// left out; kept (outlier_mm huge), it pulls the tip.
+TEST(TargetLayout, PivotPoseOffThePivotIsLeftOut) {
+  const Rig rig = ExampleStereoRig(1280, 1024);
+  const auto truth = TrueLayout();
+  const TargetLayoutResult layout =
+      MeasureTargetLayout(rig, Frames(rig, truth, 40, 0.02, 3), Options());
+  const Eigen::Vector3d tip_in_tool(5, 100, 10);
+  Rigid3 mid;
+  mid.t = Eigen::Vector3d(60, 0, 420);
+  std::vector<Rigid3> poses;
+  for (int i = 0; i < 20; ++i) {
+    const double a = 2 * M_PI * i / 10, tilt = i < 10 ? 20 : 10;
+    Rigid3 p;
+    p.R = Rot(Eigen::Vector3d(std::sin(a), std::cos(a), 0), tilt);
+    p.t = mid.t + mid.R * tip_in_tool - p.R * tip_in_tool;
+    poses.push_back(p);
+  }
+  std::vector<LayoutFrame> frames = FramesAt(
+      rig, truth, 20, [&](int i, std::mt19937_64*) { return poses[i]; }, 0.05,
+      4);
+  for (TagDetection& d : frames[6].detections[0]) {
+    for (int k = 0; k < 4; ++k) d.corners[k].x() += 0.8;
+  }
+  const Rigid3 ref_from_tool =
+      TrueRefFromTag(truth, layout.reference_tag_id, truth[0].first) *
+      truth[0].second.Inverse();
+  const Eigen::Vector3d want = ref_from_tool * tip_in_tool;
+  const PivotTipResult robust =
+      MeasurePivotTip(rig, layout, frames, PivotTipOptions());
+  PivotTipOptions keep;
+  keep.outlier_mm = 1e9;
+  const PivotTipResult kept = MeasurePivotTip(rig, layout, frames, keep);
+  const double robust_error = (robust.pivot.tip_in_tool - want).norm();
+  const double kept_error = (kept.pivot.tip_in_tool - want).norm();
+  std::printf(
+      "pivot with a bad frame: tip error %.4f mm (sigma %.4f) with %zu "
+      "frames left out, %.4f mm with all kept\n",
+      robust_error, robust.tip_sigma_mm.norm(), robust.frames_rejected.size(),
+      kept_error);
+  EXPECT_NE(std::find(robust.frames_rejected.begin(),
+                      robust.frames_rejected.end(), 6),
+            robust.frames_rejected.end());
+  EXPECT_EQ(robust.views + static_cast<int>(robust.frames_rejected.size()), 20);
+  EXPECT_TRUE(kept.frames_rejected.empty());
+  EXPECT_LT(robust_error, 0.5 * kept_error);
+  EXPECT_LT(robust_error, 3 * robust.tip_sigma_mm.norm());
 }
 
 // ToolPoseLayoutJacobian against refitting the tool pose with one tag's
