@@ -79,11 +79,12 @@ struct ProfileSums {
   double vv = 0;
 };
 
-ProfileSums Sums(const EdgeProfile& p, double e, double sigma) {
+ProfileSums Sums(const EdgeProfile& p, double e, const PhaseSigmas& sigma) {
   ProfileSums s;
   Eigen::Vector3d b, db;
+  const bool phased = p.phases.size() == p.offsets.size();
   for (size_t i = 0; i < p.offsets.size(); ++i) {
-    Basis(p, p.offsets[i], e, sigma, &b, &db);
+    Basis(p, p.offsets[i], e, sigma[phased ? p.phases[i] : 0], &b, &db);
     const double v = p.values[i];
     s.B.noalias() += b * b.transpose();
     s.D.noalias() += db * b.transpose();
@@ -167,9 +168,17 @@ double FastPhi(double x) {
 
 EdgeProfileFit FitEdgeProfile(const EdgeProfile& profile, double sigma_px,
                               int iterations, double max_shift_px) {
+  return FitEdgeProfile(profile, {sigma_px, sigma_px, sigma_px, sigma_px},
+                        iterations, max_shift_px);
+}
+
+EdgeProfileFit FitEdgeProfile(const EdgeProfile& profile,
+                              const PhaseSigmas& sigma_px, int iterations,
+                              double max_shift_px) {
   EdgeProfileFit fit;
   if (profile.offsets.size() < 6 ||
-      profile.classes.size() != profile.breaks.size() + 1 || !(sigma_px > 0)) {
+      profile.classes.size() != profile.breaks.size() + 1 ||
+      !(*std::min_element(sigma_px.begin(), sigma_px.end()) > 0)) {
     return fit;
   }
   double e = 0;
