@@ -430,6 +430,7 @@ void PixelProfile(const cv::Mat& gray, const Eigen::Vector2d& p,
       prof->phases.push_back((x & 1) + 2 * (y & 1));
     }
   }
+  prof->box_px = std::max(std::abs(n.x()), std::abs(n.y()));
 }
 
 SideProfiles ProfilesOfSide(const cv::Mat& gray, const PatternView& view,
@@ -507,7 +508,7 @@ SideProfiles ProfilesOfSide(const cv::Mat& gray, const PatternView& view,
 // shared one, 7 steps: to 4 %).
 PhaseSigmas SideBlur(const std::vector<EdgeProfile>& profiles, bool phased) {
   if (profiles.empty()) return {1.0, 1.0, 1.0, 1.0};
-  const size_t stride = std::max<size_t>(1, profiles.size() / 8);
+  size_t stride = std::max<size_t>(1, profiles.size() / 8);
   const auto cost = [&](const PhaseSigmas& sigma) {
     double sum = 0;
     for (size_t i = 0; i < profiles.size(); i += stride) {
@@ -525,6 +526,7 @@ PhaseSigmas SideBlur(const std::vector<EdgeProfile>& profiles, bool phased) {
   const double shared = std::exp(0.5 * (r.lo + r.hi));
   PhaseSigmas sigma = {shared, shared, shared, shared};
   if (!phased) return sigma;
+  stride = 1;
   for (int phase = 0; phase < 4; ++phase) {
     const GoldenSectionResult rp = GoldenSectionMinimize(
         [&](double log_sigma) {
@@ -534,6 +536,26 @@ PhaseSigmas SideBlur(const std::vector<EdgeProfile>& profiles, bool phased) {
         },
         std::log(0.5 * shared), std::log(2.0 * shared), 7);
     sigma[phase] = std::exp(0.5 * (rp.lo + rp.hi));
+  }
+  return sigma;
+}
+
+// Each side's blur (SideBlur). Demosaiced: a phase's blur depends on the
+// edge's direction (a demosaic's kernels are not round), so opposite sides,
+// nearly parallel, share their per-phase blurs, fitted on both sides'
+// profiles: twice the pixels for the four widths.
+std::array<PhaseSigmas, 4> SidesBlur(const std::array<SideProfiles, 4>& sides,
+                                     bool phased) {
+  std::array<PhaseSigmas, 4> sigma;
+  if (!phased) {
+    for (int k = 0; k < 4; ++k) sigma[k] = SideBlur(sides[k].profiles, false);
+    return sigma;
+  }
+  for (int k = 0; k < 2; ++k) {
+    std::vector<EdgeProfile> both = sides[k].profiles;
+    both.insert(both.end(), sides[k + 2].profiles.begin(),
+                sides[k + 2].profiles.end());
+    sigma[k] = sigma[k + 2] = SideBlur(both, true);
   }
   return sigma;
 }
@@ -657,20 +679,26 @@ bool RefineCornersByEdges(const cv::Mat& gray, const cv::Mat& tag_image,
     }
     const double cell = shortest / cells;
     if (shortest < 8.0 || cell < 1.5) return false;
-    std::array<Line2, 4> lines;
+    std::array<SideProfiles, 4> sides;
+    std::array<Eigen::Vector2d, 4> normals;
     for (int k = 0; k < 4; ++k) {
       const Eigen::Vector2d a = c[k], b = c[(k + 1) % 4];
       const Eigen::Vector2d dir = (b - a).normalized();
       Eigen::Vector2d n(-dir.y(), dir.x());
       if (n.dot((a + b) / 2 - centroid) < 0) n = -n;
-      const SideProfiles side = ProfilesOfSide(
+      normals[k] = n;
+      sides[k] = ProfilesOfSide(
           gray, view, a, b, n, cell, cells,
           pass == 0 ? 1.0
                     : std::max(1.0, 2.0 * *std::max_element(sigma[k].begin(),
                                                             sigma[k].end())),
           others, phased);
-      if (pass == 0) sigma[k] = SideBlur(side.profiles, phased);
-      if (!FitSide(gray, side, n, sigma[k], phased, &lines[k], &quality[k])) {
+    }
+    if (pass == 0) sigma = SidesBlur(sides, phased);
+    std::array<Line2, 4> lines;
+    for (int k = 0; k < 4; ++k) {
+      if (!FitSide(gray, sides[k], normals[k], sigma[k], phased, &lines[k],
+                   &quality[k])) {
         return false;
       }
     }

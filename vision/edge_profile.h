@@ -37,6 +37,11 @@ struct EdgeProfile {
   // 2 (y % 2)), for a demosaiced image whose four phases have their own
   // blur (FitEdgeProfile's sigma per phase); empty: one blur for all.
   std::vector<int> phases;
+  // Width of a pixel's box along the normal, px, when the samples are
+  // pixel values (read at pixel centres): the model's step is then also
+  // averaged over that box (a pixel integrates the light over its area);
+  // 0 for interpolated samples.
+  double box_px = 0;
 };
 
 // Gaussian blur per Bayer phase (index (x % 2) + 2 (y % 2)), px.
