@@ -7,7 +7,8 @@
 //      clearance and hit rate with clearance in j3.
 //   5. (--only ur10) the UR10 series C timing at 240 and 2773 poses
 //      (--repeat R runs each, median; default 3); (--only ur10-240: the 240
-//      poses only);
+//      poses only); (--only ur10-abc) series A every 4th row, B and C
+//      together, one measuring frame per series (7246 poses);
 //   6. (--only cv) k-fold cross-validation of the selection on UR10 series
 //      C (240 and 2773 poses): time and findings with the single held-out
 //      split (--folds 0), 5 and 10 folds (linearised fold fits) and 5 folds
@@ -153,6 +154,57 @@ void Ur10Timing(int repeat, bool small_only) {
         obs->rows.size(), walls[repeat / 2], cpus[repeat / 2],
         result.nominal_heldout_rms_mm, result.final_heldout_rms_mm);
   }
+}
+
+// UR10 series A (every 4th row), B and C (../shared/data), each row
+// labelled with its series (one measuring frame each), as `kincal import
+// ipa-ur10 --every 4 --series A` etc. concatenate them: wall and CPU
+// seconds of the full diagnosis, median of `repeat` runs.
+void Ur10AbcTiming(int repeat) {
+  const std::string dir =
+      std::string(KINCAL_SOURCE_DIR) + "/../shared/data/ipa-robot-accuracy/";
+  const std::vector<std::pair<std::string, std::string>> files = {
+      {"A", "Series_A/measurements_grid.csv"},
+      {"B", "Series_B/measurements_joint_configurations.csv"},
+      {"C", "Series_C/measurements_random_poses.csv"}};
+  const Robot ur10 =
+      ReadRobotYaml(std::string(KINCAL_SOURCE_DIR) + "/data/robots/ur10.yaml");
+  Observations abc;
+  for (const auto& [name, file] : files) {
+    if (!std::ifstream(dir + file)) {
+      std::printf("== ur10-abc: %s absent, skipped\n", (dir + file).c_str());
+      return;
+    }
+    const Observations one =
+        ReadIpaSeries(dir + file, ur10.JointNames()).observations;
+    if (abc.rows.empty()) {
+      abc = one;
+      abc.rows.clear();
+    }
+    const int every = name == "A" ? 4 : 1;
+    for (size_t i = 0; i < one.rows.size(); i += every) {
+      Observation o = one.rows[i];
+      o.series = name;
+      o.pose = name + "-" + o.pose;
+      abc.rows.push_back(o);
+    }
+  }
+  std::vector<double> walls, cpus;
+  DiagnosisResult result;
+  for (int run = 0; run < repeat; ++run) {
+    double wall = 0, cpu = 0;
+    result = Timed(ur10, abc, DiagnoseOptions{}, &wall, &cpu);
+    walls.push_back(wall);
+    cpus.push_back(cpu);
+  }
+  std::sort(walls.begin(), walls.end());
+  std::sort(cpus.begin(), cpus.end());
+  std::printf(
+      "== ur10 series A every 4th + B + C (a frame per series): diagnose "
+      "model (default options), median of %d\n  %4zu poses: %6.2f s wall, "
+      "%6.2f s CPU, held-out %.4f -> %.4f mm\n",
+      repeat, abc.rows.size(), walls[repeat / 2], cpus[repeat / 2],
+      result.nominal_heldout_rms_mm, result.final_heldout_rms_mm);
 }
 
 std::string FindingsLabel(const DiagnosisResult& r) {
@@ -426,6 +478,7 @@ int main(int argc, char** argv) {
   if (only.empty() || only == "timing") kincal::Timing(bh7);
   if (only == "ur10") kincal::Ur10Timing(repeat, false);
   if (only == "ur10-240") kincal::Ur10Timing(repeat, true);
+  if (only == "ur10-abc") kincal::Ur10AbcTiming(repeat);
   if (only == "cv") kincal::CvUr10(repeat);
   if (only == "cv-sim") kincal::CvSimulated(runs);
   if (only.empty() || only == "backlash") kincal::SmallestBacklash(bh7, runs);

@@ -207,6 +207,7 @@ class GeometryFitRun {
     fit_.loss = options_.loss;
     fit_.loss_scale_mm = options_.loss_scale_mm;
     fit_.distances = problem_.distances;
+    fit_.num_threads = options_.num_threads;
     // The automatic ridge: on for single-point data only.
     const bool measured = std::any_of(
         train_.begin(), train_.end(),

@@ -46,6 +46,9 @@ struct CalibrateOptions {
   // the same held-out figures and 1 lets the tips pull it 0.4 mm off
   // (docs/REAL_DATA.md).
   double distance_weight = 10.0;
+  // The least-squares fits' residual and Jacobian passes (and Ceres's) on
+  // up to this many threads.
+  int num_threads = 1;
   // Extra parameters to free besides the row geometry (e.g. "j2.beta").
   std::vector<std::string> extra_params;
   // Fit the geometry (false: only the frame / fixed points, as `evaluate`).

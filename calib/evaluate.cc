@@ -19,11 +19,19 @@ Registration Register(const ModelState& start,
   for (size_t i = 0; i < ms.size(); ++i)
     if (!excluded[i]) used.push_back(ms[i]);
   InitializeFrameAndPoints(used, &out.state);
-  FitOptions options;
-  options.free = FrameParams();
-  for (const ParamInfo& p : PointParams(out.state)) options.free.push_back(p);
-  options.compute_covariance = false;
-  Fit(used, options, &out.state);
+  // Measured rows alone: the frames from InitializeFrameAndPoints (Umeyama
+  // per frame) already minimise the squared residuals, as the model's tips
+  // do not depend on them. Fixed points (and their frames) need the fit.
+  const bool only_measured = std::all_of(
+      used.begin(), used.end(),
+      [](const Measurement& m) { return m.kind == Measurement::kMeasured; });
+  if (!only_measured) {
+    FitOptions options;
+    options.free = FrameParams();
+    for (const ParamInfo& p : PointParams(out.state)) options.free.push_back(p);
+    options.compute_covariance = false;
+    Fit(used, options, &out.state);
+  }
   std::vector<double> used_errors;
   for (size_t i = 0; i < ms.size(); ++i) {
     out.errors_mm.push_back(Residual(out.state, ms[i]).norm());

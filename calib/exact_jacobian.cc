@@ -8,6 +8,7 @@
 #include <cmath>
 
 #include "data/error.h"
+#include "data/parallel.h"
 
 namespace kincal {
 namespace {
@@ -403,7 +404,7 @@ Eigen::Vector3d JacobianColumn(const PoseDerivatives& d, const ParamInfo& p) {
 void ResidualsAndJacobian(const std::vector<Measurement>& measurements,
                           const ModelState& state,
                           const std::vector<ParamInfo>& params,
-                          Eigen::VectorXd* r, Eigen::MatrixXd* J) {
+                          Eigen::VectorXd* r, Eigen::MatrixXd* J, int threads) {
   const Chain& chain = state.chain;
   const int n = chain.num_joints();
   KINCAL_CHECK(n <= kMaxJoints, "too many joints");
@@ -418,44 +419,81 @@ void ResidualsAndJacobian(const std::vector<Measurement>& measurements,
   for (int f = 0; f < state.NumFrames(); ++f)
     frames.push_back(MakeLinearFrame(state.FrameBlock(f)));
   const FreeHooks hooks = jacobian ? FindFreeHooks(params) : FreeHooks{};
-  JointValues joints;
-  ForwardPass fwd;
-  TipDerivatives tip;
-  for (int pose = 0; pose < m; ++pose) {
-    const Measurement& meas = measurements[pose];
-    if (meas.kind != Measurement::kMeasured) continue;
-    const PoseInput& in = meas.input;
-    const LinearFrame& frame = frames.at(meas.frame);
-    ComputeJointValues(chain, in, hooks, &joints);
-    RunForwardPass(chain, ops, in, joints, jacobian, &fwd);
-    // Drift and mount tilt (calib/chain.h TipInBase), then the frame.
-    const Eigen::Vector3d drifted =
-        fwd.tip +
-        Eigen::Vector3d(chain.drift[0], chain.drift[1], chain.drift[2]) *
-            in.t_h;
-    const Vec3<double> tilted =
-        MountTilt<double>(chain.drift.data(), in.moment, drifted);
-    r->segment<3>(3 * pose) = frame.r * tilted + frame.t - meas.p_in_meas;
-    if (!jacobian) continue;
+  // Each block of poses on its own thread: the rows are independent and
+  // the chain's operations, frames and hooks are read only.
+  const auto pose_block = [&](int begin, int end) {
+    JointValues joints;
+    ForwardPass fwd;
+    TipDerivatives tip;
+    for (int pose = begin; pose < end; ++pose) {
+      const Measurement& meas = measurements[pose];
+      if (meas.kind != Measurement::kMeasured) continue;
+      const PoseInput& in = meas.input;
+      const LinearFrame& frame = frames[meas.frame];
+      ComputeJointValues(chain, in, hooks, &joints);
+      RunForwardPass(chain, ops, in, joints, jacobian, &fwd);
+      // Drift and mount tilt (calib/chain.h TipInBase), then the frame.
+      const Eigen::Vector3d drifted =
+          fwd.tip +
+          Eigen::Vector3d(chain.drift[0], chain.drift[1], chain.drift[2]) *
+              in.t_h;
+      const Vec3<double> tilted =
+          MountTilt<double>(chain.drift.data(), in.moment, drifted);
+      r->segment<3>(3 * pose) = frame.r * tilted + frame.t - meas.p_in_meas;
+      if (!jacobian) continue;
 
-    ComputeTipDerivatives(ops, fwd, n, &tip);
-    Eigen::Matrix3d d_mount_p;
-    PoseDerivatives d;
-    MountTiltDerivatives(chain, in, drifted, hooks.need_global, &d_mount_p,
-                         &d.d_global);
-    d.chain = &chain;
-    d.in = &in;
-    d.frame = &frame;
-    d.frame_index = meas.frame;
-    d.joints = &joints;
-    d.fwd = &fwd;
-    d.tip = &tip;
-    d.d_tip = frame.r * d_mount_p;
-    d.d_global = frame.r * d.d_global;
-    d.tilted = tilted;
-    for (int c = 0; c < k; ++c)
-      J->block<3, 1>(3 * pose, c) = JacobianColumn(d, params[c]);
+      ComputeTipDerivatives(ops, fwd, n, &tip);
+      Eigen::Matrix3d d_mount_p;
+      PoseDerivatives d;
+      MountTiltDerivatives(chain, in, drifted, hooks.need_global, &d_mount_p,
+                           &d.d_global);
+      d.chain = &chain;
+      d.in = &in;
+      d.frame = &frame;
+      d.frame_index = meas.frame;
+      d.joints = &joints;
+      d.fwd = &fwd;
+      d.tip = &tip;
+      d.d_tip = frame.r * d_mount_p;
+      d.d_global = frame.r * d.d_global;
+      d.tilted = tilted;
+      for (int c = 0; c < k; ++c)
+        J->block<3, 1>(3 * pose, c) = JacobianColumn(d, params[c]);
+    }
+  };
+  for (const Measurement& meas : measurements) {
+    KINCAL_CHECK(
+        meas.kind != Measurement::kMeasured ||
+            (meas.frame >= 0 && meas.frame < state.NumFrames()),
+        "a measured row's frame " << meas.frame << " of " << state.NumFrames());
   }
+  // Below a few hundred poses a thread costs more than it saves.
+  constexpr int kPosesPerThread = 256;
+  const std::vector<std::pair<int, int>> blocks =
+      EvenRanges(m, std::min(threads, m / kPosesPerThread));
+  ParallelFor(static_cast<int>(blocks.size()), static_cast<int>(blocks.size()),
+              [&](int b) { pose_block(blocks[b].first, blocks[b].second); });
+}
+
+Eigen::MatrixXd NormalMatrix(const Eigen::MatrixXd& J, int threads) {
+  const int k = static_cast<int>(J.cols());
+  // Below a few thousand rows per thread the split costs more than it saves.
+  constexpr int kRowsPerThread = 2048;
+  const std::vector<std::pair<int, int>> blocks = EvenRanges(
+      static_cast<int>(J.rows()),
+      std::max(1, std::min<int>(threads, J.rows() / kRowsPerThread)));
+  std::vector<Eigen::MatrixXd> parts(blocks.size());
+  ParallelFor(
+      static_cast<int>(blocks.size()), static_cast<int>(blocks.size()),
+      [&](int b) {
+        parts[b] = Eigen::MatrixXd::Zero(k, k);
+        parts[b].selfadjointView<Eigen::Lower>().rankUpdate(
+            J.middleRows(blocks[b].first, blocks[b].second - blocks[b].first)
+                .transpose());
+      });
+  Eigen::MatrixXd a = Eigen::MatrixXd::Zero(k, k);
+  for (const Eigen::MatrixXd& part : parts) a += part;
+  return a.selfadjointView<Eigen::Lower>();
 }
 
 }  // namespace kincal

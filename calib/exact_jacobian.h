@@ -31,11 +31,17 @@ namespace kincal {
 
 // Residuals r (3 per measurement, model - measured, mm) and, when J is not
 // null, dr / d params (internal units), 3 m x params.size(). Measured rows
-// only (kMeasured); fixed-point rows give zero rows.
+// only (kMeasured); fixed-point rows give zero rows. `threads`: the poses
+// shared among up to that many threads (blocks of at least 256 poses).
 void ResidualsAndJacobian(const std::vector<Measurement>& measurements,
                           const ModelState& state,
                           const std::vector<ParamInfo>& params,
-                          Eigen::VectorXd* r, Eigen::MatrixXd* J);
+                          Eigen::VectorXd* r, Eigen::MatrixXd* J,
+                          int threads = 1);
+
+// J^T J, the rows of J cut into blocks on up to `threads` threads (each a
+// symmetric rank update, the blocks then summed), symmetric in full.
+Eigen::MatrixXd NormalMatrix(const Eigen::MatrixXd& J, int threads = 1);
 
 }  // namespace kincal
 

@@ -123,6 +123,23 @@ void Check(const Robot& robot, uint64_t seed) {
   Eigen::VectorXd r2;
   ResidualsAndJacobian(ms, state, params, &r2, nullptr);
   EXPECT_EQ((r2 - r).norm(), 0.0);
+
+  // Poses shared among threads (blocks of 256 or more): the same residuals
+  // and Jacobian; the normal matrix in row blocks: J^T J.
+  std::vector<Measurement> many;
+  while (many.size() < 1400) many.insert(many.end(), ms.begin(), ms.end());
+  Eigen::VectorXd r_one, r_two;
+  Eigen::MatrixXd J_one, J_two;
+  ResidualsAndJacobian(many, state, params, &r_one, &J_one, 1);
+  ResidualsAndJacobian(many, state, params, &r_two, &J_two, 2);
+  EXPECT_EQ((r_two - r_one).norm(), 0.0);
+  EXPECT_EQ((J_two - J_one).norm(), 0.0);
+  const Eigen::MatrixXd normal = J_one.transpose() * J_one;
+  for (int threads : {1, 2}) {
+    const Eigen::MatrixXd a = NormalMatrix(J_one, threads);
+    EXPECT_LT((a - normal).norm(), 1e-12 * normal.norm()) << threads;
+    EXPECT_EQ((a - a.transpose()).norm(), 0.0) << threads;
+  }
 }
 
 TEST(ExactJacobianTest, MatchesAutodiffDh) {

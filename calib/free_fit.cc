@@ -58,7 +58,8 @@ double BoundedLevenbergMarquardt(const std::vector<Measurement>& ms,
   Eigen::VectorXd r;
   Eigen::MatrixXd J;
   if (k == 0 || ms.empty()) {
-    ResidualsAndJacobian(ms, *state, options.free, &r, nullptr);
+    ResidualsAndJacobian(ms, *state, options.free, &r, nullptr,
+                         options.num_threads);
     return r.squaredNorm();
   }
   double cost = 0.0;
@@ -69,11 +70,10 @@ double BoundedLevenbergMarquardt(const std::vector<Measurement>& ms,
   Eigen::VectorXd s(k);
   for (int it = 0; it < options.max_iterations; ++it) {
     if (need_jacobian) {
-      ResidualsAndJacobian(ms, *state, options.free, &r, &J);
+      ResidualsAndJacobian(ms, *state, options.free, &r, &J,
+                           options.num_threads);
       cost = r.squaredNorm();
-      Eigen::MatrixXd A = Eigen::MatrixXd::Zero(k, k);
-      A.selfadjointView<Eigen::Lower>().rankUpdate(J.transpose());
-      A = A.selfadjointView<Eigen::Lower>();
+      const Eigen::MatrixXd A = NormalMatrix(J, options.num_threads);
       for (int i = 0; i < k; ++i)  // Jacobi scaling, as Ceres
         s[i] = A(i, i) > 0 ? 1.0 / std::sqrt(A(i, i)) : 1.0;
       As = s.asDiagonal() * A * s.asDiagonal();
@@ -100,7 +100,8 @@ double BoundedLevenbergMarquardt(const std::vector<Measurement>& ms,
       double cost_new = std::numeric_limits<double>::infinity();
       if (step.allFinite()) {
         set(x_new);
-        ResidualsAndJacobian(ms, *state, options.free, &r_new, nullptr);
+        ResidualsAndJacobian(ms, *state, options.free, &r_new, nullptr,
+                             options.num_threads);
         cost_new = r_new.squaredNorm();
       }
       if (std::isfinite(cost_new) && cost_new <= cost) {
@@ -149,6 +150,7 @@ FreeFitOptions FreeFitOptionsFrom(const FitOptions& fit_options) {
   o.max_iterations = fit_options.max_iterations;
   o.function_tolerance = fit_options.function_tolerance;
   o.parameter_tolerance = fit_options.parameter_tolerance;
+  o.num_threads = fit_options.num_threads;
   return o;
 }
 
@@ -168,7 +170,8 @@ FitSummary FreeFitWithCovariance(const std::vector<Measurement>& measurements,
   FreeFit(measurements, options, state);
   Eigen::VectorXd r;
   Eigen::MatrixXd J;
-  ResidualsAndJacobian(measurements, *state, options.free, &r, &J);
+  ResidualsAndJacobian(measurements, *state, options.free, &r, &J,
+                       options.num_threads);
   const int p = static_cast<int>(options.free.size());
   summary.converged = true;
   summary.params = options.free;

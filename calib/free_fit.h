@@ -25,6 +25,9 @@ struct FreeFitOptions {
   int max_iterations = 100;
   double function_tolerance = 1e-10;
   double parameter_tolerance = 1e-10;
+  // The residual and Jacobian passes over the rows on up to this many
+  // threads (calib/exact_jacobian.h).
+  int num_threads = 1;
 };
 
 // The same free parameters, box and stopping rules as a calib/fit.h fit

@@ -128,7 +128,8 @@ double CrossValidatedRms(const std::vector<Measurement>& ms,
   Eigen::VectorXd r_own;
   Eigen::MatrixXd J_own;
   if (r_in == nullptr || J_in == nullptr) {
-    ResidualsAndJacobian(ms, fitted, options.free, &r_own, &J_own);
+    ResidualsAndJacobian(ms, fitted, options.free, &r_own, &J_own,
+                         options.num_threads);
     r_in = &r_own;
     J_in = &J_own;
   }

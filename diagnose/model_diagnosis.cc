@@ -97,9 +97,10 @@ struct Problem {
 // 1.88 mm RMS (another minimum, 0.14 after the passes) and the catalogue
 // found nothing; with bounds pressed it named `thermal` for a backlash.
 // `solver`: the least-squares solver of every fit (same problem,
-// calib/fit.h's tolerances).
+// calib/fit.h's tolerances), on `threads` threads.
 void FitBase(const std::vector<Measurement>& fit_on, const Observations& obs,
-             bool bounds_stated, GeometrySolver solver, Problem* problem) {
+             bool bounds_stated, GeometrySolver solver, int threads,
+             Problem* problem) {
   ModelState& state = problem->base_state;
   InitializeFrameAndPoints(fit_on, &state);
   std::vector<ParamInfo> nuisance;
@@ -112,6 +113,7 @@ void FitBase(const std::vector<Measurement>& fit_on, const Observations& obs,
   FitOptions frame_only;
   frame_only.free = nuisance;
   frame_only.compute_covariance = false;
+  frame_only.num_threads = threads;
   // The misfit after registering, per axis (calib/fit.h's sigma0).
   double registered_sigma0 = 0.0;
   if (solver == GeometrySolver::kExactJacobian) {
@@ -160,7 +162,9 @@ void FitBase(const std::vector<Measurement>& fit_on, const Observations& obs,
   geometry.train = &train;
   geometry.check = check;
   geometry.solver = solver;
-  const GeometryFit g = FitGeometry(geometry, CalibrateOptions{}, &state);
+  CalibrateOptions calibrate_options;
+  calibrate_options.num_threads = threads;
+  const GeometryFit g = FitGeometry(geometry, calibrate_options, &state);
   problem->base_free = g.identifiability.identifiable;
   problem->bound_override = g.fit_options.bound_override;
 }
@@ -379,12 +383,15 @@ struct Selection {
   int num_residuals = 0;                // 3 x training poses
   bool thermal_kelvin = false;          // thermal per kelvin, not per second
 
-  // The cross-validation's refits of `free` in the geometry's box.
-  FreeFitOptions CvOptions(const std::vector<ParamInfo>& free) const {
+  // The cross-validation's refits of `free` in the geometry's box, on
+  // `threads` threads (1 inside the candidates' parallel screening).
+  FreeFitOptions CvOptions(const std::vector<ParamInfo>& free,
+                           int threads = 1) const {
     FreeFitOptions o;
     o.free = free;
     o.bounds_center = &problem.nominal;
     o.bound_override = problem.bound_override;
+    o.num_threads = threads;
     return o;
   }
   double Scale(const Candidate& c) const {
@@ -416,10 +423,10 @@ CurrentModel BaseModel(const Selection& selection, DiagnosisResult* out) {
   out->nominal_heldout_rms_mm = Rms(current.state, problem.held);
   current.rss = Rss(current.state, problem.train);
   current.heldout_rms_mm = out->nominal_heldout_rms_mm;
-  out->nominal_cv_rms_mm =
-      CrossValidatedRms(problem.train, selection.folds, current.state,
-                        selection.CvOptions(current.free),
-                        selection.options.cv_refit, &current.cv_err);
+  out->nominal_cv_rms_mm = CrossValidatedRms(
+      problem.train, selection.folds, current.state,
+      selection.CvOptions(current.free, selection.options.num_threads),
+      selection.options.cv_refit, &current.cv_err);
   current.cv_rms_mm = out->nominal_cv_rms_mm;
   out->nominal_validation_rms_mm =
       ValidationRms(current.state, selection.validation);
@@ -471,10 +478,11 @@ StepLinearization Linearize(const Selection& selection,
     lin.validation_frames.frame_series.clear();
     InitializeFrameAndPoints(selection.validation, &lin.validation_frames);
   }
+  const int threads = selection.options.num_threads;
   Eigen::MatrixXd base_jac;
   ResidualsAndJacobian(problem.train, current.state, current.free, &lin.r0,
-                       &base_jac);
-  const Eigen::MatrixXd basis = Basis(Normalized(base_jac));
+                       &base_jac, threads);
+  const Eigen::MatrixXd basis = Basis(Normalized(base_jac), threads);
   // (Drift is trimmed to its identifiable part below, so it starts whole
   // each step; gravity's joints come from the catalogue and are kept.)
   for (Candidate& c : *pool) {
@@ -493,7 +501,7 @@ StepLinearization Linearize(const Selection& selection,
   }
   Eigen::VectorXd unused;
   ResidualsAndJacobian(problem.train, current.state, all_params, &unused,
-                       &lin.cand_jac);
+                       &lin.cand_jac, threads);
   std::vector<int> screen_cols;
   for (size_t q = 0; q < current.free.size(); ++q) {
     if (current.free[q].kind == ParamKind::kJointError ||
@@ -505,10 +513,11 @@ StepLinearization Linearize(const Selection& selection,
   lin.screen_jac.resize(base_jac.rows(), screen_cols.size());
   for (size_t q = 0; q < screen_cols.size(); ++q)
     lin.screen_jac.col(q) = base_jac.col(screen_cols[q]);
-  lin.screen_normal = lin.screen_jac.transpose() * lin.screen_jac;
+  lin.screen_normal = NormalMatrix(lin.screen_jac, threads);
   lin.screen_gradient = lin.screen_jac.transpose() * lin.r0;
   // Every candidate column off the current model's span, in one product.
-  const Eigen::MatrixXd projected = ProjectedOffBasis(basis, lin.cand_jac);
+  const Eigen::MatrixXd projected =
+      ProjectedOffBasis(basis, lin.cand_jac, threads);
   lin.usable.resize(pool->size());
   for (size_t c = 0; c < pool->size(); ++c) {
     lin.usable[c] = ReduceToIdentifiable(
@@ -592,12 +601,17 @@ CandidateFit ScreenCandidate(const Selection& selection,
   const double lin_rss = std::max(current.rss - lin_drop, 1e-300);
   const bool hopeless = LogFUpperTail((lin_drop / s.k) / (lin_rss / d2), s.k,
                                       d2) > std::log(100.0 * alpha);
-  if (!hopeless)
-    FreeFit(problem.train, FreeFitOptionsFrom(refit_options), &fit.state);
-  Eigen::VectorXd rt, rh;
-  ResidualsAndJacobian(problem.train, fit.state, {}, &rt, nullptr);
+  // The refit returns its training RSS; the start's is computed.
+  if (hopeless) {
+    Eigen::VectorXd rt;
+    ResidualsAndJacobian(problem.train, fit.state, {}, &rt, nullptr);
+    s.rss = rt.squaredNorm();
+  } else {
+    s.rss =
+        FreeFit(problem.train, FreeFitOptionsFrom(refit_options), &fit.state);
+  }
+  Eigen::VectorXd rh;
   ResidualsAndJacobian(problem.held, fit.state, {}, &rh, nullptr);
-  s.rss = rt.squaredNorm();
   s.train_rms_mm = std::sqrt(s.rss / static_cast<double>(problem.train.size()));
   s.heldout_rms_mm = problem.held.empty()
                          ? kNaN
@@ -717,7 +731,10 @@ void RefitWinnerJointly(const Selection& selection, const CurrentModel& current,
   std::vector<ParamInfo> refit_free = current.free;
   for (const ParamInfo& q : winner.params) refit_free.push_back(q);
   const FitOptions refit_options = problem.CandidateRefit(refit_free);
-  FreeFit(problem.train, FreeFitOptionsFrom(refit_options), &fit->state);
+  const int threads = selection.options.num_threads;
+  FreeFitOptions free_options = FreeFitOptionsFrom(refit_options);
+  free_options.num_threads = threads;
+  FreeFit(problem.train, free_options, &fit->state);
   CandidateScore& w = fit->score;
   w.rss = Rss(fit->state, problem.train);
   w.train_rms_mm = Rms(fit->state, problem.train);
@@ -728,9 +745,10 @@ void RefitWinnerJointly(const Selection& selection, const CurrentModel& current,
                                    selection.Scale(winner))
                     .value;
   if (selection.WithFolds()) {
-    w.cv_rms_mm = CrossValidatedRms(problem.train, selection.folds, fit->state,
-                                    selection.CvOptions(refit_options.free),
-                                    selection.options.cv_refit, &fit->cv_err);
+    w.cv_rms_mm =
+        CrossValidatedRms(problem.train, selection.folds, fit->state,
+                          selection.CvOptions(refit_options.free, threads),
+                          selection.options.cv_refit, &fit->cv_err);
   }
   if (!(w.rss <= screened.score.rss) ||
       (!selection.validation.empty() &&
@@ -865,6 +883,7 @@ Refit FinalRefit(const Selection& selection, const CurrentModel& current,
   ModelState final_state = current.state;
   FitOptions fit_options = selection.problem.Boxed(current.free);
   fit_options.compute_covariance = true;
+  fit_options.num_threads = selection.options.num_threads;
   const FitSummary final_fit = FreeFitWithCovariance(
       selection.problem.all, FreeFitOptionsFrom(fit_options), &final_state);
   for (size_t i = 0; i < accepted.size(); ++i) {
@@ -1007,7 +1026,7 @@ DiagnosisResult DiagnoseModel(const Robot& nominal, const Observations& obs,
   out.heldout_poses = static_cast<int>(problem.held.size());
   out.folds = FoldCount(problem, obs, options);
   FitBase(problem.train, obs, nominal.bounds_stated,
-          GeometrySolver::kExactJacobian, &problem);
+          GeometrySolver::kExactJacobian, options.num_threads, &problem);
 
   Selection selection(problem, obs, options);
   if (out.folds >= 2)
@@ -1034,8 +1053,9 @@ DiagnosisResult DiagnoseModel(const Robot& nominal, const Observations& obs,
   out.verdict = out.findings.empty() ? "no_significant_effect" : "effect_found";
   PerPoseResiduals(problem, final_state, &out);
   if (current.state.NumFrames() > 1)
-    out.series = CheckSeries(obs, problem.train, problem.held, current.state,
-                             current.free, options.false_alarm);
+    out.series =
+        CheckSeries(obs, problem.train, problem.held, current.state,
+                    current.free, options.false_alarm, options.num_threads);
   out.state = final_state;
   FitRecordInput record;
   record.obs = &obs;
@@ -1097,7 +1117,7 @@ std::vector<Magnitude> FitCandidates(const Robot& nominal,
   for (Measurement& m : problem.all)
     FillTransmissionSines(problem.nominal, &m.input);
   FitBase(problem.all, obs, nominal.bounds_stated, GeometrySolver::kCeres,
-          &problem);
+          /*threads=*/1, &problem);
   const std::vector<Candidate> catalogue =
       CatalogueCandidates(problem.nominal, problem.all);
   const Eigen::MatrixXd basis = Basis(Normalized(

@@ -62,11 +62,11 @@ Eigen::Vector3d ScaleColumn(const ModelState& state, const Measurement& m,
 // The relative scales' test and the shared scale's sine (SeriesChecks).
 void TestScales(const std::vector<Measurement>& train, const ModelState& state,
                 const std::vector<ParamInfo>& free, double false_alarm,
-                SeriesChecks* out) {
+                int threads, SeriesChecks* out) {
   const int frames = state.NumFrames();
   Eigen::VectorXd r;
   Eigen::MatrixXd jac;
-  ResidualsAndJacobian(train, state, free, &r, &jac);
+  ResidualsAndJacobian(train, state, free, &r, &jac, threads);
   const int n = static_cast<int>(r.size()), p = static_cast<int>(jac.cols());
   const int q = frames - 1;
   Eigen::MatrixXd scales = Eigen::MatrixXd::Zero(n, q);
@@ -85,7 +85,7 @@ void TestScales(const std::vector<Measurement>& train, const ModelState& state,
   Eigen::VectorXd norms = a.colwise().norm();
   for (int c = 0; c < a.cols(); ++c)
     if (norms(c) > 0) a.col(c) /= norms(c);
-  const Eigen::MatrixXd normal = a.transpose() * a;
+  const Eigen::MatrixXd normal = NormalMatrix(a, threads);
   const Eigen::VectorXd gradient = a.transpose() * r;
   const Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd> full(
       normal.topLeftCorner(p + q, p + q));
@@ -124,8 +124,8 @@ SeriesChecks CheckSeries(const Observations& obs,
                          const std::vector<Measurement>& train,
                          const std::vector<Measurement>& held,
                          const ModelState& state,
-                         const std::vector<ParamInfo>& free,
-                         double false_alarm) {
+                         const std::vector<ParamInfo>& free, double false_alarm,
+                         int threads) {
   SeriesChecks out;
   const int frames = state.NumFrames();
   out.series.resize(frames);
@@ -152,7 +152,7 @@ SeriesChecks CheckSeries(const Observations& obs,
     check.scale_sigma_ppm = f == 0 ? kNaN : 0.0;
     RobotOrInstrument(obs, rows, train_res, &check);
   }
-  if (frames > 1) TestScales(train, state, free, false_alarm, &out);
+  if (frames > 1) TestScales(train, state, free, false_alarm, threads, &out);
   return out;
 }
 

@@ -58,13 +58,14 @@ struct SeriesChecks {
 
 // `train` / `held`: the measurements (Measurement::frame = series index,
 // ModelState::frame_series), `state` the final model, `free` its free
-// parameters (frames included). `false_alarm`: the scale test's level.
+// parameters (frames included). `false_alarm`: the scale test's level;
+// `threads`: its Jacobian and normal equations on up to that many threads.
 SeriesChecks CheckSeries(const Observations& obs,
                          const std::vector<Measurement>& train,
                          const std::vector<Measurement>& held,
                          const ModelState& state,
-                         const std::vector<ParamInfo>& free,
-                         double false_alarm);
+                         const std::vector<ParamInfo>& free, double false_alarm,
+                         int threads = 1);
 
 }  // namespace kincal
 

@@ -7,12 +7,11 @@
 
 #include <Eigen/Core>
 #include <algorithm>
-#include <atomic>
-#include <thread>
 #include <vector>
 
 #include "calib/fit.h"
 #include "calib/model_state.h"
+#include "data/parallel.h"
 
 namespace kincal {
 
@@ -23,17 +22,19 @@ double FDistributionUpperTail(double f, double d1, double d2);
 
 // Column-normalised Jacobian columns; zero columns stay zero.
 Eigen::MatrixXd Normalized(Eigen::MatrixXd j);
-// Orthonormal basis of the column span of `a` (rank-revealing QR).
-Eigen::MatrixXd Basis(const Eigen::MatrixXd& a);
+// Orthonormal basis of the column span of `a` (QR; rank-revealing where the
+// columns come near dependence), on up to `threads` threads.
+Eigen::MatrixXd Basis(const Eigen::MatrixXd& a, int threads = 1);
 // Which columns of `cand` (normalised) keep a part outside the span of
 // `basis` and of the candidate's earlier accepted columns (sine > 1e-5).
 std::vector<bool> IndependentColumns(const Eigen::MatrixXd& basis,
                                      const Eigen::MatrixXd& cand);
 // The same in two parts, so that many candidates share one projection: the
 // normalised columns minus their part in the span of `basis`, then which of
-// those keep a part outside the earlier accepted ones.
+// those keep a part outside the earlier accepted ones. `threads`: blocks of
+// columns projected in parallel.
 Eigen::MatrixXd ProjectedOffBasis(const Eigen::MatrixXd& basis,
-                                  const Eigen::MatrixXd& cand);
+                                  const Eigen::MatrixXd& cand, int threads = 1);
 std::vector<bool> IndependentProjectedColumns(const Eigen::MatrixXd& rest);
 // True when every column of `cand` is independent of `basis`.
 bool IdentifiableAgainst(const Eigen::MatrixXd& basis,
@@ -47,23 +48,6 @@ double RepeatedPoseNoise(const std::vector<Measurement>& ms);
 double NearestPoseNoise(const ModelState& state,
                         const std::vector<Measurement>& ms);
 
-// Runs `work(i)` for i in [0, n) on up to `threads` threads.
-template <typename F>
-void ParallelFor(int n, int threads, const F& work) {
-  threads = std::max(1, std::min(threads, n));
-  if (threads == 1) {
-    for (int i = 0; i < n; ++i) work(i);
-    return;
-  }
-  std::atomic<int> next(0);
-  std::vector<std::thread> pool;
-  for (int t = 0; t < threads; ++t) {
-    pool.emplace_back([&] {
-      for (int i = next++; i < n; i = next++) work(i);
-    });
-  }
-  for (std::thread& t : pool) t.join();
-}
 }  // namespace kincal
 
 #endif  // KINCAL_DIAGNOSE_STATISTICS_H_

@@ -2,7 +2,6 @@
 
 #include <gtest/gtest.h>
 
-#include <atomic>
 #include <cmath>
 #include <random>
 
@@ -63,10 +62,41 @@ TEST(StatisticsTest, RepeatedPoseNoiseRecoversSigma) {
   EXPECT_EQ(RepeatedPoseNoise(ms), 0.0);
 }
 
-TEST(StatisticsTest, ParallelForRunsEachIndexOnce) {
-  std::vector<std::atomic<int>> hits(57);
-  ParallelFor(57, 3, [&](int i) { ++hits[i]; });
-  for (const auto& h : hits) EXPECT_EQ(h.load(), 1);
+// Basis: orthonormal columns spanning `a`, on one thread or two, whether
+// the columns are independent (the Cholesky QR), nearly dependent (sine
+// 1e-8: the rank-revealing QR keeps it) or dependent (it drops it).
+TEST(StatisticsTest, BasisSpansTheColumnsAndDropsDependentOnes) {
+  std::mt19937 rng(3);
+  std::normal_distribution<double> n(0.0, 1.0);
+  Eigen::MatrixXd a(9000, 12);
+  for (int i = 0; i < a.rows(); ++i)
+    for (int j = 0; j < a.cols(); ++j) a(i, j) = n(rng) * (1 + j);
+  const auto check = [](const Eigen::MatrixXd& m, int rank) {
+    for (int threads : {1, 2}) {
+      const Eigen::MatrixXd q = Basis(Normalized(m), threads);
+      ASSERT_EQ(q.cols(), rank) << threads;
+      EXPECT_LT(
+          (q.transpose() * q - Eigen::MatrixXd::Identity(q.cols(), q.cols()))
+              .cwiseAbs()
+              .maxCoeff(),
+          1e-12)
+          << threads;
+      const Eigen::MatrixXd off = m - q * (q.transpose() * m);
+      EXPECT_LT(off.norm(), 1e-10 * m.norm()) << threads;
+    }
+  };
+  check(a, 12);
+  Eigen::MatrixXd near = a;
+  near.col(11) = a.col(0) + a.col(1) + 1e-8 * a.col(11);
+  check(near, 12);
+  Eigen::MatrixXd dependent = a;
+  dependent.col(11) = a.col(0) - 2.0 * a.col(3);
+  check(dependent, 11);
+  // The projection off it: the same on two threads.
+  const Eigen::MatrixXd q = Basis(Normalized(a.leftCols(6)));
+  EXPECT_LT((ProjectedOffBasis(q, a, 2) - ProjectedOffBasis(q, a, 1)).norm(),
+            1e-12);
+  EXPECT_LT(ProjectedOffBasis(q, a, 2).leftCols(6).norm(), 1e-12);
 }
 
 }  // namespace
