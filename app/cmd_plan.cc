@@ -4,8 +4,10 @@
 
 #include <cmath>
 #include <cstdio>
+#include <iostream>
 #include <memory>
 #include <optional>
+#include <sstream>
 
 #include "app/app_util.h"
 #include "app/command.h"
@@ -69,6 +71,41 @@ void UseUrdfCollisionGeometry(const Robot& robot, PlanArgs* args) {
   args->options.safety.links = std::move(links);
 }
 
+// Each joint's coverage: travel, largest gap, whether it is wide.
+nlohmann::json CoverageJson(const std::vector<JointCoverage>& coverage) {
+  nlohmann::json out = nlohmann::json::array();
+  for (const JointCoverage& c : coverage) {
+    out.push_back({{"joint", c.joint},
+                   {"circular", c.circular},
+                   {"travel", {Number(c.lo), Number(c.hi)}},
+                   {"largest_gap", Number(c.Gap())},
+                   {"gap", {Number(c.from), Number(c.to)}},
+                   {"wide", c.wide}});
+  }
+  return out;
+}
+
+// A campaign for the diagnosis (--criterion coverage) whose poses still
+// leave a joint a wide gap (more poses, or obstacles and visibility that
+// close part of the travel): a warning naming the joint and the gap.
+void AddCoverageWarnings(const PlanResult& plan, PlanArgs* args) {
+  if (args->options.criterion != PlanOptions::kCoverage) return;
+  Warnings warnings(args->json ? nullptr : &std::cerr);
+  for (const JointCoverage& c : plan.planned_coverage) {
+    if (!c.wide) continue;
+    std::ostringstream os;
+    os.precision(4);
+    os << "joint '" << c.joint << "': the planned poses leave " << c.Gap()
+       << " of its " << (c.circular ? "turn" : "travel") << " without a "
+       << "reading (" << c.from << " .. " << c.to << "), over 10 % of it: "
+       << "a joint error fitted on them is not supported there; plan more "
+       << "poses (--n), or widen what --obstacles, --limit-margin and the "
+       << "rig leave reachable";
+    warnings.Add("travel_gap", os.str());
+  }
+  for (const Warning& w : warnings.list()) args->warnings.push_back(w);
+}
+
 // The safety fields both JSON objects share.
 void SafetyJson(const PlanArgs& args, nlohmann::json* j) {
   (*j)["link_geometry"] = args.link_geometry;
@@ -106,6 +143,8 @@ nlohmann::json PlanJson(const PlanArgs& args, const Robot& robot,
                                {"O3", Number(plan.random.o3)},
                                {"O4", Number(plan.random.o4)}};
   j["random_log_det"] = Number(plan.random.log_det);
+  j["coverage"] = {{"planned", CoverageJson(plan.planned_coverage)},
+                   {"random", CoverageJson(plan.random_coverage)}};
   j["joint_travel"] = Number(plan.planned.joint_travel);
   j["random_joint_travel"] = Number(plan.random.joint_travel);
   j["unidentifiable"] = plan.unidentifiable;
@@ -298,8 +337,10 @@ int RunPlan(PlanArgs args) {
     args.options.criterion = PlanOptions::kDOptimal;
   } else if (args.criterion == "sigma") {
     args.options.criterion = PlanOptions::kSigma;
+  } else if (args.criterion == "coverage") {
+    args.options.criterion = PlanOptions::kCoverage;
   } else {
-    throw InputError("--criterion: expected 'd' or 'sigma', got '" +
+    throw InputError("--criterion: expected 'd', 'sigma' or 'coverage', got '" +
                      args.criterion + "'");
   }
   Progress progress("kincal plan", args.json);
@@ -308,6 +349,7 @@ int RunPlan(PlanArgs args) {
   };
   const PlanResult plan = PlanPoses(robot, args.options);
   progress.Done();
+  AddCoverageWarnings(plan, &args);
   WriteFileAtomic(args.out, FormatPosesCsv(robot, plan.poses));
   if (!args.random_out.empty()) {
     WriteFileAtomic(args.random_out, FormatPosesCsv(robot, plan.random_poses));
@@ -338,6 +380,13 @@ int RunPlan(PlanArgs args) {
       "%.2f (random %.2f)\n",
       plan.random_sigma_gmean / plan.planned_sigma_gmean,
       plan.planned.joint_travel, plan.random.joint_travel);
+  std::printf("  travel coverage, largest gap without a reading (random):\n");
+  for (size_t j = 0; j < plan.planned_coverage.size(); ++j) {
+    const JointCoverage& c = plan.planned_coverage[j];
+    std::printf("    %-24s %8.2f of %.6g%s (%.2f)%s\n", c.joint.c_str(),
+                c.Gap(), c.hi - c.lo, c.circular ? " (one turn)" : "",
+                plan.random_coverage[j].Gap(), c.wide ? "  wide" : "");
+  }
   return 0;
 }
 
@@ -383,7 +432,9 @@ void AddPlanCommand(CLI::App& app, Runner* run) {
       ->check(CLI::Range(1.0, 89.0));
   sub->add_option("--criterion", args->criterion,
                   "sigma: minimise the product of the robot parameters' "
-                  "predicted sigmas; d: D-optimal (log det)");
+                  "predicted sigmas; d: D-optimal (log det); coverage: a "
+                  "campaign for diagnose model, every joint's readings "
+                  "spread over its travel");
   sub->add_option("--extreme", args->options.extreme_fraction,
                   "probability that a candidate puts a joint at a limit")
       ->check(CLI::Range(0.0, 1.0));

@@ -106,6 +106,29 @@ DiagnosisResult Timed(const Robot& robot, const Observations& obs,
   return r;
 }
 
+// `runs` diagnoses timed: the last one's result, the median wall and CPU
+// seconds.
+struct MedianTiming {
+  DiagnosisResult result;
+  double wall = 0, cpu = 0;
+};
+MedianTiming TimedMedian(const Robot& robot, const Observations& obs,
+                         const DiagnoseOptions& o, int runs) {
+  MedianTiming out;
+  std::vector<double> walls, cpus;
+  for (int run = 0; run < runs; ++run) {
+    double wall = 0, cpu = 0;
+    out.result = Timed(robot, obs, o, &wall, &cpu);
+    walls.push_back(wall);
+    cpus.push_back(cpu);
+  }
+  std::sort(walls.begin(), walls.end());
+  std::sort(cpus.begin(), cpus.end());
+  out.wall = walls[runs / 2];
+  out.cpu = cpus[runs / 2];
+  return out;
+}
+
 // UR10 series C from ../shared/data and its every 11th pose (240); false
 // (with a line saying so) when the data are absent.
 bool LoadUr10SeriesC(const char* tag, Robot* ur10, Observations* all,
@@ -139,20 +162,11 @@ void Ur10Timing(int repeat, bool small_only) {
       repeat);
   for (const Observations* obs : {&small, &all}) {
     if (small_only && obs == &all) break;
-    DiagnosisResult result;
-    std::vector<double> walls, cpus;
-    for (int run = 0; run < repeat; ++run) {
-      double wall = 0, cpu = 0;
-      result = Timed(ur10, *obs, DiagnoseOptions{}, &wall, &cpu);
-      walls.push_back(wall);
-      cpus.push_back(cpu);
-    }
-    std::sort(walls.begin(), walls.end());
-    std::sort(cpus.begin(), cpus.end());
+    const MedianTiming t = TimedMedian(ur10, *obs, DiagnoseOptions{}, repeat);
     std::printf(
         "  %4zu poses: %6.2f s wall, %6.2f s CPU, held-out %.4f -> %.4f mm\n",
-        obs->rows.size(), walls[repeat / 2], cpus[repeat / 2],
-        result.nominal_heldout_rms_mm, result.final_heldout_rms_mm);
+        obs->rows.size(), t.wall, t.cpu, t.result.nominal_heldout_rms_mm,
+        t.result.final_heldout_rms_mm);
   }
 }
 
@@ -189,22 +203,13 @@ void Ur10AbcTiming(int repeat) {
       abc.rows.push_back(o);
     }
   }
-  std::vector<double> walls, cpus;
-  DiagnosisResult result;
-  for (int run = 0; run < repeat; ++run) {
-    double wall = 0, cpu = 0;
-    result = Timed(ur10, abc, DiagnoseOptions{}, &wall, &cpu);
-    walls.push_back(wall);
-    cpus.push_back(cpu);
-  }
-  std::sort(walls.begin(), walls.end());
-  std::sort(cpus.begin(), cpus.end());
+  const MedianTiming t = TimedMedian(ur10, abc, DiagnoseOptions{}, repeat);
   std::printf(
       "== ur10 series A every 4th + B + C (a frame per series): diagnose "
       "model (default options), median of %d\n  %4zu poses: %6.2f s wall, "
       "%6.2f s CPU, held-out %.4f -> %.4f mm\n",
-      repeat, abc.rows.size(), walls[repeat / 2], cpus[repeat / 2],
-      result.nominal_heldout_rms_mm, result.final_heldout_rms_mm);
+      repeat, abc.rows.size(), t.wall, t.cpu, t.result.nominal_heldout_rms_mm,
+      t.result.final_heldout_rms_mm);
 }
 
 std::string FindingsLabel(const DiagnosisResult& r) {
@@ -255,23 +260,15 @@ void CvUr10(int repeat) {
       DiagnoseOptions o;
       o.folds = m.folds;
       o.cv_refit = m.refit;
-      std::vector<double> walls, cpus;
-      DiagnosisResult r;
       const int runs = m.refit && obs == &all ? 1 : repeat;
-      for (int run = 0; run < runs; ++run) {
-        double wall = 0, cpu = 0;
-        r = Timed(ur10, *obs, o, &wall, &cpu);
-        walls.push_back(wall);
-        cpus.push_back(cpu);
-      }
-      std::sort(walls.begin(), walls.end());
-      std::sort(cpus.begin(), cpus.end());
+      const MedianTiming t = TimedMedian(ur10, *obs, o, runs);
+      const DiagnosisResult& r = t.result;
       std::printf(
           "  %4zu poses, %-26s: %6.2f s wall, %6.2f s CPU, cv %.4f -> %.4f, "
           "held-out %.4f -> %.4f mm: %s\n",
-          obs->rows.size(), m.name, walls[runs / 2], cpus[runs / 2],
-          r.nominal_cv_rms_mm, r.final_cv_rms_mm, r.nominal_heldout_rms_mm,
-          r.final_heldout_rms_mm, FindingsLabel(r).c_str());
+          obs->rows.size(), m.name, t.wall, t.cpu, r.nominal_cv_rms_mm,
+          r.final_cv_rms_mm, r.nominal_heldout_rms_mm, r.final_heldout_rms_mm,
+          FindingsLabel(r).c_str());
       if (m.folds == 5 && !m.refit) lin5 = r;
       if (m.folds == 5 && m.refit) refit5 = r;
     }

@@ -610,6 +610,34 @@ std::string DescribeRejections(const PlanResult& plan) {
 
 }  // namespace
 
+namespace {
+
+// The design's candidates (indices): the travel coverage for kCoverage,
+// else the D-optimal / sigma exchange on the bound-scaled Jacobian of the
+// plan's identifiable parameters (plan->swaps counts its exchanges).
+std::vector<int> ChooseDesign(const Robot& inner, const Problem& pr,
+                              const std::vector<Measurement>& ms,
+                              const Poses& candidates,
+                              const PlanOptions& options, PlanResult* plan) {
+  if (options.criterion == PlanOptions::kCoverage)
+    return CoverageDesign(inner, candidates, options.n);
+  const int p = static_cast<int>(plan->params.size());
+  Eigen::MatrixXd jac = ResidualJacobian(ms, pr.state, plan->params);
+  for (int k = 0; k < p; ++k) {
+    jac.col(k) *= ParamScale(pr.chain, plan->params[k]);
+  }
+  std::vector<int> marginal;
+  if (options.criterion == PlanOptions::kSigma) {
+    for (int k = 0; k < p; ++k) {
+      if (IsRobotParam(plan->params[k])) marginal.push_back(k);
+    }
+  }
+  return ExchangeDesign(jac, options.n, marginal, options.max_swap_passes,
+                        &plan->swaps);
+}
+
+}  // namespace
+
 PlanResult PlanPoses(const Robot& robot, const PlanOptions& options) {
   const auto start = std::chrono::steady_clock::now();
   CheckPlanInputs(robot, options);
@@ -728,25 +756,19 @@ PlanResult PlanPoses(const Robot& robot, const PlanOptions& options) {
                      " identifiable parameters need at least " +
                      std::to_string(p / 3 + 1) + " poses");
   }
-  Eigen::MatrixXd jac = ResidualJacobian(ms, pr.state, plan.params);
-  for (int k = 0; k < p; ++k) {
-    jac.col(k) *= ParamScale(pr.chain, plan.params[k]);
-  }
-  std::vector<int> marginal;
-  if (options.criterion == PlanOptions::kSigma) {
-    for (int k = 0; k < p; ++k) {
-      if (IsRobotParam(plan.params[k])) marginal.push_back(k);
-    }
-  }
   stage("choosing " + std::to_string(options.n) +
-        " poses (greedy, then Fedorov exchange)");
-  const std::vector<int> chosen = ExchangeDesign(
-      jac, options.n, marginal, options.max_swap_passes, &plan.swaps);
+        (options.criterion == PlanOptions::kCoverage
+             ? " poses (greedy travel coverage)"
+             : " poses (greedy, then Fedorov exchange)"));
+  const std::vector<int> chosen =
+      ChooseDesign(inner, pr, ms, candidates, options, &plan);
   Poses design;
   for (int i : chosen) design.push_back(candidates[i]);
   stage("ordering the poses for short joint motions");
   plan.poses = OrderPoses(robot, design);
   plan.random_poses = OrderPoses(robot, plan.random_poses);
+  plan.planned_coverage = TravelCoverage(inner, plan.poses);
+  plan.random_coverage = TravelCoverage(inner, plan.random_poses);
   stage("predicting sigma (planned and random poses)");
 
   plan.planned = PredictQuality(robot, plan, plan.poses, options);

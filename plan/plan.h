@@ -41,6 +41,7 @@
 #include "calib/model_state.h"
 #include "camcal/rig.h"
 #include "data/robot.h"
+#include "plan/coverage.h"
 #include "plan/safety.h"
 #include "vision/target.h"
 
@@ -58,7 +59,10 @@ struct PlanOptions {
   std::function<void(const std::string&)> progress;
   // kDOptimal: maximise log det(J^T J). kSigma: minimise the product of the
   // predicted sigmas of the robot's parameters (frame / point excluded).
-  enum Criterion { kDOptimal, kSigma };
+  // kCoverage: a campaign for `diagnose model`: every joint's readings
+  // spread over its travel (plan/coverage.h CoverageDesign), so that joint
+  // errors along the travel are supported everywhere.
+  enum Criterion { kDOptimal, kSigma, kCoverage };
   Criterion criterion = kSigma;
   // Candidate poses put each joint at one of its limits with this
   // probability (extreme poses carry the most information).
@@ -116,6 +120,9 @@ struct PlanResult {
   // Collisions by what was met ("plane 'table'", "self-collision", ...).
   std::map<std::string, long> collisions;
   int swaps = 0;
+  // Each joint's travel coverage (plan/coverage.h) by the planned and by
+  // the random poses, over the limits minus the margin.
+  std::vector<JointCoverage> planned_coverage, random_coverage;
   std::vector<std::vector<double>> evaluation_poses;  // reading units
   double seconds = 0;
 };

@@ -127,6 +127,34 @@ TEST(Plan, LimitMarginKeepsEveryPoseAwayFromTheLimits) {
   EXPECT_THROW(PlanPoses(robot, options), InputError);
 }
 
+// A campaign for the diagnosis on the UR10 and the BH-7 (prismatic j1, a
+// travel shorter than a turn): every joint's largest gap without a reading
+// below the random poses' and under 10 % of the travel (not `wide`), where
+// the D-optimal design leaves wide gaps.
+TEST(Plan, CoverageCampaignSpreadsEveryJointOverItsTravel) {
+  for (const Robot& robot : {Ur10(), Bh7()}) {
+    PlanOptions options;
+    options.n = 60;
+    options.candidates = 1500;
+    options.evaluation_poses = 50;
+    options.criterion = PlanOptions::kCoverage;
+    const PlanResult plan = PlanPoses(robot, options);
+    ExpectWithinLimits(robot, plan.poses);
+    ASSERT_EQ(plan.planned_coverage.size(), robot.joints.size());
+    for (size_t j = 0; j < robot.joints.size(); ++j) {
+      const JointCoverage& c = plan.planned_coverage[j];
+      EXPECT_FALSE(c.wide) << robot.name << " " << c.joint << " " << c.Gap();
+      EXPECT_LT(c.Gap(), plan.random_coverage[j].Gap())
+          << robot.name << " " << c.joint;
+    }
+    options.criterion = PlanOptions::kSigma;
+    const PlanResult sigma = PlanPoses(robot, options);
+    int wide = 0;
+    for (const JointCoverage& c : sigma.planned_coverage) wide += c.wide;
+    EXPECT_GT(wide, 0) << robot.name;
+  }
+}
+
 TEST(Plan, OrderingShortensTheJointPath) {
   const Robot robot = Bh7();
   PlanOptions options;

@@ -81,6 +81,44 @@ TEST(PlanCli, WritesPosesAndTheSpecFields) {
   EXPECT_EQ(rows, 25);
 }
 
+// A campaign for the diagnosis: the JSON's coverage per joint, no wide gap
+// with 40 poses; with 8 poses the gaps are wide and each joint is warned
+// about (`travel_gap`, in the JSON and on stderr in text mode).
+TEST(PlanCli, CoverageCampaignReportsTheGapsAndWarnsOfWideOnes) {
+  const std::string dir = testing::MakeTempDir("plan_coverage");
+  const std::string base = "plan --robot " + testing::SourceDir() +
+                           "/data/robots/ur10.yaml --criterion coverage "
+                           "--candidates 800 --out " +
+                           dir + "/poses.csv";
+  RunResult r = RunKincal(base + " --n 40 --json");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  auto j = nlohmann::json::parse(r.out);
+  ASSERT_EQ(j["coverage"]["planned"].size(), 6u);
+  for (const auto& c : j["coverage"]["planned"]) {
+    EXPECT_FALSE(c["wide"].get<bool>()) << c.dump();
+    EXPECT_TRUE(c["circular"].get<bool>());
+    EXPECT_LT(c["largest_gap"].get<double>(), 36.0) << c.dump();
+  }
+  EXPECT_FALSE(j.contains("warnings") && !j["warnings"].empty()) << j.dump();
+  r = RunKincal(base + " --n 8 --json");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  j = nlohmann::json::parse(r.out);
+  int gaps = 0;
+  for (const auto& w : j["warnings"]) gaps += w["code"] == "travel_gap";
+  EXPECT_EQ(gaps, 6) << j["warnings"].dump();
+  r = RunKincal(base + " --n 8");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.err.find("warning [travel_gap]: joint 'elbow_joint'"),
+            std::string::npos)
+      << r.err;
+  EXPECT_NE(r.out.find("travel coverage"), std::string::npos) << r.out;
+  r = RunKincal("plan --robot " + testing::SourceDir() +
+                "/data/robots/ur10.yaml --criterion e --n 8 --out " + dir +
+                "/bad.csv");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("'coverage'"), std::string::npos) << r.err;
+}
+
 TEST(PlanCli, RobotWithoutLimitsIsBadInputAndWritesNothing) {
   const std::string dir = testing::MakeTempDir("plan_cli_nolimits");
   WriteFileAtomic(dir + "/robot.yaml",
