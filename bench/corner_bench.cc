@@ -35,18 +35,23 @@ namespace {
 
 struct Stat {
   double sum_sq = 0, off_sq = 0, off_max = 0;
+  double radial_sum = 0, scale_sq = 0;  // along the tag centre's direction
   int n = 0, tags = 0;
   void AddCorner(const Eigen::Vector2d& e) {
     sum_sq += e.squaredNorm();
     ++n;
   }
-  void AddTag(const Eigen::Vector2d& mean) {
+  void AddTag(const Eigen::Vector2d& mean, double radial) {
     off_sq += mean.squaredNorm();
     off_max = std::max(off_max, mean.norm());
+    radial_sum += radial;
+    scale_sq += radial * radial;
     ++tags;
   }
   double Rms() const { return n ? std::sqrt(sum_sq / n) : 0; }
   double OffRms() const { return tags ? std::sqrt(off_sq / tags) : 0; }
+  double RadialMean() const { return tags ? radial_sum / tags : 0; }
+  double ScaleRms() const { return tags ? std::sqrt(scale_sq / tags) : 0; }
 };
 
 struct Scene {
@@ -83,6 +88,14 @@ std::vector<Scene> Scenes() {
   o = base();
   o.jpeg_quality = 70;
   s.push_back({"jpeg 70", o});
+  o = base();
+  o.bayer = true;
+  s.push_back({"bayer (RGGB, gains 0.55 1 0.75)", o});
+  o.noise_sigma = 0;
+  s.push_back({"bayer without noise", o});
+  o = base();
+  o.noise_sigma = 0;
+  s.push_back({"plain without noise", o});
   s.push_back({"widened (target_bench's draw)", base(), true});
   return s;
 }
@@ -105,14 +118,19 @@ void Accumulate(const TagTruth& t,
                 const std::array<Eigen::Vector2d, 4>& corners, Stat* s,
                 const std::array<bool, 4>& usable = {true, true, true, true}) {
   Eigen::Vector2d mean = Eigen::Vector2d::Zero();
+  const Eigen::Vector2d centre =
+      (t.corners[0] + t.corners[1] + t.corners[2] + t.corners[3]) / 4.0;
+  double radial = 0;
   int n = 0;
   for (int k = 0; k < 4; ++k) {
     if (!usable[k]) continue;
     s->AddCorner(corners[k] - t.corners[k]);
     mean += corners[k] - t.corners[k];
+    radial +=
+        (corners[k] - t.corners[k]).dot((t.corners[k] - centre).normalized());
     ++n;
   }
-  if (n > 0) s->AddTag(mean / n);
+  if (n > 0) s->AddTag(mean / n, radial / n);
 }
 
 void RunScene(const Scene& scene, int holders) {
@@ -201,6 +219,8 @@ void RunScene(const Scene& scene, int holders) {
     std::printf("  %-26s corner RMS %.4f px", name.c_str() + 2, s.Rms());
     if (s.tags > 0) {
       std::printf("  tag shift RMS %.4f max %.3f px", s.OffRms(), s.off_max);
+      std::printf("  outward mean %+.4f RMS %.4f px", s.RadialMean(),
+                  s.ScaleRms());
     }
     std::printf("\n");
   }

@@ -90,6 +90,9 @@ void AprilTagOptions::Check() const {
     fail("max_fallback_edge_rms_px (expected >= max_edge_rms_px)",
          max_fallback_edge_rms_px);
   }
+  if (!(demosaiced_ratio > 1.0)) {
+    fail("demosaiced_ratio (expected > 1)", demosaiced_ratio);
+  }
   if (!(decode_sharpening >= 0.0)) {
     fail("decode_sharpening (expected >= 0)", decode_sharpening);
   }
@@ -163,11 +166,52 @@ CornerSource JudgeCorner(const TagDetection& t, int k,
                                                      : CornerSource::kNeither;
 }
 
+// Per phase, the mean of (2 I - left - right)^2 + (2 I - up - down)^2 over
+// the tags' bounding boxes (their edges are where the phases' blurs show);
+// the ratio of the largest to the smallest, 1 with too few pixels.
+double PhaseSharpnessRatio(const cv::Mat& gray,
+                           const std::vector<TagDetection>& dets) {
+  std::array<double, 4> energy = {0, 0, 0, 0};
+  std::array<int, 4> count = {0, 0, 0, 0};
+  for (const TagDetection& d : dets) {
+    Eigen::Vector2d lo = d.corners[0], hi = d.corners[0];
+    for (const auto& c : d.corners) {
+      lo = lo.cwiseMin(c);
+      hi = hi.cwiseMax(c);
+    }
+    const int x0 = std::max(1, static_cast<int>(lo.x()));
+    const int y0 = std::max(1, static_cast<int>(lo.y()));
+    const int x1 = std::min(gray.cols - 2, static_cast<int>(hi.x()) + 1);
+    const int y1 = std::min(gray.rows - 2, static_cast<int>(hi.y()) + 1);
+    for (int y = y0; y <= y1; ++y) {
+      const uint8_t* r = gray.ptr<uint8_t>(y);
+      const uint8_t* up = gray.ptr<uint8_t>(y - 1);
+      const uint8_t* down = gray.ptr<uint8_t>(y + 1);
+      for (int x = x0; x <= x1; ++x) {
+        const double h = 2.0 * r[x] - r[x - 1] - r[x + 1];
+        const double v = 2.0 * r[x] - up[x] - down[x];
+        const int phase = (x & 1) + 2 * (y & 1);
+        energy[phase] += h * h + v * v;
+        ++count[phase];
+      }
+    }
+  }
+  double lo = 1e300, hi = 0;
+  for (int p = 0; p < 4; ++p) {
+    if (count[p] < 100) return 1.0;
+    lo = std::min(lo, energy[p] / count[p]);
+    hi = std::max(hi, energy[p] / count[p]);
+  }
+  return lo > 0 ? hi / lo : 1.0;
+}
+
 // Each detection refined with the others' quads known (its sampling skips
 // them), then checked corner by corner against libapriltag's.
 void AprilTagDetector::RefineByEdges(const cv::Mat& gray,
                                      std::vector<TagDetection>* dets) {
   const int cells = static_cast<int>(impl_->family.family->width_at_border);
+  const bool phased = !dets->empty() && PhaseSharpnessRatio(gray, *dets) >
+                                            options_.demosaiced_ratio;
   for (size_t i = 0; i < dets->size(); ++i) {
     TagDetection& t = (*dets)[i];
     std::vector<NeighbourTag> others;
@@ -176,7 +220,7 @@ void AprilTagDetector::RefineByEdges(const cv::Mat& gray,
         others.push_back({(*dets)[j].detector_corners});
       }
     }
-    if (!RefineCornersByEdges(gray, Pattern(t.id), cells, &t, others)) {
+    if (!RefineCornersByEdges(gray, Pattern(t.id), cells, &t, others, phased)) {
       continue;
     }
     const TagDetection judged = t;  // every corner against the refined ones
@@ -363,11 +407,38 @@ bool SamePattern(const EdgeProfile& a, const EdgeProfile& b,
   return true;
 }
 
+// A demosaiced image's profile: the pixels whose centres lie in the strip
+// across the side at p (|along| < half_width, |offset| <= reach), each at
+// its own offset with its Bayer phase, unsorted. Read at pixel centres, not
+// interpolated: interpolation would mix the phases' blurs into one.
+void PixelProfile(const cv::Mat& gray, const Eigen::Vector2d& p,
+                  const Eigen::Vector2d& n, const Eigen::Vector2d& dir,
+                  double reach, double half_width, EdgeProfile* prof) {
+  const double rx = reach * std::abs(n.x()) + half_width * std::abs(dir.x());
+  const double ry = reach * std::abs(n.y()) + half_width * std::abs(dir.y());
+  for (int y = static_cast<int>(std::ceil(p.y() - ry));
+       y <= static_cast<int>(std::floor(p.y() + ry)); ++y) {
+    for (int x = static_cast<int>(std::ceil(p.x() - rx));
+         x <= static_cast<int>(std::floor(p.x() + rx)); ++x) {
+      const Eigen::Vector2d d = Eigen::Vector2d(x, y) - p;
+      const double along = dir.dot(d), o = n.dot(d);
+      if (along < -half_width || along >= half_width || std::abs(o) > reach) {
+        continue;
+      }
+      prof->offsets.push_back(o);
+      prof->values.push_back(gray.at<uint8_t>(y, x));
+      prof->phases.push_back((x & 1) + 2 * (y & 1));
+    }
+  }
+  prof->box_px = std::max(std::abs(n.x()), std::abs(n.y()));
+}
+
 SideProfiles ProfilesOfSide(const cv::Mat& gray, const PatternView& view,
                             const Eigen::Vector2d& a, const Eigen::Vector2d& b,
                             const Eigen::Vector2d& n, double cell, double cells,
                             double along_px,
-                            const std::vector<NeighbourTag>& others) {
+                            const std::vector<NeighbourTag>& others,
+                            bool phased) {
   SideProfiles out;
   out.cell = cell;
   const double len = (b - a).norm();
@@ -384,10 +455,15 @@ SideProfiles ProfilesOfSide(const cv::Mat& gray, const PatternView& view,
     const Eigen::Vector2d lo = p - reach * n, hi = p + reach * n;
     if (!Inside(gray, lo, 1.0) || !Inside(gray, hi, 1.0)) continue;
     EdgeProfile prof;
-    for (double o = -reach; o <= reach + 1e-9; o += step) {
-      const Eigen::Vector2d q = p + o * n;
-      prof.offsets.push_back(o);
-      prof.values.push_back(Bilinear(gray, q.x(), q.y()));
+    if (phased) {
+      PixelProfile(gray, p, n, dir, reach,
+                   std::max(0.5, 0.5 * 0.8 * len / samples), &prof);
+    } else {
+      for (double o = -reach; o <= reach + 1e-9; o += step) {
+        const Eigen::Vector2d q = p + o * n;
+        prof.offsets.push_back(o);
+        prof.values.push_back(Bilinear(gray, q.x(), q.y()));
+      }
     }
     // Pattern beyond the window as far as a wide blur reaches into it.
     PatternAlong(view, p, n, -reach - 6.0, reach + 6.0, &prof);
@@ -426,34 +502,75 @@ SideProfiles ProfilesOfSide(const cv::Mat& gray, const PatternView& view,
 }
 
 // The side's blur: the sigma that fits eight of its profiles best
-// (golden section on log sigma in [0.3, 3] px, 8 steps: to 2 %).
-double SideBlur(const std::vector<EdgeProfile>& profiles) {
-  if (profiles.empty()) return 1.0;
-  const size_t stride = std::max<size_t>(1, profiles.size() / 8);
-  const auto cost = [&](double log_sigma) {
+// (golden section on log sigma in [0.3, 3] px, 8 steps: to 2 %). With
+// `phased` (profiles read at pixel centres with their Bayer phases), then
+// each phase's own sigma in turn, the others held (within 0.5-2x the
+// shared one, 7 steps: to 4 %).
+PhaseSigmas SideBlur(const std::vector<EdgeProfile>& profiles, bool phased) {
+  if (profiles.empty()) return {1.0, 1.0, 1.0, 1.0};
+  size_t stride = std::max<size_t>(1, profiles.size() / 8);
+  const auto cost = [&](const PhaseSigmas& sigma) {
     double sum = 0;
     for (size_t i = 0; i < profiles.size(); i += stride) {
-      const EdgeProfileFit f =
-          FitEdgeProfile(profiles[i], std::exp(log_sigma), 3);
+      const EdgeProfileFit f = FitEdgeProfile(profiles[i], sigma, 3);
       sum += f.ok ? f.rms * f.rms : 1e6;
     }
     return sum;
   };
-  const GoldenSectionResult r =
-      GoldenSectionMinimize(cost, std::log(0.3), std::log(3.0), 8);
-  return std::exp(0.5 * (r.lo + r.hi));
+  const GoldenSectionResult r = GoldenSectionMinimize(
+      [&](double log_sigma) {
+        const double s = std::exp(log_sigma);
+        return cost({s, s, s, s});
+      },
+      std::log(0.3), std::log(3.0), 8);
+  const double shared = std::exp(0.5 * (r.lo + r.hi));
+  PhaseSigmas sigma = {shared, shared, shared, shared};
+  if (!phased) return sigma;
+  stride = 1;
+  for (int phase = 0; phase < 4; ++phase) {
+    const GoldenSectionResult rp = GoldenSectionMinimize(
+        [&](double log_sigma) {
+          PhaseSigmas s = sigma;
+          s[phase] = std::exp(log_sigma);
+          return cost(s);
+        },
+        std::log(0.5 * shared), std::log(2.0 * shared), 7);
+    sigma[phase] = std::exp(0.5 * (rp.lo + rp.hi));
+  }
+  return sigma;
+}
+
+// Each side's blur (SideBlur). Demosaiced: a phase's blur depends on the
+// edge's direction (a demosaic's kernels are not round), so opposite sides,
+// nearly parallel, share their per-phase blurs, fitted on both sides'
+// profiles: twice the pixels for the four widths.
+std::array<PhaseSigmas, 4> SidesBlur(const std::array<SideProfiles, 4>& sides,
+                                     bool phased) {
+  std::array<PhaseSigmas, 4> sigma;
+  if (!phased) {
+    for (int k = 0; k < 4; ++k) sigma[k] = SideBlur(sides[k].profiles, false);
+    return sigma;
+  }
+  for (int k = 0; k < 2; ++k) {
+    std::vector<EdgeProfile> both = sides[k].profiles;
+    both.insert(both.end(), sides[k + 2].profiles.begin(),
+                sides[k + 2].profiles.end());
+    sigma[k] = sigma[k + 2] = SideBlur(both, true);
+  }
+  return sigma;
 }
 
 // Edge points of one side: the profiles' shifts along the normal.
 bool FitSide(const cv::Mat& gray, const SideProfiles& side,
-             const Eigen::Vector2d& n, double sigma, Line2* line,
-             TagSideQuality* quality) {
+             const Eigen::Vector2d& n, const PhaseSigmas& sigmas, bool phased,
+             Line2* line, TagSideQuality* quality) {
+  const double sigma = sigmas[0];
   std::vector<Eigen::Vector2d> pts;
   std::vector<double> contrast, fit_rms;
   const double w = std::min(0.45 * side.cell, 3.0);
   for (size_t i = 0; i < side.profiles.size(); ++i) {
     const EdgeProfile& prof = side.profiles[i];
-    const EdgeProfileFit f = FitEdgeProfile(prof, sigma);
+    const EdgeProfileFit f = FitEdgeProfile(prof, sigmas);
     if (!f.ok) continue;
     double shift = f.shift_px;
     // A sharp side (sigma < 0.8 px, its neighbouring edges one cell away):
@@ -469,7 +586,7 @@ bool FitSide(const cv::Mat& gray, const SideProfiles& side,
     // of a pixel-integrated step; the model's area in closed form). The rule
     // alone read the white plateau darkened by the border's outer edge and
     // pulled every side inwards: a tag-scale bias.
-    if (sigma < 0.8 && w >= 0.8 && 0.55 * side.cell >= 2.5 * sigma) {
+    if (!phased && sigma < 0.8 && w >= 0.8 && 0.55 * side.cell >= 2.5 * sigma) {
       EdgeProfile fine;
       for (double o = shift - w - 0.25; o <= shift + w + 0.25; o += 0.25) {
         const Eigen::Vector2d q = side.base[i] + o * n;
@@ -522,7 +639,8 @@ bool FitSide(const cv::Mat& gray, const SideProfiles& side,
     ss += r * r;
   }
   quality->line_rms_px = std::sqrt(ss / kept.size());
-  quality->blur_px = sigma;
+  quality->blur_px =
+      phased ? 0.25 * (sigmas[0] + sigmas[1] + sigmas[2] + sigmas[3]) : sigma;
   quality->contrast = Median(contrast);
   quality->fit_rms = Median(fit_rms);
   quality->points = static_cast<int>(kept.size());
@@ -546,11 +664,12 @@ bool FitSide(const cv::Mat& gray, const SideProfiles& side,
 // with the plateaus at the window's ends instead (edge_profile.h).
 bool RefineCornersByEdges(const cv::Mat& gray, const cv::Mat& tag_image,
                           int cells, TagDetection* det,
-                          const std::vector<NeighbourTag>& others) {
+                          const std::vector<NeighbourTag>& others,
+                          bool phased) {
   const double start = 0.5 * (tag_image.cols - cells);
   std::array<Eigen::Vector2d, 4> c = det->corners;
   std::array<TagSideQuality, 4> quality{};
-  std::array<double, 4> sigma = {0, 0, 0, 0};
+  std::array<PhaseSigmas, 4> sigma{};
   for (int pass = 0; pass < 2; ++pass) {
     PatternView view{&tag_image, ImageFromTemplate(c, start, cells).inverse()};
     const Eigen::Vector2d centroid = (c[0] + c[1] + c[2] + c[3]) / 4.0;
@@ -560,17 +679,26 @@ bool RefineCornersByEdges(const cv::Mat& gray, const cv::Mat& tag_image,
     }
     const double cell = shortest / cells;
     if (shortest < 8.0 || cell < 1.5) return false;
-    std::array<Line2, 4> lines;
+    std::array<SideProfiles, 4> sides;
+    std::array<Eigen::Vector2d, 4> normals;
     for (int k = 0; k < 4; ++k) {
       const Eigen::Vector2d a = c[k], b = c[(k + 1) % 4];
       const Eigen::Vector2d dir = (b - a).normalized();
       Eigen::Vector2d n(-dir.y(), dir.x());
       if (n.dot((a + b) / 2 - centroid) < 0) n = -n;
-      const SideProfiles side = ProfilesOfSide(
+      normals[k] = n;
+      sides[k] = ProfilesOfSide(
           gray, view, a, b, n, cell, cells,
-          pass == 0 ? 1.0 : std::max(1.0, 2.0 * sigma[k]), others);
-      if (pass == 0) sigma[k] = SideBlur(side.profiles);
-      if (!FitSide(gray, side, n, sigma[k], &lines[k], &quality[k])) {
+          pass == 0 ? 1.0
+                    : std::max(1.0, 2.0 * *std::max_element(sigma[k].begin(),
+                                                            sigma[k].end())),
+          others, phased);
+    }
+    if (pass == 0) sigma = SidesBlur(sides, phased);
+    std::array<Line2, 4> lines;
+    for (int k = 0; k < 4; ++k) {
+      if (!FitSide(gray, sides[k], normals[k], sigma[k], phased, &lines[k],
+                   &quality[k])) {
         return false;
       }
     }

@@ -108,6 +108,16 @@ struct AprilTagOptions {
   double max_edge_rms_px = 0.15;
   double detector_off_edges_px = 0.3;
   double max_fallback_edge_rms_px = 0.3;
+  // A colour camera's demosaiced image (Bayer to gray) blurs its four pixel
+  // phases differently (bilinear demosaic: the pixels that sampled green
+  // are sharper than those that sampled red or blue), so an edge read
+  // through interpolation looks skewed wherever the phases either side of
+  // it differ. An image whose phases differ in sharpness by more than this
+  // ratio (PhaseSharpnessRatio) is refined as demosaiced: its profiles are
+  // read at pixel centres with their phase, and each side fits one blur
+  // per phase (edge_profile.h). Measured: gray renders 1.0-1.3 (any blur,
+  // motion, defocus, JPEG), OpenCV-demosaiced Bayer renders 3-12.
+  double demosaiced_ratio = 2.0;
 
   // Throws InputError naming the bad option and its value.
   void Check() const;
@@ -156,13 +166,24 @@ class AprilTagDetector {
 // window comes within one of their cells are left out, unless that would
 // leave fewer than a third of the side's samples (an AprilGrid's tags, one
 // white board around them all, keep every sample).
+// `phased`: the image is demosaiced (AprilTagOptions::demosaiced_ratio):
+// profiles at pixel centres, a blur per Bayer phase, no area rule.
 // Returns false and leaves `det` unchanged when the refinement fails (a
 // side too short, too close to the image border, or with fewer than four
 // edge points); fills det->sides otherwise.
 bool RefineCornersByEdges(const cv::Mat& gray, const cv::Mat& tag_image,
                           int cells, TagDetection* det,
-                          const std::vector<NeighbourTag>& others = {});
+                          const std::vector<NeighbourTag>& others = {},
+                          bool phased = false);
 bool RefineCornersBySubPix(const cv::Mat& gray, TagDetection* det);
+
+// How differently the four Bayer phases ((x % 2, y % 2)) of `gray` are
+// blurred around the detected tags: the largest phase's mean squared second
+// difference (along x plus along y) over the smallest's, over the tags'
+// bounding boxes; 1 when a phase has fewer than 100 pixels there. About 1
+// for a gray sensor; a demosaiced mosaic's sharp and blunt phases give 3+.
+double PhaseSharpnessRatio(const cv::Mat& gray,
+                           const std::vector<TagDetection>& dets);
 
 // The tag's image as printed (libapriltag's apriltag_to_image): one pixel per
 // cell, 0 = black, 255 = white, including the white border (10x10 cells for

@@ -127,6 +127,62 @@ TEST(AprilTagDetector, RejectsBadOptions) {
   o = AprilTagDetector::Options();
   o.max_hamming = 3;
   EXPECT_THROW(o.Check(), InputError);
+  o = AprilTagDetector::Options();
+  o.demosaiced_ratio = 1.0;
+  EXPECT_THROW(o.Check(), InputError);
+}
+
+// A tag drawn at 12 px per cell with sharp edges, blurred by 0.7 px; with
+// `bayer`, taken through an RGGB mosaic (channel gains 0.55, 1, 0.75 on gray
+// paper) and OpenCV's demosaic to gray, as a colour camera's driver does.
+cv::Mat DrawnTag(bool bayer) {
+  cv::Mat big;
+  cv::resize(TagImage("tag36h11", 7), big, cv::Size(), 12, 12,
+             cv::INTER_NEAREST);
+  cv::Mat image(240, 240, CV_32FC1, cv::Scalar(128));
+  big.convertTo(image(cv::Rect(50, 60, big.cols, big.rows)), CV_32F,
+                190.0 / 255, 30);
+  cv::GaussianBlur(image, image, cv::Size(0, 0), 0.7);
+  if (bayer) {
+    for (int y = 0; y < image.rows; ++y) {
+      for (int x = 0; x < image.cols; ++x) {
+        const bool red = x % 2 == 0 && y % 2 == 0;
+        const bool blue = x % 2 == 1 && y % 2 == 1;
+        image.at<float>(y, x) *= red ? 0.55f : blue ? 0.75f : 1.0f;
+      }
+    }
+  }
+  cv::Mat out;
+  image.convertTo(out, CV_8UC1);
+  if (bayer) cv::cvtColor(out, out, cv::COLOR_BayerBG2GRAY);
+  return out;
+}
+
+TEST(AprilTagDetector, TellsADemosaicedImageByItsPhases) {
+  AprilTagDetector detector;
+  for (const bool bayer : {false, true}) {
+    const cv::Mat image = DrawnTag(bayer);
+    const auto dets = detector.Detect(image);
+    ASSERT_EQ(dets.size(), 1u);
+    const double ratio = PhaseSharpnessRatio(image, dets);
+    if (bayer) {
+      EXPECT_GT(ratio, 2.5);
+    } else {
+      EXPECT_LT(ratio, 1.3);
+    }
+  }
+  // The tag's edges lie on pixel boundaries (x0 + 12 - 0.5 ...): the
+  // demosaiced image refined with a blur per phase finds them.
+  const auto dets = detector.Detect(DrawnTag(true));
+  ASSERT_EQ(dets.size(), 1u);
+  const double lo_x = 61.5, hi_x = 157.5, lo_y = 71.5, hi_y = 167.5;
+  const Eigen::Vector2d expected[4] = {
+      {lo_x, hi_y}, {hi_x, hi_y}, {hi_x, lo_y}, {lo_x, lo_y}};
+  for (int k = 0; k < 4; ++k) {
+    EXPECT_TRUE(dets[0].refined[k]);
+    EXPECT_NEAR((dets[0].corners[k] - expected[k]).norm(), 0.0, 0.05)
+        << "corner " << k << " at " << dets[0].corners[k].transpose();
+  }
 }
 
 TEST(AprilTagDetector, RejectsColorImage) {

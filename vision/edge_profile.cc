@@ -40,6 +40,13 @@ inline double Gauss(double x) {
   return (1 - t) * table.v[i] + t * table.v[i + 1];
 }
 
+// G(x) = x Phi(x) + phi(x), the integral of Phi up to x.
+inline double IntegralPhi(double x) {
+  if (x <= -kPhiRange) return 0.0;
+  if (x >= kPhiRange) return x;
+  return x * FastPhi(x) + Gauss(x);
+}
+
 // Basis of the three classes at offset o, and its derivative with respect
 // to e, for shift e and blur sigma.
 void Basis(const EdgeProfile& p, double o, double e, double sigma,
@@ -55,8 +62,14 @@ void Basis(const EdgeProfile& p, double o, double e, double sigma,
     double phi = 0.0, g = 0.0;  // at +inf
     if (i < p.breaks.size()) {
       const double x = (o - e - p.breaks[i]) * inv;
-      phi = FastPhi(x);
-      g = x > -kPhiRange && x < kPhiRange ? Gauss(x) : 0.0;
+      if (p.box_px > 0) {
+        const double h = 0.5 * p.box_px * inv;
+        phi = (IntegralPhi(x + h) - IntegralPhi(x - h)) / (2 * h);
+        g = (FastPhi(x + h) - FastPhi(x - h)) / (2 * h);
+      } else {
+        phi = FastPhi(x);
+        g = x > -kPhiRange && x < kPhiRange ? Gauss(x) : 0.0;
+      }
     }
     const int c = p.classes[i];
     (*b)(c) += prev_phi - phi;
@@ -79,11 +92,12 @@ struct ProfileSums {
   double vv = 0;
 };
 
-ProfileSums Sums(const EdgeProfile& p, double e, double sigma) {
+ProfileSums Sums(const EdgeProfile& p, double e, const PhaseSigmas& sigma) {
   ProfileSums s;
   Eigen::Vector3d b, db;
+  const bool phased = p.phases.size() == p.offsets.size();
   for (size_t i = 0; i < p.offsets.size(); ++i) {
-    Basis(p, p.offsets[i], e, sigma, &b, &db);
+    Basis(p, p.offsets[i], e, sigma[phased ? p.phases[i] : 0], &b, &db);
     const double v = p.values[i];
     s.B.noalias() += b * b.transpose();
     s.D.noalias() += db * b.transpose();
@@ -167,9 +181,17 @@ double FastPhi(double x) {
 
 EdgeProfileFit FitEdgeProfile(const EdgeProfile& profile, double sigma_px,
                               int iterations, double max_shift_px) {
+  return FitEdgeProfile(profile, {sigma_px, sigma_px, sigma_px, sigma_px},
+                        iterations, max_shift_px);
+}
+
+EdgeProfileFit FitEdgeProfile(const EdgeProfile& profile,
+                              const PhaseSigmas& sigma_px, int iterations,
+                              double max_shift_px) {
   EdgeProfileFit fit;
   if (profile.offsets.size() < 6 ||
-      profile.classes.size() != profile.breaks.size() + 1 || !(sigma_px > 0)) {
+      profile.classes.size() != profile.breaks.size() + 1 ||
+      !(*std::min_element(sigma_px.begin(), sigma_px.end()) > 0)) {
     return fit;
   }
   double e = 0;

@@ -33,7 +33,19 @@ struct EdgeProfile {
   // -inf and +inf).
   std::vector<double> breaks;
   std::vector<int> classes;  // 0 black, 1 white, 2 outside
+  // Per sample, the Bayer phase of the pixel it was read at ((x % 2) +
+  // 2 (y % 2)), for a demosaiced image whose four phases have their own
+  // blur (FitEdgeProfile's sigma per phase); empty: one blur for all.
+  std::vector<int> phases;
+  // Width of a pixel's box along the normal, px, when the samples are
+  // pixel values (read at pixel centres): the model's step is then also
+  // averaged over that box (a pixel integrates the light over its area);
+  // 0 for interpolated samples.
+  double box_px = 0;
 };
+
+// Gaussian blur per Bayer phase (index (x % 2) + 2 (y % 2)), px.
+using PhaseSigmas = std::array<double, 4>;
 
 struct EdgeProfileFit {
   bool ok = false;
@@ -47,6 +59,14 @@ struct EdgeProfileFit {
 // short, the black and white levels are not apart, or e leaves +-max_shift.
 EdgeProfileFit FitEdgeProfile(const EdgeProfile& profile, double sigma_px,
                               int iterations = 6, double max_shift_px = 2.0);
+// The same with a blur per phase: sample i is blurred by
+// sigma_px[profile.phases[i]] (sigma_px[0] for all when phases is empty).
+// A demosaic's per-phase kernels are symmetric about their pixel but of
+// different widths; one blur for all would make the profile look skewed
+// wherever the phases left and right of the edge differ, and shift it.
+EdgeProfileFit FitEdgeProfile(const EdgeProfile& profile,
+                              const PhaseSigmas& sigma_px, int iterations = 6,
+                              double max_shift_px = 2.0);
 
 // The area rule on the profile's samples (linearly interpolated) over
 // [centre - w, centre + w]: edge = centre + w - integral (v - inside) /

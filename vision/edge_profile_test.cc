@@ -57,6 +57,63 @@ TEST(EdgeProfile, RecoversTheShiftUnderWideBlurWithNeighbours) {
   }
 }
 
+// Pixel values across an edge at `edge` (pattern of Synthetic, cell 4 px)
+// read at pixel centres o = k + 0.3, alternating between two Bayer phases
+// (0 and 3) blurred by sigma[0] and sigma[3]; each averaged over a pixel
+// box of `box` px along the normal (0: none) by a 64-point midpoint rule.
+EdgeProfile PhasedPixels(double edge, const PhaseSigmas& sigma, double box) {
+  EdgeProfile p;
+  p.breaks = {-4.0, 0.0, 4.0};
+  p.classes = {1, 0, 1, 2};
+  const EdgeProfile point = p;  // the model at a point, no box
+  p.box_px = box;
+  for (int k = -6; k <= 6; ++k) {
+    const double o = k + 0.3;
+    const int phase = (k & 1) ? 3 : 0;
+    double v = 0;
+    const int n = box > 0 ? 64 : 1;
+    for (int j = 0; j < n; ++j) {
+      const double u = box > 0 ? box * ((j + 0.5) / n - 0.5) : 0.0;
+      v += EdgeProfileModel(point, {o + u}, edge, sigma[phase],
+                            {30, 220, 60})[0];
+    }
+    p.offsets.push_back(o);
+    p.values.push_back(v / n);
+    p.phases.push_back(phase);
+  }
+  return p;
+}
+
+TEST(EdgeProfile, BlurPerPhaseRecoversTheShiftOneBlurDoesNot) {
+  // A demosaic's phases: one sharp (0.6 px), one blunt (1.1 px), each
+  // symmetric about its pixel. One blur for both skews the profile.
+  const PhaseSigmas sigma = {0.6, 1.0, 1.0, 1.1};
+  double worst_one_blur = 0;
+  for (double edge : {-0.4, -0.1, 0.2, 0.45}) {
+    const EdgeProfile p = PhasedPixels(edge, sigma, 0);
+    const EdgeProfileFit f = FitEdgeProfile(p, sigma);
+    ASSERT_TRUE(f.ok);
+    EXPECT_NEAR(f.shift_px, edge, 1e-3);
+    EdgeProfile unphased = p;
+    unphased.phases.clear();
+    const EdgeProfileFit one = FitEdgeProfile(unphased, 0.85);
+    ASSERT_TRUE(one.ok);
+    worst_one_blur = std::max(worst_one_blur, std::abs(one.shift_px - edge));
+  }
+  EXPECT_GT(worst_one_blur, 0.02);
+}
+
+TEST(EdgeProfile, PixelBoxIsInTheModel) {
+  const PhaseSigmas sigma = {0.4, 0.4, 0.4, 0.4};
+  for (double edge : {-0.3, 0.0, 0.25}) {
+    const EdgeProfile p = PhasedPixels(edge, sigma, 1.0);
+    const EdgeProfileFit f = FitEdgeProfile(p, sigma);
+    ASSERT_TRUE(f.ok);
+    EXPECT_NEAR(f.shift_px, edge, 2e-3);
+    EXPECT_LT(f.rms, 0.2);  // gray levels, of a contrast of 190
+  }
+}
+
 TEST(EdgeProfile, ModelReproducesTheProfileItWasFittedTo) {
   std::mt19937_64 rng(5);
   const EdgeProfile p = Synthetic(0.3, 3.0, 0.9, 30, 220, 60, 0, &rng);
