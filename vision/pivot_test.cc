@@ -153,16 +153,16 @@ TEST(Pivot, RenderedPivotRecoversTipOffset) {
   EXPECT_LT(r.rms_mm, 0.2);
 }
 
-// PivotTipJacobian against finite differences of the pivot fit: each pose
-// corrected on the left by a small rotation, then by a small translation.
-TEST(Pivot, TipJacobianMatchesFiniteDifferences) {
-  const Eigen::Vector3d tip(3, 100, 12), pivot(40, 60, 480);
-  const auto poses = PivotPoses(tip, pivot, Eigen::Matrix3d::Identity(), 8);
-  const Eigen::MatrixXd jacobian = PivotTipJacobian(poses, tip);
-  ASSERT_EQ(jacobian.rows(), 3);
-  ASSERT_EQ(jacobian.cols(), 48);
+// `jacobian` (3 x 6 per pose) against finite differences of `fit` (poses ->
+// tip): each pose corrected on the left by a small rotation, then by a small
+// translation; within `tolerance` of the numeric column's size (at least 1).
+template <typename Fit>
+void ExpectTipJacobian(const std::vector<Rigid3>& poses,
+                       const Eigen::Vector3d& tip,
+                       const Eigen::MatrixXd& jacobian, double tolerance,
+                       const Fit& fit) {
   const double h = 1e-6;
-  for (int i = 0; i < 8; ++i) {
+  for (size_t i = 0; i < poses.size(); ++i) {
     for (int k = 0; k < 6; ++k) {
       std::vector<Rigid3> moved = poses;
       Eigen::Vector3d delta = Eigen::Vector3d::Zero();
@@ -172,13 +172,26 @@ TEST(Pivot, TipJacobianMatchesFiniteDifferences) {
       } else {
         moved[i].t += delta;
       }
-      const Eigen::Vector3d numeric =
-          (PivotCalibration(moved).tip_in_tool - tip) / h;
+      const Eigen::Vector3d numeric = (fit(moved) - tip) / h;
       EXPECT_LT((numeric - jacobian.col(6 * i + k)).norm(),
-                1e-4 * std::max(1.0, numeric.norm()))
+                tolerance * std::max(1.0, numeric.norm()))
           << i << " " << k;
     }
   }
+}
+
+// PivotTipJacobian against finite differences of the pivot fit: each pose
+// corrected on the left by a small rotation, then by a small translation.
+TEST(Pivot, TipJacobianMatchesFiniteDifferences) {
+  const Eigen::Vector3d tip(3, 100, 12), pivot(40, 60, 480);
+  const auto poses = PivotPoses(tip, pivot, Eigen::Matrix3d::Identity(), 8);
+  const Eigen::MatrixXd jacobian = PivotTipJacobian(poses, tip);
+  ASSERT_EQ(jacobian.rows(), 3);
+  ASSERT_EQ(jacobian.cols(), 48);
+  ExpectTipJacobian(poses, tip, jacobian, 1e-4,
+                    [](const std::vector<Rigid3>& moved) {
+                      return PivotCalibration(moved).tip_in_tool;
+                    });
 }
 
 // Poses that err as camera poses do, mostly by a turn about the tags (the
@@ -247,24 +260,10 @@ TEST(Pivot, WeightedTipJacobianMatchesFiniteDifferences) {
   const Eigen::MatrixXd jacobian = PivotTipJacobian(poses, tip, fit.weights);
   const Eigen::MatrixXd plain = PivotTipJacobian(poses, tip);
   EXPECT_GT((jacobian - plain).norm(), 1e-3 * plain.norm());
-  const double h = 1e-6;
-  for (int i = 0; i < 8; ++i) {
-    for (int k = 0; k < 6; ++k) {
-      std::vector<Rigid3> moved = poses;
-      Eigen::Vector3d delta = Eigen::Vector3d::Zero();
-      delta(k % 3) = h;
-      if (k < 3) {
-        moved[i].R = RotationMatrixFromVector(delta) * moved[i].R;
-      } else {
-        moved[i].t += delta;
-      }
-      const Eigen::Vector3d numeric =
-          (PivotCalibration(moved, 1e-3, 0, covariances).tip_in_tool - tip) / h;
-      EXPECT_LT((numeric - jacobian.col(6 * i + k)).norm(),
-                1e-3 * std::max(1.0, numeric.norm()))
-          << i << " " << k;
-    }
-  }
+  ExpectTipJacobian(
+      poses, tip, jacobian, 1e-3, [&](const std::vector<Rigid3>& moved) {
+        return PivotCalibration(moved, 1e-3, 0, covariances).tip_in_tool;
+      });
 }
 
 }  // namespace
