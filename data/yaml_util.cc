@@ -1,5 +1,7 @@
 #include "data/yaml_util.h"
 
+#include <algorithm>
+#include <charconv>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -121,11 +123,17 @@ std::vector<double> YamlReader::Numbers(const YAML::Node& node,
 }
 
 std::string FormatDouble(double value) {
+  // %g at the least precision (at least 6) that reads back to the same
+  // double: the digits std::to_chars's shortest round trip needs (one call
+  // instead of a search over the precisions; a covariance of 150
+  // parameters is 22,500 numbers).
   char buf[64];
-  for (int precision = 6; precision <= 17; ++precision) {
-    std::snprintf(buf, sizeof(buf), "%.*g", precision, value);
-    if (std::strtod(buf, nullptr) == value) break;
-  }
+  const std::to_chars_result r = std::to_chars(buf, buf + sizeof(buf), value,
+                                               std::chars_format::scientific);
+  int digits = 0;
+  for (const char* c = buf; c != r.ptr && *c != 'e'; ++c)
+    digits += (*c >= '0' && *c <= '9') ? 1 : 0;
+  std::snprintf(buf, sizeof(buf), "%.*g", std::max(6, digits), value);
   return buf;
 }
 
