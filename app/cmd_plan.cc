@@ -4,7 +4,6 @@
 
 #include <cmath>
 #include <cstdio>
-#include <iostream>
 #include <memory>
 #include <optional>
 #include <sstream>
@@ -90,7 +89,7 @@ nlohmann::json CoverageJson(const std::vector<JointCoverage>& coverage) {
 // close part of the travel): a warning naming the joint and the gap.
 void AddCoverageWarnings(const PlanResult& plan, PlanArgs* args) {
   if (args->options.criterion != PlanOptions::kCoverage) return;
-  Warnings warnings(args->json ? nullptr : &std::cerr);
+  Warnings warnings = CommandWarnings();
   for (const JointCoverage& c : plan.planned_coverage) {
     if (!c.wide) continue;
     std::ostringstream os;

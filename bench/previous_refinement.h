@@ -13,6 +13,7 @@
 #include <opencv2/core.hpp>
 #include <vector>
 
+#include "data/median.h"
 #include "vision/apriltag_detector.h"
 #include "vision/image_lines.h"
 
@@ -23,7 +24,6 @@ using image_lines::FitLine;
 using image_lines::Inside;
 using image_lines::Intersect;
 using image_lines::Line2;
-using image_lines::Median;
 using image_lines::SegmentsDistance;
 
 // A side whose sampling reaches another tag's quad (its black square within
@@ -115,8 +115,8 @@ bool AreaRuleRefinement(const cv::Mat& gray, TagDetection* det,
       bright.push_back(Bilinear(gray, p_bright.x(), p_bright.y()));
     }
     if (base.size() < 4) return false;
-    const double i_dark = Median(dark);
-    const double i_bright = Median(bright);
+    const double i_dark = UpperMedian(dark);
+    const double i_bright = UpperMedian(bright);
     // Reversed-border families (tagStandard41h12) have the bright side
     // inside: the area rule only needs the two levels apart.
     if (std::abs(i_bright - i_dark) < 5.0) return false;
@@ -150,7 +150,7 @@ bool AreaRuleRefinement(const cv::Mat& gray, TagDetection* det,
     // Drop points far from the line (another edge, a glint) and refit.
     std::vector<double> res;
     for (const auto& q : pts) res.push_back(std::abs(line.n.dot(q) - line.c));
-    const double mad = Median(res);
+    const double mad = UpperMedian(res);
     const double limit = std::max(3.0 * 1.4826 * mad, 0.05);
     std::vector<Eigen::Vector2d> kept;
     for (size_t i = 0; i < pts.size(); ++i) {

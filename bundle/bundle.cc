@@ -18,6 +18,7 @@
 #include "calib/holdout.h"
 #include "calib/identifiability.h"
 #include "data/error.h"
+#include "data/median.h"
 #include "data/observations.h"
 #include "data/rigid3.h"
 
@@ -339,12 +340,6 @@ std::vector<double> CornerErrors(State* st, const std::vector<Obs>& obs,
     }
   }
   return out;
-}
-
-// The upper median (element size / 2 in order) of a non-empty `v`.
-double UpperMedian(std::vector<double> v) {
-  std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
-  return v[v.size() / 2];
 }
 
 // The automatic Huber scale (BundleOptions::huber_px = 0) from the corner

@@ -186,10 +186,7 @@ FitSummary FreeFitWithCovariance(const std::vector<Measurement>& measurements,
     summary.values[i] =
         options.free[i].ToInterface(ParamValue(*state, options.free[i]));
   if (p > 0 && dof > 0) {
-    Eigen::MatrixXd A = Eigen::MatrixXd::Zero(p, p);
-    A.selfadjointView<Eigen::Lower>().rankUpdate(J.transpose());
-    A = A.selfadjointView<Eigen::Lower>();
-    const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(A);
+    const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(NormalMatrix(J));
     const Eigen::VectorXd& l = eig.eigenvalues();
     const double lmax = l.maxCoeff();
     Eigen::VectorXd inv = Eigen::VectorXd::Zero(p);

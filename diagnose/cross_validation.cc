@@ -148,9 +148,7 @@ double CrossValidatedRms(const std::vector<Measurement>& ms,
       Jf[f].middleRows<3>(3 * j) = J.middleRows<3>(3 * members[f][j]);
       rf[f].segment<3>(3 * j) = r.segment<3>(3 * members[f][j]);
     }
-    Af[f] = Eigen::MatrixXd::Zero(P, P);
-    Af[f].selfadjointView<Eigen::Lower>().rankUpdate(Jf[f].transpose());
-    Af[f] = Af[f].selfadjointView<Eigen::Lower>();
+    Af[f] = NormalMatrix(Jf[f]);
     gf[f] = Jf[f].transpose() * rf[f];
     A += Af[f];
     g += gf[f];

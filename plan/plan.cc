@@ -608,10 +608,6 @@ std::string DescribeRejections(const PlanResult& plan) {
          " with too few tags visible";
 }
 
-}  // namespace
-
-namespace {
-
 // The design's candidates (indices): the travel coverage for kCoverage,
 // else the D-optimal / sigma exchange on the bound-scaled Jacobian of the
 // plan's identifiable parameters (plan->swaps counts its exchanges).

@@ -11,6 +11,7 @@ extern "C" {
 #include <sstream>
 
 #include "data/error.h"
+#include "data/median.h"
 #include "data/minimize.h"
 #include "vision/edge_profile.h"
 #include "vision/image_lines.h"
@@ -23,7 +24,6 @@ using image_lines::FitLine;
 using image_lines::Inside;
 using image_lines::Intersect;
 using image_lines::Line2;
-using image_lines::Median;
 using image_lines::SegmentsDistance;
 
 cv::Mat TagImage(const std::string& family, int id) {
@@ -626,7 +626,7 @@ bool FitSide(const cv::Mat& gray, const SideProfiles& side,
   // Drop points far from the line (another edge, a glint) and refit.
   std::vector<double> res;
   for (const auto& q : pts) res.push_back(std::abs(line->n.dot(q) - line->c));
-  const double limit = std::max(3.0 * 1.4826 * Median(res), 0.05);
+  const double limit = std::max(3.0 * 1.4826 * UpperMedian(res), 0.05);
   std::vector<Eigen::Vector2d> kept;
   for (size_t i = 0; i < pts.size(); ++i) {
     if (res[i] <= limit) kept.push_back(pts[i]);
@@ -641,8 +641,8 @@ bool FitSide(const cv::Mat& gray, const SideProfiles& side,
   quality->line_rms_px = std::sqrt(ss / kept.size());
   quality->blur_px =
       phased ? 0.25 * (sigmas[0] + sigmas[1] + sigmas[2] + sigmas[3]) : sigma;
-  quality->contrast = Median(contrast);
-  quality->fit_rms = Median(fit_rms);
+  quality->contrast = UpperMedian(contrast);
+  quality->fit_rms = UpperMedian(fit_rms);
   quality->points = static_cast<int>(kept.size());
   quality->near_other_tag = side.near_other_tag;
   return true;

@@ -34,13 +34,6 @@ inline bool Inside(const cv::Mat& gray, const Eigen::Vector2d& p,
          p.x() <= gray.cols - 1 - margin && p.y() <= gray.rows - 1 - margin;
 }
 
-inline double Median(std::vector<double> v) {
-  if (v.empty()) return 0;
-  const size_t mid = v.size() / 2;
-  std::nth_element(v.begin(), v.begin() + mid, v.end());
-  return v[mid];
-}
-
 // A line n . x = c with |n| = 1.
 struct Line2 {
   Eigen::Vector2d n;

@@ -3,7 +3,6 @@
 #include <Eigen/Dense>
 #include <cmath>
 #include <sstream>
-#include <stdexcept>
 
 #include "data/error.h"
 
@@ -111,10 +110,9 @@ PivotResult PivotCalibration(
     throw InputError("pivot calibration: expected at least 3 tool poses, got " +
                      std::to_string(n));
   }
-  if (!pose_covariances.empty() &&
-      static_cast<int>(pose_covariances.size()) != n) {
-    throw std::invalid_argument("PivotCalibration: one covariance per pose");
-  }
+  KINCAL_CHECK(pose_covariances.empty() ||
+                   static_cast<int>(pose_covariances.size()) == n,
+               "PivotCalibration: one covariance per pose");
   const double tilt = PivotTiltRangeDeg(rig_from_tool);
   if (tilt < min_tilt_range_deg) {
     std::ostringstream os;

@@ -13,6 +13,7 @@
 
 #include "camcal/cost_functions.h"
 #include "data/error.h"
+#include "data/median.h"
 #include "data/rigid3.h"
 #include "vision/stereo_images.h"
 
@@ -709,11 +710,9 @@ std::vector<int> RejectPivotOutliers(const PivotTipOptions& options,
   while (static_cast<int>(poses->poses.size()) > options.min_views) {
     const PivotResult fit = PivotCalibration(
         poses->poses, options.min_conditioning, 0, poses->covariances);
-    std::vector<double> sorted = fit.residuals_mm;
-    std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2,
-                     sorted.end());
-    const double limit = std::max(
-        options.outlier_mm, options.outlier_ratio * sorted[sorted.size() / 2]);
+    const double limit =
+        std::max(options.outlier_mm,
+                 options.outlier_ratio * UpperMedian(fit.residuals_mm));
     const auto worst =
         std::max_element(fit.residuals_mm.begin(), fit.residuals_mm.end());
     if (*worst <= limit) break;
