@@ -96,6 +96,9 @@ struct McTrial {
   std::vector<double> z_t, z_r, z_tip;
   double max_t_mm = 0, max_r_deg = 0, tip_mm = 0;
   double tip_sigma_mm = 0, tip_layout_sigma_mm = 0, tip_pivot_sigma_mm = 0;
+  // The corner offsets shared by every view: their sigma (mm, per axis in
+  // the tag plane) and their part of the tip's sigma.
+  double corner_offset_sigma_mm = 0, tip_systematic_sigma_mm = 0;
   double seconds = 0;
   // Detected corners against the rendered truth: RMS (px) and the largest
   // mean offset of one tag observation's four corners (px).
@@ -218,6 +221,8 @@ inline McTrial RunTargetTrial(
   trial.tip_sigma_mm = tip.tip_sigma_mm.norm();
   trial.tip_layout_sigma_mm = tip.layout_sigma_mm.norm();
   trial.tip_pivot_sigma_mm = tip.pivot.tip_sigma_mm.norm();
+  trial.corner_offset_sigma_mm = tip.corner_offset_sigma_mm;
+  trial.tip_systematic_sigma_mm = tip.systematic_sigma_mm.norm();
   trial.effects = effects;
   trial.corner_rms_px = std::sqrt(corner_errors.sum_sq / corner_errors.n);
   trial.max_tag_offset_px = corner_errors.max_offset;
