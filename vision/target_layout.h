@@ -57,7 +57,9 @@ struct LayoutFrame {
 //    residuals c would have had left out of the fit, as a jackknife): any
 //    error shared by a tag's corners counts fully, whatever its size per
 //    observation. Errors shared across frames (a bias of the corner detector
-//    that repeats at every view of a tag) are not seen by either.
+//    that repeats at every view of a tag) are not seen by either; the
+//    corner offsets of TargetLayoutResult::corner_offset_sigma_mm add them
+//    to both.
 enum class LayoutCovariance { kCornerNoise, kTagObservations };
 
 struct TargetLayoutOptions {
