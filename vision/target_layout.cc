@@ -555,6 +555,8 @@ using OffsetGroups = std::map<std::pair<int, int>, OffsetGroup>;
 void AddOffsetEvidence(int tag, int k, const Eigen::Matrix2d& jd,
                        const Eigen::Vector2d& residual,
                        const Eigen::MatrixXd& left, OffsetGroups* groups) {
+  // A tag seen edge-on says nothing about offsets in its plane.
+  if (!(std::abs(jd.determinant()) > 1e-6 * jd.squaredNorm())) return;
   const Eigen::Matrix2d to_plane = jd.inverse();
   OffsetGroup& g = (*groups)[{tag, k}];
   if (g.n == 0) g.left = Eigen::MatrixXd::Zero(2, left.cols());
