@@ -11,6 +11,7 @@
 // where POV-Ray is not installed (apt-get install povray).
 
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <cmath>
 #include <cstdio>
@@ -38,14 +39,22 @@ double Rms(const std::vector<double>& v) {
   return v.empty() ? 0 : std::sqrt(s / v.size());
 }
 
-// Renders `scene` with POV-Ray (3 x 3 adaptive antialiasing) into `png`.
+// Renders `scene` with POV-Ray into `png`: 3 x 3 adaptive antialiasing, or
+// the options in KINCAL_POVRAY_AA (e.g. "+A0.0 +AM1 +R5": 5 x 5 on every
+// pixel) for a measurement of what the antialiasing costs.
+std::string Antialiasing() {
+  const char* aa = std::getenv("KINCAL_POVRAY_AA");
+  return aa != nullptr ? aa : "+A0.02 +AM2 +R3";
+}
+
 cv::Mat RenderWithPovray(const std::string& dir, const std::string& name,
                          const std::string& scene, const CameraIntrinsics& c) {
   std::ofstream(dir + "/" + name + ".pov") << scene;
   const std::string cmd = "cd '" + dir + "' && povray +I" + name + ".pov +O" +
                           name + ".png +W" + std::to_string(c.width) + " +H" +
-                          std::to_string(c.height) +
-                          " +FN8 -D +A0.02 +AM2 +R3 +J Display=off "
+                          std::to_string(c.height) + " +FN8 -D " +
+                          Antialiasing() +
+                          " +J Display=off "
                           "File_Gamma=1.0 -V -GA >/dev/null 2>&1";
   EXPECT_EQ(std::system(cmd.c_str()), 0) << cmd;
   return cv::imread(dir + "/" + name + ".png", cv::IMREAD_COLOR);
@@ -124,7 +133,8 @@ PovErrors RunPovrayFrames(int frames, uint64_t seed, const std::string& dir) {
 TEST(TrackOnPovrayRenders, RefinedCornersAndTipsBeatPlainLibapriltag) {
   if (std::system("command -v povray >/dev/null 2>&1") != 0)
     GTEST_SKIP() << "POV-Ray is not installed (apt-get install povray)";
-  const fs::path dir = fs::temp_directory_path() / "kincal_povray_test";
+  const fs::path dir = fs::temp_directory_path() /
+                       ("kincal_povray_test_" + std::to_string(getpid()));
   fs::remove_all(dir);
   fs::create_directories(dir);
   const PovErrors e = RunPovrayFrames(8, 21, dir.string());
