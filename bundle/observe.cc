@@ -36,10 +36,12 @@ SessionObservations ObserveSession(const Session& session, const Rig& rig,
       continue;
     }
     std::vector<std::vector<TagDetection>> dets(nc);
+    std::vector<BayerBalance> balance(nc);
     ForEachCamera(nc, [&](int c) {
-      dets[c] = detectors[c]->Detect(
-          ReadCameraImage(sf.images[c], rig.cameras[c].intrinsics));
+      dets[c] = detectors[c]->Detect(ReadCameraImage(
+          sf.images[c], rig.cameras[c].intrinsics, options.bayer, &balance[c]));
     });
+    for (const BayerBalance& b : balance) out.bayer_doubtful += b.doubtful;
     BundleFrame f;
     f.frame = sf.frame;
     f.q_reading = sf.q;
