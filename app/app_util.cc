@@ -245,6 +245,16 @@ void WarnDoubtfulBayer(int doubtful, int images, BayerPattern pattern,
           "demosaiced images)");
 }
 
+void WarnRawMosaic(int cameras, Warnings* warnings) {
+  if (cameras == 0) return;
+  warnings->Add("images_look_raw_bayer",
+                std::to_string(cameras) +
+                    " cameras' images look like a colour camera's raw Bayer "
+                    "mosaic read as gray (neighbouring pixels of flat paper "
+                    "differ by more than 15 %): the corners are then far off. "
+                    "Name the pattern with --bayer (GenICam BayerRG8 = RGGB)");
+}
+
 void WarnPoseCoverage(const Robot& nominal, const Observations& obs,
                       Warnings* warnings) {
   const PoseCoverage coverage = CheckPoseCoverage(nominal, obs);

@@ -124,6 +124,9 @@ CLI::Option* AddBayerOption(CLI::App* sub, std::string* pattern);
 // a raw mosaic of `pattern`.
 void WarnDoubtfulBayer(int doubtful, int images, BayerPattern pattern,
                        Warnings* warnings);
+// The warning for `cameras` cameras whose images, read as gray, look like
+// a raw Bayer mosaic (LooksLikeRawMosaic): --bayer names the pattern.
+void WarnRawMosaic(int cameras, Warnings* warnings);
 
 // A command's warnings list: each warning goes to stderr as it is found (in
 // JSON mode too, so that a later refusal still shows it) and into the JSON

@@ -189,6 +189,7 @@ struct Tracked {
   std::vector<int> full_searches;  // per camera
   std::map<std::string, int> left_out;  // tag observations left out, by why
   int bayer_doubtful = 0;  // images whose Bayer balance is doubtful
+  int looks_raw = 0;       // cameras whose first image looks like a mosaic
 };
 
 std::string PosesHeader(const std::string& header,
@@ -320,10 +321,16 @@ Tracked TrackFrames(const TrackArgs& args, const Rig& rig, const Target& target,
   for (size_t f = 0; f < n; ++f) {
     std::vector<std::vector<TagDetection>> dets(nc);
     std::vector<BayerBalance> balance(nc);
+    std::vector<int> looks_raw(nc, 0);
     ForEachCamera(nc, [&](int c) {
-      dets[c] = trackers[c]->Track(ReadCameraImage(
-          pairs.images[c][f], rig.cameras[c].intrinsics, bayer, &balance[c]));
+      const cv::Mat image = ReadCameraImage(
+          pairs.images[c][f], rig.cameras[c].intrinsics, bayer, &balance[c]);
+      if (f == 0 && bayer == BayerPattern::kNone) {
+        looks_raw[c] = LooksLikeRawMosaic(image);
+      }
+      dets[c] = trackers[c]->Track(image);
     });
+    for (int raw : looks_raw) out.looks_raw += raw;
     for (const BayerBalance& b : balance) out.bayer_doubtful += b.doubtful;
     const ToolPoseResult r = EstimateToolPose(rig, target, dets);
     int cameras_with_tags = 0;
@@ -557,6 +564,7 @@ int RunTrack(const TrackArgs& args) {
   WarnDoubtfulBayer(tracked.bayer_doubtful,
                     static_cast<int>(pairs.size() * rig.cameras.size()),
                     ParseBayerPattern(args.bayer), &warnings);
+  WarnRawMosaic(tracked.looks_raw, &warnings);
   if (merged) {
     WriteMergedObservations(args, rig, merge.merged);
     WarnPoseCoverage(ReadRobot(args.robot), merge.merged, &warnings);

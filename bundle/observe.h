@@ -37,6 +37,9 @@ struct SessionObservations {
   int without_joints = 0;
   int without_tags = 0;    // frames with joints where no target tag was seen
   int bayer_doubtful = 0;  // images whose Bayer balance is doubtful
+  // Without a Bayer pattern: cameras whose first image looks like a raw
+  // mosaic read as gray (LooksLikeRawMosaic).
+  int looks_raw = 0;
   double seconds = 0.0;
 };
 

@@ -122,6 +122,13 @@ BayerBalance MeasureBayerBalance(const cv::Mat& mosaic, BayerPattern pattern) {
   return out;
 }
 
+bool LooksLikeRawMosaic(const cv::Mat& gray) {
+  // The pattern only names the greens; any one measures all four gains.
+  const BayerBalance b = MeasureBayerBalance(gray, BayerPattern::kRggb);
+  if (b.cells < BayerBalance::kMinCells) return false;
+  return *std::min_element(b.gain.begin(), b.gain.end()) < 1 / 1.15;
+}
+
 cv::Mat BalanceBayerMosaic(const cv::Mat& mosaic, BayerPattern pattern,
                            BayerBalance* balance) {
   const BayerBalance b = MeasureBayerBalance(mosaic, pattern);

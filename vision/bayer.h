@@ -47,6 +47,11 @@ struct BayerBalance {
 // them moves the medians little.
 BayerBalance MeasureBayerBalance(const cv::Mat& mosaic, BayerPattern pattern);
 
+// True when a gray image looks like a raw mosaic read as gray: over bright
+// flat cells its pixel phases differ in gain by more than 15 % (a gray or
+// demosaiced image's phases agree on flat paper).
+bool LooksLikeRawMosaic(const cv::Mat& gray);
+
 // The mosaic (CV_8UC1) as a balanced
 // 8-bit gray image: each photosite / its phase's gain, rounded and
 // saturated. `balance` (optional) receives what was measured. kNone

@@ -70,6 +70,12 @@ TEST(BayerBalance, WrongPatternOrNoPaperIsDoubtful) {
   EXPECT_EQ(b.gain[0], 1.0);
 }
 
+TEST(BayerBalance, TellsARawMosaicReadAsGray) {
+  EXPECT_TRUE(LooksLikeRawMosaic(Mosaic({0.55, 1.0, 1.0, 0.75}, 4)));
+  EXPECT_FALSE(LooksLikeRawMosaic(Mosaic({1, 1, 1, 1}, 4)));
+  EXPECT_FALSE(LooksLikeRawMosaic(Mosaic({0.95, 1.0, 1.0, 0.95}, 4)));
+}
+
 TEST(BayerBalance, PatternNames) {
   EXPECT_EQ(ParseBayerPattern("rggb"), BayerPattern::kRggb);
   EXPECT_EQ(ParseBayerPattern("BGGR"), BayerPattern::kBggr);
