@@ -155,7 +155,7 @@ TEST(CornerScale, DemosaicedBayerCornersAsGoodAsGray) {
 // where the demosaic's skew dominates (35 px tags), and the unbalanced
 // mosaic read as gray is far worse. Measured (noise 1.5, blur 0.5): 59 px
 // tags gray 0.0170, raw 0.0222, demosaiced 0.0180, unbalanced 0.0576 px;
-// 35 px tags 0.0214, 0.0246, 0.0304, 0.1125 px.
+// 35 px tags 0.0214, 0.0247, 0.0304, 0.1125 px.
 TEST(CornerScale, RawBayerCornersAsGoodAsGray) {
   RenderOptions gray;
   gray.blur_sigma_px = 0.5;

@@ -39,7 +39,8 @@ struct BayerBalance {
   static constexpr int kMinCells = 50;
 };
 
-// Measures the four gains: over 2x2 cells that are bright (mean >= 0.6 x
+// Measures the four gains: over 2x2 cells (every second one in x and y)
+// that are bright (mean >= 0.6 x
 // the 95th percentile of the cells' means, none saturated) and flat (each
 // phase within 8 % in the cells right of and below), the median of each
 // phase's value over the cell's mean; normalised to the largest. Gray
