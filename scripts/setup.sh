@@ -6,7 +6,7 @@ PKGS=(
   build-essential cmake pkg-config git
   libopencv-dev libapriltag-dev libceres-dev libeigen3-dev
   libv4l-dev libaravis-dev libusb-1.0-0-dev
-  libpng-dev libcairo2-dev poppler-utils
+  libpng-dev libcairo2-dev poppler-utils povray
   libyaml-cpp-dev nlohmann-json3-dev libcli11-dev
   libtinyxml2-dev liburdfdom-dev liburdfdom-tools
   chromium clang libclang-rt-14-dev

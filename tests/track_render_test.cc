@@ -16,6 +16,7 @@
 
 #include "bundle/testing/synthetic.h"
 #include "synth/render.h"
+#include "tests/testing/holder_views.h"
 #include "vision/apriltag_detector.h"
 #include "vision/tool_pose.h"
 #include "vision/triangulate.h"
@@ -30,58 +31,6 @@ struct Scene {
   double max_tilt_deg = 35;
   double tag_mm = 22;
 };
-
-// The holder facing the rig (tool z into the tags ~ rig z), tilted by up to
-// max_tilt about a random axis in the image plane, turned in-plane at
-// random, placed in the common view ~450 mm away.
-Rigid3 RandomPose(std::mt19937_64* rng, double max_tilt_deg) {
-  std::uniform_real_distribution<double> u(-1, 1);
-  const double spin = M_PI * u(*rng);
-  const double tilt = max_tilt_deg * M_PI / 180 * std::abs(u(*rng));
-  const double axis = M_PI * u(*rng);
-  Rigid3 r;
-  r.R = (Eigen::AngleAxisd(tilt,
-                           Eigen::Vector3d(std::cos(axis), std::sin(axis), 0)) *
-         Eigen::AngleAxisd(spin, Eigen::Vector3d::UnitZ()))
-            .toRotationMatrix();
-  r.t = Eigen::Vector3d(60 + 30 * u(*rng), 25 * u(*rng), 440 + 40 * u(*rng));
-  return r;
-}
-
-// The reference: corners seen in both cameras triangulated, then a
-// rigid (Kabsch) fit of the target's corners to them.
-bool TriangulatedRigidTip(const Rig& rig, const Target& target,
-                          const std::vector<std::vector<TagDetection>>& dets,
-                          Eigen::Vector3d* tip) {
-  std::vector<Eigen::Vector3d> a, b;
-  for (const StereoCorner& c : MatchTagCorners(dets[0], dets[1])) {
-    const TargetTag* tag = target.FindTag(c.tag_id);
-    if (tag == nullptr) continue;
-    const TriangulatedPoint p = TriangulatePoint(rig, {{0, c.px0}, {1, c.px1}});
-    if (!p.ok) continue;
-    a.push_back(tag->CornerInTool(c.corner));
-    b.push_back(p.p_in_rig);
-  }
-  if (a.size() < 6) return false;
-  Eigen::Vector3d ma = Eigen::Vector3d::Zero(), mb = Eigen::Vector3d::Zero();
-  for (size_t i = 0; i < a.size(); ++i) {
-    ma += a[i];
-    mb += b[i];
-  }
-  ma /= a.size();
-  mb /= b.size();
-  Eigen::Matrix3d H = Eigen::Matrix3d::Zero();
-  for (size_t i = 0; i < a.size(); ++i)
-    H += (a[i] - ma) * (b[i] - mb).transpose();
-  Eigen::JacobiSVD<Eigen::Matrix3d> svd(
-      H, Eigen::ComputeFullU | Eigen::ComputeFullV);
-  Eigen::Matrix3d D = Eigen::Matrix3d::Identity();
-  if ((svd.matrixV() * svd.matrixU().transpose()).determinant() < 0)
-    D(2, 2) = -1;
-  const Eigen::Matrix3d R = svd.matrixV() * D * svd.matrixU().transpose();
-  *tip = R * (target.tip_in_tool - ma) + mb;
-  return true;
-}
 
 struct Errors {
   std::vector<double> ours, plain_pose, plain_tri;
