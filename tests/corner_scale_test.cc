@@ -154,7 +154,7 @@ TEST(CornerScale, DemosaicedBayerCornersAsGoodAsGray) {
 // green's; a demosaic averages it down), beat the demosaiced image's
 // where the demosaic's skew dominates (35 px tags), and the unbalanced
 // mosaic read as gray is far worse. Measured (noise 1.5, blur 0.5): 59 px
-// tags gray 0.0170, raw 0.0222, demosaiced 0.0180, unbalanced 0.0576 px;
+// tags gray 0.0170, raw 0.0224, demosaiced 0.0180, unbalanced 0.0576 px;
 // 35 px tags 0.0214, 0.0247, 0.0304, 0.1125 px.
 TEST(CornerScale, RawBayerCornersAsGoodAsGray) {
   RenderOptions gray;
