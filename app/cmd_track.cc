@@ -493,8 +493,8 @@ void RefuseSwappedCameras(const TrackArgs& args, const Rig& rig,
   detector.quad_decimate = args.decimate;
   const CameraOrderCheck check = CheckCameraOrder(
       rig, target, pairs.images[0], pairs.images[1],
-      [&](const ToolPoseResult& r) { return PassesGate(args, 2, r); },
-      detector);
+      [&](const ToolPoseResult& r) { return PassesGate(args, 2, r); }, detector,
+      6, ParseBayerPattern(args.bayer));
   if (!check.LooksSwapped()) return;
   throw InputError(
       "the images of " + pairs.option[0] + " and " + pairs.option[1] +
