@@ -113,6 +113,7 @@ void Print(const TargetArgs& args, const TargetLayoutResult& layout,
                            {"sigma_t_mm", Vec3(t.sigma_t_mm)},
                            {"sigma_r_deg", Vec3(t.sigma_r_deg)}});
     }
+    j["corner_offset_sigma_mm"] = Number(layout.corner_offset_sigma_mm);
     j["tip_in_tool"] = nullptr;
     j["tip_sigma_mm"] = nullptr;
     if (pivot) {
@@ -123,6 +124,8 @@ void Print(const TargetArgs& args, const TargetLayoutResult& layout,
       j["pivot_tilt_deg"] = Number(pivot->pivot.tilt_range_deg);
       j["pivot_in_rig"] = Vec3(pivot->pivot.pivot_in_rig);
       j["tip_layout_sigma_mm"] = Vec3(pivot->layout_sigma_mm);
+      j["tip_shared_sigma_mm"] = Vec3(pivot->systematic_sigma_mm);
+      j["corner_offset_sigma_mm"] = Number(pivot->corner_offset_sigma_mm);
       j["pivot_frames_rejected"] = pivot->frames_rejected;
     }
     j["seconds"] = seconds;

@@ -41,16 +41,18 @@ int main(int argc, char** argv) {
   double max_t = 0, max_r = 0, max_tip = 0;
   std::printf(
       "seed tags views pivot  max_t_mm max_r_deg  tip_mm  tip_sigma "
-      "(pivot, layout)  rms z_t z_r z_tip   s  corner_px max_offset\n");
+      "(pivot, layout, shared)  rms z_t z_r z_tip   s  corner_px max_offset "
+      "offset_um\n");
   for (int seed = first; seed < first + seeds; ++seed) {
     const McTrial t = RunTargetTrial(seed, model, plain);
     std::printf(
-        "%4d %4d %5d %5d  %8.4f %9.4f  %6.4f  %6.4f (%6.4f, %6.4f)  %5.2f "
-        "%5.2f %5.2f  %4.1f  %.4f %.3f\n",
+        "%4d %4d %5d %5d  %8.4f %9.4f  %6.4f  %6.4f (%6.4f, %6.4f, %6.4f)  "
+        "%5.2f %5.2f %5.2f  %4.1f  %.4f %.3f %5.1f\n",
         seed, t.tags, t.views, t.pivot_views, t.max_t_mm, t.max_r_deg, t.tip_mm,
         t.tip_sigma_mm, t.tip_pivot_sigma_mm, t.tip_layout_sigma_mm,
-        RmsOf(t.z_t), RmsOf(t.z_r), RmsOf(t.z_tip), t.seconds, t.corner_rms_px,
-        t.max_tag_offset_px);
+        t.tip_systematic_sigma_mm, RmsOf(t.z_t), RmsOf(t.z_r), RmsOf(t.z_tip),
+        t.seconds, t.corner_rms_px, t.max_tag_offset_px,
+        1e3 * t.corner_offset_sigma_mm);
     const RenderOptions& e = t.effects;
     std::printf(
         "     effects: blur %.2f noise %.1f defocus %.2f motion %.2f px at "

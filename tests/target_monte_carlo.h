@@ -96,6 +96,9 @@ struct McTrial {
   std::vector<double> z_t, z_r, z_tip;
   double max_t_mm = 0, max_r_deg = 0, tip_mm = 0;
   double tip_sigma_mm = 0, tip_layout_sigma_mm = 0, tip_pivot_sigma_mm = 0;
+  // The corner offsets shared by every view: their sigma (mm, per axis in
+  // the tag plane) and their part of the tip's sigma.
+  double corner_offset_sigma_mm = 0, tip_systematic_sigma_mm = 0;
   double seconds = 0;
   // Detected corners against the rendered truth: RMS (px) and the largest
   // mean offset of one tag observation's four corners (px).
@@ -108,9 +111,15 @@ struct CornerErrors {
   int n = 0;
 };
 
+// The rendered truth of every detection, [frame][camera][detection] as
+// LayoutFrame::detections (NaN corners for a detection without a truth).
+using TruthCorners =
+    std::vector<std::vector<std::vector<std::array<Eigen::Vector2d, 4>>>>;
+
 inline std::vector<LayoutFrame> RenderAndDetect(
     const Rig& rig, const Target& target, const std::vector<Rigid3>& poses,
-    const RenderOptions& options, std::mt19937_64* rng, CornerErrors* errors) {
+    const RenderOptions& options, std::mt19937_64* rng, CornerErrors* errors,
+    TruthCorners* truth_corners = nullptr) {
   const StereoRenderer renderer(rig, target, options);
   AprilTagOptions detector_options;
   detector_options.family = target.family;
@@ -120,11 +129,17 @@ inline std::vector<LayoutFrame> RenderAndDetect(
     const StereoFrameTruth truth = renderer.Render(poses[i], rng);
     LayoutFrame f;
     f.frame = static_cast<int>(i);
+    if (truth_corners) truth_corners->emplace_back();
     for (const ViewTruth& view : truth.views) {
       f.detections.push_back(detector.Detect(view.image));
+      if (truth_corners) truth_corners->back().emplace_back();
       for (const TagDetection& d : f.detections.back()) {
+        std::array<Eigen::Vector2d, 4> nan;
+        for (Eigen::Vector2d& c : nan) c.setConstant(NAN);
+        if (truth_corners) truth_corners->back().back().push_back(nan);
         for (const TagTruth& t : view.tags) {
           if (t.id != d.id) continue;
+          if (truth_corners) truth_corners->back().back().back() = t.corners;
           // The corners the detector trusts (those the fits use).
           Eigen::Vector2d mean = Eigen::Vector2d::Zero();
           int n = 0;
@@ -146,24 +161,27 @@ inline std::vector<LayoutFrame> RenderAndDetect(
   return frames;
 }
 
-inline McTrial RunTargetTrial(
-    int seed, LayoutCovariance model = LayoutCovariance::kTagObservations,
-    bool plain = false) {
-  const auto start = std::chrono::steady_clock::now();
-  std::mt19937_64 rng(1000 + seed);
-  std::uniform_real_distribution<double> u(0, 2 * M_PI);
-  const Rig rig = ExampleStereoRig(640, 512);
-  const Target truth = RandomHolder(2 + seed % 3, &rng);
-  RenderOptions effects = WidenedEffects(&rng);
-  if (plain) {
-    effects = RenderOptions();
-    effects.blur_sigma_px = 0.5;
-    effects.noise_sigma = 1.5;
-  }
-  const double phase_a = u(rng), phase_b = u(rng);
+// One Monte Carlo session: the holder, the rendering effects and the tool
+// poses of the layout session (40 views) and of the pivot session (32).
+struct McSession {
+  Target truth;
+  RenderOptions effects;
   std::vector<Rigid3> views, pivot;
+};
+
+inline McSession MakeSession(int seed, bool plain, std::mt19937_64* rng) {
+  std::uniform_real_distribution<double> u(0, 2 * M_PI);
+  McSession s;
+  s.truth = RandomHolder(2 + seed % 3, rng);
+  s.effects = WidenedEffects(rng);
+  if (plain) {
+    s.effects = RenderOptions();
+    s.effects.blur_sigma_px = 0.5;
+    s.effects.noise_sigma = 1.5;
+  }
+  const double phase_a = u(*rng), phase_b = u(*rng);
   for (int i = 0; i < 40; ++i) {
-    views.push_back(TiltedAbout(
+    s.views.push_back(TiltedAbout(
         ExampleToolPose(i + 7 * seed), 25 * std::sin(0.9 * i + phase_a),
         30 * std::cos(0.6 * i + phase_b), Eigen::Vector3d::Zero()));
   }
@@ -171,9 +189,23 @@ inline McTrial RunTargetTrial(
   for (int i = 0; i < 32; ++i) {
     // Two circles about the tip, +-25 and +-12 deg.
     const double a = 2 * M_PI * i / 16 + phase_a, tilt = i < 16 ? 25 : 12;
-    pivot.push_back(TiltedAbout(mid, tilt * std::sin(a), tilt * std::cos(a),
-                                truth.tip_in_tool));
+    s.pivot.push_back(TiltedAbout(mid, tilt * std::sin(a), tilt * std::cos(a),
+                                  s.truth.tip_in_tool));
   }
+  return s;
+}
+
+inline McTrial RunTargetTrial(
+    int seed, LayoutCovariance model = LayoutCovariance::kTagObservations,
+    bool plain = false) {
+  const auto start = std::chrono::steady_clock::now();
+  std::mt19937_64 rng(1000 + seed);
+  const Rig rig = ExampleStereoRig(640, 512);
+  const McSession session = MakeSession(seed, plain, &rng);
+  const Target& truth = session.truth;
+  const RenderOptions& effects = session.effects;
+  const std::vector<Rigid3>& views = session.views;
+  const std::vector<Rigid3>& pivot = session.pivot;
   CornerErrors corner_errors;
   const std::vector<LayoutFrame> view_frames =
       RenderAndDetect(rig, truth, views, effects, &rng, &corner_errors);
@@ -218,6 +250,8 @@ inline McTrial RunTargetTrial(
   trial.tip_sigma_mm = tip.tip_sigma_mm.norm();
   trial.tip_layout_sigma_mm = tip.layout_sigma_mm.norm();
   trial.tip_pivot_sigma_mm = tip.pivot.tip_sigma_mm.norm();
+  trial.corner_offset_sigma_mm = tip.corner_offset_sigma_mm;
+  trial.tip_systematic_sigma_mm = tip.systematic_sigma_mm.norm();
   trial.effects = effects;
   trial.corner_rms_px = std::sqrt(corner_errors.sum_sq / corner_errors.n);
   trial.max_tag_offset_px = corner_errors.max_offset;

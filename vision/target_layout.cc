@@ -533,6 +533,153 @@ Eigen::MatrixXd TagCovariance(const Problem& p, const Rig& rig,
   return cov;
 }
 
+// How a corner's residual moves with its offset in the tag's plane (2 x 2):
+// c_in_tool = R_tag c_in_tag + u, so d r / d c_in_tag[x, y] is the
+// Jacobian on the tag's translation u times R_tag's first two columns.
+Eigen::Matrix2d OffsetJacobian(const Matrix26& d_tag,
+                               const Eigen::Matrix3d& tool_R_tag) {
+  return d_tag.rightCols<3>() * tool_R_tag.leftCols<2>();
+}
+
+// Per (tag index, corner): how many observations, the sums of z = Jd^-1 r
+// (the residual in the tag's plane, mm), of |z|^2 and of Jd^-1 times the
+// residual's change with the offsets once the fit has absorbed its part.
+struct OffsetGroup {
+  int n = 0;
+  Eigen::Vector2d z_sum = Eigen::Vector2d::Zero();
+  double z_sq = 0;
+  Eigen::MatrixXd left;
+};
+using OffsetGroups = std::map<std::pair<int, int>, OffsetGroup>;
+
+void AddOffsetEvidence(int tag, int k, const Eigen::Matrix2d& jd,
+                       const Eigen::Vector2d& residual,
+                       const Eigen::MatrixXd& left, OffsetGroups* groups) {
+  // A tag seen edge-on says nothing about offsets in its plane.
+  if (!(std::abs(jd.determinant()) > 1e-6 * jd.squaredNorm())) return;
+  const Eigen::Matrix2d to_plane = jd.inverse();
+  OffsetGroup& g = (*groups)[{tag, k}];
+  if (g.n == 0) g.left = Eigen::MatrixXd::Zero(2, left.cols());
+  const Eigen::Vector2d z = to_plane * residual;
+  ++g.n;
+  g.z_sum += z;
+  g.z_sq += z.squaredNorm();
+  g.left += to_plane * left;
+}
+
+// Per group the mean m of z over its n observations: E|m|^2 = s^2 |B|_F^2
+// + var(z) / n, B the mean of the mapped left-over change.
+CornerOffsetMoments MomentsOf(const OffsetGroups& groups) {
+  CornerOffsetMoments out;
+  for (const auto& [key, g] : groups) {
+    if (g.n < 2) continue;
+    const Eigen::Vector2d m = g.z_sum / g.n;
+    const double var = (g.z_sq - g.n * m.squaredNorm()) / (g.n - 1);
+    out.shared_mm2 += m.squaredNorm() - var / g.n;
+    out.seen += (g.left / g.n).squaredNorm();
+  }
+  return out;
+}
+
+struct CornerOffsets {
+  CornerOffsetMoments moments;
+  double sigma_mm = 0;
+  Eigen::MatrixXd tags_from_offsets;  // 6 per tag x 8 per tag
+};
+
+// The corner offsets shared by every view (TargetLayoutResult::
+// corner_offset_sigma_mm). Model: corner k of tag i sits at its printed
+// place plus d_ik (tag plane, mm) in every view, d_ik ~ N(0, s^2 I2),
+// independent between corners; the residual of corner observation j is
+// r_j = (I - P) (Jd d + e) with P the fit's projection (the poses and the
+// layout absorb part of d) and e the noise of that view.
+//  - the layout moves with d as G = -H^-1 J^T Jd (its tag rows);
+//  - each observation's residual mapped into its tag's plane, z_j =
+//    Jd_j^-1 r_j (mm); per (tag, corner) the mean m over its n views has
+//    E|m|^2 = s^2 |B|_F^2 + var(z) / n, with B the mean of Jd_j^-1 ((I -
+//    P) Jd)_j (the part of d the fit leaves in the residuals). So
+//    s^2 = sum (|m|^2 - var(z) / n) / sum |B|_F^2 (moments; 0 if negative).
+// The frames are eliminated by their Schur complement as in TagCovariance.
+CornerOffsets CornerOffsetSystematic(const Problem& p, const Rig& rig,
+                                     double tag_size_mm) {
+  const int tags = static_cast<int>(p.ids.size());
+  const int frames = static_cast<int>(p.frame_blocks.size());
+  const int nd = 8 * tags;
+  const auto column = [&](int tag) {
+    return tag == p.reference ? -1 : 6 * (tag < p.reference ? tag : tag - 1);
+  };
+  const int dim = 6 * (tags - 1);
+  struct Row {
+    int corner;
+    Eigen::Vector2d r;
+    Matrix26 jf, jt;
+    Eigen::Matrix2d jd;
+  };
+  std::vector<Row> rows;
+  std::vector<Matrix6d> h_ff(frames, Matrix6d::Zero());
+  std::vector<Eigen::MatrixXd> h_ft(frames, Eigen::MatrixXd::Zero(6, dim));
+  std::vector<Eigen::MatrixXd> b_f(frames, Eigen::MatrixXd::Zero(6, nd));
+  Eigen::MatrixXd h_tt = Eigen::MatrixXd::Zero(dim, dim);
+  Eigen::MatrixXd b_t = Eigen::MatrixXd::Zero(dim, nd);
+  for (size_t i = 0; i < p.corners.size(); ++i) {
+    if (!p.corner_used[i]) continue;
+    const Corner& c = p.corners[i];
+    Row row{static_cast<int>(i), {}, {}, {}, {}};
+    if (!CornerJacobians(c.px, TagCornerInTag(c.k, tag_size_mm),
+                         rig.cameras[c.camera], p.frame_R0[c.frame],
+                         p.tag_R0[c.tag], p.frame_blocks[c.frame].data(),
+                         p.tag_blocks[c.tag].data(), &row.r, &row.jf,
+                         &row.jt)) {
+      continue;
+    }
+    row.jd = OffsetJacobian(row.jt, p.tag_R0[c.tag]);
+    const int dcol = 8 * c.tag + 2 * c.k;
+    h_ff[c.frame] += row.jf.transpose() * row.jf;
+    b_f[c.frame].middleCols<2>(dcol) += row.jf.transpose() * row.jd;
+    const int col = column(c.tag);
+    if (col >= 0) {
+      h_ft[c.frame].middleCols<6>(col) += row.jf.transpose() * row.jt;
+      h_tt.block<6, 6>(col, col) += row.jt.transpose() * row.jt;
+      b_t.middleRows<6>(col).middleCols<2>(dcol) += row.jt.transpose() * row.jd;
+    }
+    rows.push_back(row);
+  }
+  // H [x_f; x_t] = J^T Jd by the Schur complement on the tags.
+  std::vector<Matrix6d> h_ff_inv(frames);
+  Eigen::MatrixXd schur = h_tt, rhs = b_t;
+  for (int f = 0; f < frames; ++f) {
+    h_ff_inv[f] = PseudoInverse(h_ff[f]);
+    schur -= h_ft[f].transpose() * h_ff_inv[f] * h_ft[f];
+    rhs -= h_ft[f].transpose() * h_ff_inv[f] * b_f[f];
+  }
+  const Eigen::MatrixXd x_t = schur.ldlt().solve(rhs);
+  std::vector<Eigen::MatrixXd> x_f(frames);
+  for (int f = 0; f < frames; ++f) {
+    x_f[f] = h_ff_inv[f] * (b_f[f] - h_ft[f] * x_t);
+  }
+  OffsetGroups groups;
+  for (const Row& row : rows) {
+    const Corner& c = p.corners[row.corner];
+    Eigen::MatrixXd left = -row.jf * x_f[c.frame];
+    const int col = column(c.tag);
+    if (col >= 0) left -= row.jt * x_t.middleRows<6>(col);
+    left.middleCols<2>(8 * c.tag + 2 * c.k) += row.jd;
+    AddOffsetEvidence(c.tag, c.k, row.jd, row.r, left, &groups);
+  }
+  const CornerOffsetMoments moments = MomentsOf(groups);
+  CornerOffsets out;
+  out.moments = moments;
+  out.sigma_mm = moments.SigmaMm();
+  out.tags_from_offsets = Eigen::MatrixXd::Zero(6 * tags, nd);
+  for (int t = 0; t < tags; ++t) {
+    if (column(t) >= 0) {
+      out.tags_from_offsets.middleRows<6>(6 * t) =
+          -x_t.middleRows<6>(column(t));
+    }
+  }
+  return out;
+}
+
 }  // namespace
 
 TargetLayoutResult MeasureTargetLayout(const Rig& rig,
@@ -620,6 +767,14 @@ TargetLayoutResult MeasureTargetLayout(const Rig& rig,
   Rebase(&p);
   result.covariance = TagCovariance(p, rig, options.tag_size_mm,
                                     result.sigma0_px, options.covariance);
+  const CornerOffsets offsets =
+      CornerOffsetSystematic(p, rig, options.tag_size_mm);
+  result.corner_offset_sigma_mm = offsets.sigma_mm;
+  result.corner_offset_moments = offsets.moments;
+  result.tags_from_corner_offsets = offsets.tags_from_offsets;
+  result.covariance += offsets.sigma_mm * offsets.sigma_mm *
+                       offsets.tags_from_offsets *
+                       offsets.tags_from_offsets.transpose();
   for (size_t i = 0; i < result.tags.size(); ++i) {
     for (int k = 0; k < 3; ++k) {
       const int row = 6 * static_cast<int>(i) + k;
@@ -645,12 +800,15 @@ TargetLayoutResult MeasureTargetLayout(const Rig& rig,
   return result;
 }
 
-Eigen::MatrixXd ToolPoseLayoutJacobian(
-    const Rig& rig, const TargetLayoutResult& layout,
-    const ToolPoseResult& pose, Eigen::Matrix<double, 6, 6>* information) {
+Eigen::MatrixXd ToolPoseLayoutJacobian(const Rig& rig,
+                                       const TargetLayoutResult& layout,
+                                       const ToolPoseResult& pose,
+                                       Eigen::Matrix<double, 6, 6>* information,
+                                       Eigen::MatrixXd* from_corner_offsets) {
   const int tags = static_cast<int>(layout.tags.size());
   Matrix6d h = Matrix6d::Zero();
   Eigen::MatrixXd cross = Eigen::MatrixXd::Zero(6, 6 * tags);
+  Eigen::MatrixXd cross_offsets = Eigen::MatrixXd::Zero(6, 8 * tags);
   const std::array<double, 6> frame_block = {0,
                                              0,
                                              0,
@@ -680,9 +838,13 @@ Eigen::MatrixXd ToolPoseLayoutJacobian(
       }
       h += jf.transpose() * jf;
       cross.middleCols<6>(6 * index) += jf.transpose() * jt;
+      cross_offsets.middleCols<2>(8 * index + 2 * k) +=
+          jf.transpose() * OffsetJacobian(jt, tool_from_tag.R);
     }
   }
   if (information) *information = h;
+  if (from_corner_offsets)
+    *from_corner_offsets = -h.ldlt().solve(cross_offsets);
   return -h.ldlt().solve(cross);
 }
 
@@ -695,8 +857,57 @@ struct PivotPoses {
   std::vector<Rigid3> poses;
   std::vector<Eigen::Matrix<double, 6, 6>> covariances;
   std::vector<Eigen::MatrixXd> layout_jacobians;
+  std::vector<Eigen::MatrixXd> offset_jacobians;  // d pose / d corner offsets
+  std::vector<ToolPoseResult> results;
   std::vector<int> frames;
 };
+
+// The pivot session's evidence on the shared corner offsets (as
+// CornerOffsetSystematic's on the layout session's): the same offsets move
+// each pivot pose (O_i + L_i G) and the layout (G), and what the pose fit
+// does not absorb stays in its residuals.
+CornerOffsetMoments PivotOffsetMoments(const Rig& rig,
+                                       const TargetLayoutResult& layout,
+                                       const PivotPoses& p) {
+  const Eigen::MatrixXd& g = layout.tags_from_corner_offsets;
+  if (g.rows() != 6 * static_cast<int>(layout.tags.size())) return {};
+  OffsetGroups groups;
+  for (size_t i = 0; i < p.poses.size(); ++i) {
+    const Eigen::MatrixXd pose_move =
+        p.offset_jacobians[i] + p.layout_jacobians[i] * g;
+    const Rigid3& pose = p.poses[i];
+    const std::array<double, 6> frame_block = {
+        0, 0, 0, pose.t.x(), pose.t.y(), pose.t.z()};
+    for (const TagObservationResult& obs : p.results[i].tags) {
+      if (!obs.used) continue;
+      int index = -1;
+      for (size_t t = 0; t < layout.tags.size(); ++t) {
+        if (layout.tags[t].id == obs.tag_id) index = static_cast<int>(t);
+      }
+      if (index < 0) continue;
+      const Rigid3& tag = layout.tags[index].tool_from_tag;
+      const std::array<double, 6> tag_block = {0,         0,         0,
+                                               tag.t.x(), tag.t.y(), tag.t.z()};
+      for (int k = 0; k < 4; ++k) {
+        if (!obs.corner_used[k]) continue;
+        Eigen::Vector2d r;
+        Matrix26 jf, jt;
+        if (!CornerJacobians(
+                obs.corners_px[k],
+                TagCornerInTag(k, layout.target.tags[index].size_mm),
+                rig.cameras[obs.camera], pose.R, tag.R, frame_block.data(),
+                tag_block.data(), &r, &jf, &jt)) {
+          continue;
+        }
+        const Eigen::Matrix2d jd = OffsetJacobian(jt, tag.R);
+        Eigen::MatrixXd left = jf * pose_move + jt * g.middleRows<6>(6 * index);
+        left.middleCols<2>(8 * index + 2 * k) += jd;
+        AddOffsetEvidence(index, k, jd, r, left, &groups);
+      }
+    }
+  }
+  return MomentsOf(groups);
+}
 
 // The pivot frames whose tool pose misses the common pivot: the worst pose
 // is left out while its pivot residual exceeds max(options.outlier_mm,
@@ -721,6 +932,8 @@ std::vector<int> RejectPivotOutliers(const PivotTipOptions& options,
     poses->poses.erase(poses->poses.begin() + i);
     poses->covariances.erase(poses->covariances.begin() + i);
     poses->layout_jacobians.erase(poses->layout_jacobians.begin() + i);
+    poses->offset_jacobians.erase(poses->offset_jacobians.begin() + i);
+    poses->results.erase(poses->results.begin() + i);
     poses->frames.erase(poses->frames.begin() + i);
   }
   std::sort(rejected.begin(), rejected.end());
@@ -739,8 +952,11 @@ PivotTipResult MeasurePivotTip(const Rig& rig, const TargetLayoutResult& layout,
         EstimateToolPose(rig, layout.target, f.detections, options.pose);
     if (!r.found) continue;
     Matrix6d information;
+    Eigen::MatrixXd from_offsets;
     p.layout_jacobians.push_back(
-        ToolPoseLayoutJacobian(rig, layout, r, &information));
+        ToolPoseLayoutJacobian(rig, layout, r, &information, &from_offsets));
+    p.offset_jacobians.push_back(from_offsets);
+    p.results.push_back(r);
     p.poses.push_back(r.rig_from_tool);
     p.covariances.push_back(PseudoInverse(information));
     p.frames.push_back(f.frame);
@@ -767,10 +983,34 @@ PivotTipResult MeasurePivotTip(const Rig& rig, const TargetLayoutResult& layout,
     tip_from_layout +=
         tip_from_poses.middleCols<6>(6 * i) * p.layout_jacobians[i];
   }
+  // The shared corner offsets move the layout and every pivot pose at once:
+  // d tip / d offsets = sum_i d tip / d pose_i (d pose_i / d offsets +
+  // d pose_i / d layout G); their share leaves the layout's covariance.
+  // Their sigma from both sessions' residuals.
+  CornerOffsetMoments moments = PivotOffsetMoments(rig, layout, p);
+  moments.shared_mm2 += layout.corner_offset_moments.shared_mm2;
+  moments.seen += layout.corner_offset_moments.seen;
+  out.corner_offset_sigma_mm = moments.SigmaMm();
+  const double s2 = out.corner_offset_sigma_mm * out.corner_offset_sigma_mm;
+  Eigen::MatrixXd layout_random = layout.covariance;
+  Eigen::Matrix3d systematic = Eigen::Matrix3d::Zero();
+  const Eigen::MatrixXd& g = layout.tags_from_corner_offsets;
+  if (g.rows() == layout.covariance.rows()) {
+    layout_random -= layout.corner_offset_sigma_mm *
+                     layout.corner_offset_sigma_mm * g * g.transpose();
+    Eigen::MatrixXd tip_from_offsets = Eigen::MatrixXd::Zero(3, g.cols());
+    for (size_t i = 0; i < p.poses.size(); ++i) {
+      tip_from_offsets += tip_from_poses.middleCols<6>(6 * i) *
+                          (p.offset_jacobians[i] + p.layout_jacobians[i] * g);
+    }
+    systematic = s2 * tip_from_offsets * tip_from_offsets.transpose();
+  }
   const Eigen::Matrix3d layout_cov =
-      tip_from_layout * layout.covariance * tip_from_layout.transpose();
-  const Eigen::Matrix3d total = out.pivot.tip_covariance + layout_cov;
+      tip_from_layout * layout_random * tip_from_layout.transpose();
+  const Eigen::Matrix3d total =
+      out.pivot.tip_covariance + layout_cov + systematic;
   for (int k = 0; k < 3; ++k) {
+    out.systematic_sigma_mm(k) = std::sqrt(std::max(0.0, systematic(k, k)));
     out.layout_sigma_mm(k) = std::sqrt(std::max(0.0, layout_cov(k, k)));
     out.tip_sigma_mm(k) = std::sqrt(std::max(0.0, total(k, k)));
   }

@@ -26,6 +26,7 @@
 // (MeasurePivotTip) carries the layout's covariance into the tip's sigma.
 
 #include <Eigen/Core>
+#include <cmath>
 #include <functional>
 #include <string>
 #include <vector>
@@ -56,7 +57,9 @@ struct LayoutFrame {
 //    residuals c would have had left out of the fit, as a jackknife): any
 //    error shared by a tag's corners counts fully, whatever its size per
 //    observation. Errors shared across frames (a bias of the corner detector
-//    that repeats at every view of a tag) are not seen by either.
+//    that repeats at every view of a tag) are not seen by either; the
+//    corner offsets of TargetLayoutResult::corner_offset_sigma_mm add them
+//    to both.
 enum class LayoutCovariance { kCornerNoise, kTagObservations };
 
 struct TargetLayoutOptions {
@@ -89,6 +92,19 @@ struct LayoutTag {
   Eigen::Vector3d sigma_r_deg = Eigen::Vector3d::Zero();
 };
 
+// The moments behind a corner-offset sigma (CornerOffsetSystematic): over
+// every (tag, corner), shared_mm2 sums |m|^2 - var(z) / n (the mean
+// residual in the tag's plane, less its noise part) and seen the share of
+// the offsets' variance the fit leaves in those means; s^2 = shared_mm2 /
+// seen. Sessions of the same tool add up.
+struct CornerOffsetMoments {
+  double shared_mm2 = 0;
+  double seen = 0;
+  double SigmaMm() const {
+    return seen > 0 && shared_mm2 > 0 ? std::sqrt(shared_mm2 / seen) : 0.0;
+  }
+};
+
 struct TargetLayoutResult {
   // family, tags (by id) with tool_from_tag and sigma; no tip
   // (has_tip = false).
@@ -106,6 +122,19 @@ struct TargetLayoutResult {
   // of `tags` (rotation error vector in the tool frame, rad; translation,
   // mm); the reference tag's rows and columns are 0.
   Eigen::MatrixXd covariance;
+  // The error every view shares (CornerOffsetSystematic): each tag corner
+  // as the detector places it, off its printed place by a fixed offset in
+  // the tag's plane, the same in every view (a corner bias that depends on
+  // the tag's own pattern next to the corner and on the blur, which no
+  // number of views averages out). corner_offset_sigma_mm: its 1-sigma per
+  // in-plane axis (mm), estimated from the fit's residuals (0 when the
+  // residuals show none); tags_from_corner_offsets: how the tags' pose
+  // corrections move with the offsets, 6 per tag (as covariance) x 8 per
+  // tag (corner k's tag-plane x, y at columns 8 i + 2 k). `covariance`
+  // includes sigma^2 G G^T of it.
+  double corner_offset_sigma_mm = 0;
+  CornerOffsetMoments corner_offset_moments;
+  Eigen::MatrixXd tags_from_corner_offsets;
   // Frames of the session that show two or more tags (those carry the
   // layout) and all frames.
   int multi_tag_views = 0;
@@ -128,10 +157,14 @@ TargetLayoutResult MeasureTargetLayout(const Rig& rig,
 // -(Jp^T Jp)^-1 Jp^T Jl at the fitted pose.
 // information (optional): the pose fit's Jp^T Jp (6 x 6, same order), whose
 // inverse is the pose's covariance up to the corner variance.
+// from_corner_offsets (optional): how the pose moves with the tags' corner
+// offsets of TargetLayoutResult::corner_offset_sigma_mm (6 x 8 per tag, its
+// columns as tags_from_corner_offsets'), -(Jp^T Jp)^-1 Jp^T Jd.
 Eigen::MatrixXd ToolPoseLayoutJacobian(
     const Rig& rig, const TargetLayoutResult& layout,
     const ToolPoseResult& pose,
-    Eigen::Matrix<double, 6, 6>* information = nullptr);
+    Eigen::Matrix<double, 6, 6>* information = nullptr,
+    Eigen::MatrixXd* from_corner_offsets = nullptr);
 
 struct PivotTipOptions {
   // Pivot frames with a tool pose needed at least.
@@ -160,6 +193,14 @@ struct PivotTipResult {
   // frame (ToolPoseLayoutJacobian, PivotTipJacobian).
   Eigen::Vector3d tip_sigma_mm = Eigen::Vector3d::Zero();
   Eigen::Vector3d layout_sigma_mm = Eigen::Vector3d::Zero();  // its part
+  // The part of the corner offsets shared by every view
+  // (TargetLayoutResult::corner_offset_sigma_mm), through the layout and
+  // through every pivot frame's pose at once; layout_sigma_mm then holds
+  // the layout's other part only.
+  Eigen::Vector3d systematic_sigma_mm = Eigen::Vector3d::Zero();
+  // The corner offsets' sigma from the layout and the pivot sessions'
+  // residuals together (mm per in-plane axis).
+  double corner_offset_sigma_mm = 0;
 };
 
 // The tip by pivot calibration of the tool tracked with the measured layout
