@@ -222,6 +222,39 @@ void AddWarnings(const std::vector<Warning>& warnings, nlohmann::json* j) {
 
 Warnings CommandWarnings() { return Warnings(&std::cerr); }
 
+CLI::Option* AddBayerOption(CLI::App* sub, std::string* pattern) {
+  return sub
+      ->add_option("--bayer", *pattern,
+                   "the images are a colour camera's raw Bayer mosaic "
+                   "(GenICam BayerRG8 = RGGB; RGGB, GRBG, GBRG, BGGR): each "
+                   "pixel phase is white-balanced to gray from the image "
+                   "itself, no demosaic blur (none = gray images)")
+      ->capture_default_str();
+}
+
+void WarnDoubtfulBayer(int doubtful, int images, BayerPattern pattern,
+                       Warnings* warnings) {
+  if (doubtful == 0) return;
+  warnings->Add(
+      "bayer_balance_doubtful",
+      std::to_string(doubtful) + " of " + std::to_string(images) +
+          " images do not look like a raw " + BayerPatternName(pattern) +
+          " mosaic (its two green phases differ by more than 10 %, or no "
+          "bright flat paper to balance on); their corners may be off. "
+          "Check the camera's pixel format (--bayer none for gray or "
+          "demosaiced images)");
+}
+
+void WarnRawMosaic(int cameras, Warnings* warnings) {
+  if (cameras == 0) return;
+  warnings->Add("images_look_raw_bayer",
+                std::to_string(cameras) +
+                    " cameras' images look like a colour camera's raw Bayer "
+                    "mosaic read as gray (neighbouring pixels of flat paper "
+                    "differ by more than 15 %): the corners are then far off. "
+                    "Name the pattern with --bayer (GenICam BayerRG8 = RGGB)");
+}
+
 void WarnPoseCoverage(const Robot& nominal, const Observations& obs,
                       Warnings* warnings) {
   const PoseCoverage coverage = CheckPoseCoverage(nominal, obs);

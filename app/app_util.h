@@ -15,6 +15,7 @@
 #include "data/observations.h"
 #include "data/robot.h"
 #include "data/warnings.h"
+#include "vision/bayer.h"
 
 namespace kincal::app {
 
@@ -114,6 +115,18 @@ void RefuseBlindCameras(const std::vector<int>& tag_counts,
                         const std::vector<std::string>& cameras,
                         const std::vector<std::string>& images,
                         const std::string& rig_file, const std::string& frames);
+
+// Adds --bayer PATTERN to `sub` (images are a colour camera's raw mosaic,
+// balanced to gray before detection; vision/bayer.h).
+CLI::Option* AddBayerOption(CLI::App* sub, std::string* pattern);
+// The warning for `doubtful` of `images` images whose Bayer balance looked
+// wrong (green phases apart, or no bright flat paper): the images may not be
+// a raw mosaic of `pattern`.
+void WarnDoubtfulBayer(int doubtful, int images, BayerPattern pattern,
+                       Warnings* warnings);
+// The warning for `cameras` cameras whose images, read as gray, look like
+// a raw Bayer mosaic (LooksLikeRawMosaic): --bayer names the pattern.
+void WarnRawMosaic(int cameras, Warnings* warnings);
 
 // A command's warnings list: each warning goes to stderr as it is found (in
 // JSON mode too, so that a later refusal still shows it) and into the JSON

@@ -46,6 +46,7 @@ struct BundleArgs {
   double max_reproj_px = 0.5;
   // A finding must move the tool row's end by at least this much (RMS, mm).
   double min_effect_mm = 0.005;
+  std::string bayer = "none";  // raw mosaic pattern of the images
   bool json = false, quiet = false;
 };
 
@@ -420,10 +421,15 @@ int RunBundleCommand(BundleArgs args) {
 
   BundleRun run;
   ObserveOptions oo;
+  oo.bayer = ParseBayerPattern(args.bayer);
   oo.progress = [&progress](int done, int total) {
     progress.Update(done, total, "frames (detecting tags)");
   };
   run.obs = ObserveSession(session, rig, target, oo);
+  WarnDoubtfulBayer(
+      run.obs.bayer_doubtful,
+      static_cast<int>(run.obs.frames.size() * rig.cameras.size()), oo.bayer,
+      &warnings);
   // No camera with a tag at all: the start's own message (too few tracked
   // frames) says more than naming a camera.
   std::vector<std::string> folders;
@@ -550,6 +556,7 @@ void AddBundleCommand(CLI::App& app, Runner* run) {
   sub->add_option("--max-reproj", args->max_reproj_px,
                   "--out-obs: a tip needs a pose fit within this RMS, px")
       ->capture_default_str();
+  AddBayerOption(sub, &args->bayer);
   sub->add_flag("--quiet", args->quiet, "no progress on stderr");
   sub->add_flag("--json", args->json, "print one JSON object");
   sub->footer(HelpFooter(

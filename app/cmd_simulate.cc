@@ -357,6 +357,7 @@ int RunSimulate(SimulateArgs args) {
       args.render_options.light_in_rig =
           Eigen::Vector3d(std::sin(a), 0.0, std::cos(a));
     }
+    if (args.render_options.bayer_raw) args.render_options.bayer = true;
     if (args.render_options.shadow_tag >= 0) {
       args.render_options.shadow_angle_deg = 30.0;
       args.render_options.shadow_offset = 0.1;
@@ -522,6 +523,10 @@ void AddSimulateCommand(CLI::App& app, Runner* run) {
   sub->add_flag("--render-bayer", args->render_options.bayer,
                 "a colour sensor: RGGB photosites with their own gains and "
                 "noise, demosaiced to gray by OpenCV");
+  sub->add_flag("--render-bayer-raw", args->render_options.bayer_raw,
+                "a colour sensor's raw mosaic (as --render-bayer, not "
+                "demosaiced: one photosite per pixel; read it with track/"
+                "bundle --bayer RGGB)");
   sub->add_flag("--json", args->json, "print a JSON summary");
   sub->footer(HelpFooter(
       "Example: a BH-7 session with a hidden 0.15 deg backlash in j3, 240 "

@@ -51,6 +51,7 @@ struct TrackArgs {
   bool no_tracking = false;
   double decimate = 2.0;
   bool quiet = false;
+  std::string bayer = "none";  // raw mosaic pattern of the images
 };
 
 std::string PosesPath(const std::string& out) {
@@ -187,6 +188,8 @@ struct Tracked {
   std::vector<int> tag_frames;     // per camera: frames with a target tag
   std::vector<int> full_searches;  // per camera
   std::map<std::string, int> left_out;  // tag observations left out, by why
+  int bayer_doubtful = 0;  // images whose Bayer balance is doubtful
+  int looks_raw = 0;       // cameras whose first image looks like a mosaic
 };
 
 std::string PosesHeader(const std::string& header,
@@ -298,6 +301,7 @@ Tracked TrackFrames(const TrackArgs& args, const Rig& rig, const Target& target,
   topt.enabled = !args.no_tracking;
   topt.Check();
   const int nc = static_cast<int>(rig.cameras.size());
+  const BayerPattern bayer = ParseBayerPattern(args.bayer);
   std::vector<std::unique_ptr<TagTracker>> trackers;
   for (int c = 0; c < nc; ++c) {
     trackers.push_back(std::make_unique<TagTracker>(topt));
@@ -316,10 +320,18 @@ Tracked TrackFrames(const TrackArgs& args, const Rig& rig, const Target& target,
   Progress progress("kincal track", args.json || args.quiet);
   for (size_t f = 0; f < n; ++f) {
     std::vector<std::vector<TagDetection>> dets(nc);
+    std::vector<BayerBalance> balance(nc);
+    std::vector<int> looks_raw(nc, 0);
     ForEachCamera(nc, [&](int c) {
-      dets[c] = trackers[c]->Track(
-          ReadCameraImage(pairs.images[c][f], rig.cameras[c].intrinsics));
+      const cv::Mat image = ReadCameraImage(
+          pairs.images[c][f], rig.cameras[c].intrinsics, bayer, &balance[c]);
+      if (f == 0 && bayer == BayerPattern::kNone) {
+        looks_raw[c] = LooksLikeRawMosaic(image);
+      }
+      dets[c] = trackers[c]->Track(image);
     });
+    for (int raw : looks_raw) out.looks_raw += raw;
+    for (const BayerBalance& b : balance) out.bayer_doubtful += b.doubtful;
     const ToolPoseResult r = EstimateToolPose(rig, target, dets);
     int cameras_with_tags = 0;
     for (int c = 0; c < nc; ++c) {
@@ -481,8 +493,8 @@ void RefuseSwappedCameras(const TrackArgs& args, const Rig& rig,
   detector.quad_decimate = args.decimate;
   const CameraOrderCheck check = CheckCameraOrder(
       rig, target, pairs.images[0], pairs.images[1],
-      [&](const ToolPoseResult& r) { return PassesGate(args, 2, r); },
-      detector);
+      [&](const ToolPoseResult& r) { return PassesGate(args, 2, r); }, detector,
+      6, ParseBayerPattern(args.bayer));
   if (!check.LooksSwapped()) return;
   throw InputError(
       "the images of " + pairs.option[0] + " and " + pairs.option[1] +
@@ -549,6 +561,10 @@ int RunTrack(const TrackArgs& args) {
   WriteFileAtomic(poses_path, tracked.poses);
   const bool merged = !merge.merged.rows.empty();
   Warnings warnings = CommandWarnings();
+  WarnDoubtfulBayer(tracked.bayer_doubtful,
+                    static_cast<int>(pairs.size() * rig.cameras.size()),
+                    ParseBayerPattern(args.bayer), &warnings);
+  WarnRawMosaic(tracked.looks_raw, &warnings);
   if (merged) {
     WriteMergedObservations(args, rig, merge.merged);
     WarnPoseCoverage(ReadRobot(args.robot), merge.merged, &warnings);
@@ -588,6 +604,7 @@ void AddTrackCommand(CLI::App& app, Runner* run) {
   sub->add_flag("--no-tracking", args->no_tracking,
                 "search every full frame (no region prediction)");
   sub->add_flag("--quiet", args->quiet, "no progress bar on stderr");
+  AddBayerOption(sub, &args->bayer);
   sub->add_option("--obs", args->obs,
                   "observations.csv with the joint readings of the same "
                   "frames (one row per pair, in order)");

@@ -7,7 +7,9 @@
 // fit keeps (what the bundle takes).
 //
 //   build/bin/session_corners_bench --session S/session --rig S/rig.yaml
-//       --target S/target.yaml
+//       --target S/target.yaml [--bayer RGGB]
+// (--bayer: the images are raw mosaics, balanced to gray as track and
+// bundle --bayer do.)
 
 #include <algorithm>
 #include <cmath>
@@ -77,7 +79,7 @@ std::map<Key, Eigen::Vector2d> ReadCorners(const std::string& path) {
 }
 
 int Run(const std::string& session_dir, const std::string& rig_path,
-        const std::string& target_path) {
+        const std::string& target_path, BayerPattern bayer) {
   const Rig rig = ReadRigYaml(rig_path);
   const Target target = ReadTargetYaml(target_path);
   SessionReadOptions ro;
@@ -88,11 +90,16 @@ int Run(const std::string& session_dir, const std::string& rig_path,
   dopt.family = target.family;
   AprilTagDetector detector(dopt);
   std::map<std::string, Stat> stats;
+  std::vector<double> phase_ratios;
   for (const SessionFrame& sf : session.frames) {
     std::vector<std::vector<TagDetection>> dets(rig.cameras.size());
     for (size_t c = 0; c < rig.cameras.size(); ++c) {
-      dets[c] = detector.Detect(
-          ReadCameraImage(sf.images[c], rig.cameras[c].intrinsics));
+      const cv::Mat image =
+          ReadCameraImage(sf.images[c], rig.cameras[c].intrinsics, bayer);
+      dets[c] = detector.Detect(image);
+      if (!dets[c].empty()) {
+        phase_ratios.push_back(PhaseSharpnessRatio(image, dets[c]));
+      }
     }
     const ToolPoseResult pose = EstimateToolPose(rig, target, dets);
     for (size_t c = 0; c < dets.size(); ++c) {
@@ -151,6 +158,12 @@ int Run(const std::string& session_dir, const std::string& rig_path,
     }
   }
   std::printf("%s\n", session_dir.c_str());
+  if (!phase_ratios.empty()) {
+    std::sort(phase_ratios.begin(), phase_ratios.end());
+    std::printf("  phase sharpness ratio: median %.2f, min %.2f, max %.2f\n",
+                phase_ratios[phase_ratios.size() / 2], phase_ratios.front(),
+                phase_ratios.back());
+  }
   for (auto& [name, s] : stats) s.Print(name.substr(2));
   return 0;
 }
@@ -159,17 +172,18 @@ int Run(const std::string& session_dir, const std::string& rig_path,
 }  // namespace kincal
 
 int main(int argc, char** argv) {
-  std::string session, rig, target;
+  std::string session, rig, target, bayer = "none";
   for (int i = 1; i + 1 < argc; i += 2) {
     if (!std::strcmp(argv[i], "--session")) session = argv[i + 1];
     if (!std::strcmp(argv[i], "--rig")) rig = argv[i + 1];
     if (!std::strcmp(argv[i], "--target")) target = argv[i + 1];
+    if (!std::strcmp(argv[i], "--bayer")) bayer = argv[i + 1];
   }
   if (session.empty() || rig.empty() || target.empty()) {
     std::fprintf(stderr,
                  "usage: session_corners_bench --session DIR --rig RIG.yaml "
-                 "--target TARGET.yaml\n");
+                 "--target TARGET.yaml [--bayer RGGB]\n");
     return 2;
   }
-  return kincal::Run(session, rig, target);
+  return kincal::Run(session, rig, target, kincal::ParseBayerPattern(bayer));
 }

@@ -36,10 +36,18 @@ SessionObservations ObserveSession(const Session& session, const Rig& rig,
       continue;
     }
     std::vector<std::vector<TagDetection>> dets(nc);
+    std::vector<BayerBalance> balance(nc);
+    std::vector<int> looks_raw(nc, 0);
     ForEachCamera(nc, [&](int c) {
-      dets[c] = detectors[c]->Detect(
-          ReadCameraImage(sf.images[c], rig.cameras[c].intrinsics));
+      const cv::Mat image = ReadCameraImage(
+          sf.images[c], rig.cameras[c].intrinsics, options.bayer, &balance[c]);
+      if (done == 0 && options.bayer == BayerPattern::kNone) {
+        looks_raw[c] = LooksLikeRawMosaic(image);
+      }
+      dets[c] = detectors[c]->Detect(image);
     });
+    for (int raw : looks_raw) out.looks_raw += raw;
+    for (const BayerBalance& b : balance) out.bayer_doubtful += b.doubtful;
     BundleFrame f;
     f.frame = sf.frame;
     f.q_reading = sf.q;

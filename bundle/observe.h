@@ -15,6 +15,7 @@
 #include "camcal/rig.h"
 #include "data/session.h"
 #include "vision/apriltag_detector.h"
+#include "vision/bayer.h"
 #include "vision/target.h"
 #include "vision/tool_pose.h"
 
@@ -23,6 +24,9 @@ namespace kincal {
 struct ObserveOptions {
   AprilTagOptions detector;  // family is taken from the target
   ToolPoseOptions pose;
+  // The images are a colour camera's raw mosaic of this pattern, balanced
+  // to gray before detection (vision/bayer.h); kNone = gray images.
+  BayerPattern bayer = BayerPattern::kNone;
   // Progress: called after each frame with (done, total).
   std::function<void(int, int)> progress;
 };
@@ -31,7 +35,11 @@ struct SessionObservations {
   std::vector<BundleFrame> frames;  // frames with joint readings, in order
   int session_frames = 0;
   int without_joints = 0;
-  int without_tags = 0;  // frames with joints where no target tag was seen
+  int without_tags = 0;    // frames with joints where no target tag was seen
+  int bayer_doubtful = 0;  // images whose Bayer balance is doubtful
+  // Without a Bayer pattern: cameras whose first image looks like a raw
+  // mosaic read as gray (LooksLikeRawMosaic).
+  int looks_raw = 0;
   double seconds = 0.0;
 };
 

@@ -453,7 +453,7 @@ cv::Mat ExposeAndRecord(cv::Mat radiance, const RenderOptions& options,
   }
   cv::Mat out;
   radiance.convertTo(out, CV_8UC1);  // rounds and saturates
-  if (options.bayer) {
+  if (options.bayer && !options.bayer_raw) {
     // OpenCV names a mosaic by its second row's pattern: RGGB is "BG".
     cv::Mat gray;
     cv::cvtColor(out, gray, cv::COLOR_BayerBG2GRAY);
@@ -498,6 +498,9 @@ void RenderOptions::Check() const {
   in_range("shadow_offset", shadow_offset, -1, 1);
   for (double g : tag_gain) in_range("tag_gain", g, 0, 10);
   for (double g : bayer_gains) in_range("bayer_gains", g, 0.05, 2);
+  if (bayer_raw && !bayer) {
+    throw InputError("render option bayer_raw needs bayer (a colour sensor)");
+  }
   if (!light_in_rig.allFinite()) {
     throw InputError("render option light_in_rig is not finite");
   }

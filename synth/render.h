@@ -105,7 +105,9 @@ struct RenderOptions {
   //  - bayer: a colour sensor (RGGB mosaic with the channel gains
   //    bayer_gains for gray paper, noise and 8 bits per photosite), whose
   //    image is demosaiced to gray by OpenCV (cvtColor, Bayer to gray), as
-  //    a colour camera's driver delivers it.
+  //    a colour camera's driver delivers it; with bayer_raw the mosaic
+  //    itself (one 8-bit photosite per pixel, not demosaiced), as a colour
+  //    camera delivers it in its raw formats (GenICam BayerRG8, V4L2 RGGB).
   Eigen::Vector3d light_in_rig = Eigen::Vector3d::Zero();
   double ambient = 0.15;
   std::vector<double> tag_gain;
@@ -114,6 +116,7 @@ struct RenderOptions {
   double shadow_offset = 0.0;
   double shadow_gain = 0.35;
   bool bayer = false;
+  bool bayer_raw = false;  // with bayer: write the mosaic, not demosaiced
   std::array<double, 3> bayer_gains = {0.55, 1.0, 0.75};  // R, G, B
   // The needle: a cylinder from needle_base_in_tool to the target's tip.
   bool draw_needle = false;

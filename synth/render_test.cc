@@ -221,6 +221,26 @@ TEST(Render, BayerSensorDemosaicsToGray) {
   EXPECT_LT(s.Rms(), 0.15);
 }
 
+// The raw mosaic (bayer_raw): each photosite of flat gray paper carries its
+// channel's gain (RGGB: R at even x and y, B at odd x and y).
+TEST(Render, BayerRawWritesTheMosaic) {
+  const Rig rig = ExampleStereoRig(320, 256);
+  RenderOptions o;
+  o.bayer = true;
+  o.bayer_raw = true;
+  StereoRenderer renderer(rig, ExampleTarget(), o);
+  std::mt19937_64 rng(2);
+  const StereoFrameTruth f = renderer.Render(ExampleToolPose(0), &rng);
+  const cv::Mat& im = f.views[0].image;
+  EXPECT_NEAR(im.at<uint8_t>(4, 4), o.background * o.bayer_gains[0], 0.6);
+  EXPECT_NEAR(im.at<uint8_t>(4, 5), o.background * o.bayer_gains[1], 0.6);
+  EXPECT_NEAR(im.at<uint8_t>(5, 4), o.background * o.bayer_gains[1], 0.6);
+  EXPECT_NEAR(im.at<uint8_t>(5, 5), o.background * o.bayer_gains[2], 0.6);
+  RenderOptions raw_alone;
+  raw_alone.bayer_raw = true;
+  EXPECT_THROW(raw_alone.Check(), InputError);
+}
+
 TEST(Render, SameSeedSameImages) {
   const Rig rig = ExampleStereoRig(320, 256);
   RenderOptions o;

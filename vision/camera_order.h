@@ -14,6 +14,7 @@
 
 #include "camcal/rig.h"
 #include "vision/apriltag_detector.h"
+#include "vision/bayer.h"
 #include "vision/target.h"
 #include "vision/tool_pose.h"
 
@@ -32,12 +33,14 @@ struct CameraOrderCheck {
 // Tries up to `max_pairs` pairs, spread evenly over the session (first[k]
 // is the image of rig camera 0, second[k] of camera 1), each with
 // full-frame detection. An image whose size does not fit the camera it is
-// tried for counts as not passing.
+// tried for counts as not passing. `bayer`: the images are raw mosaics of
+// this pattern (vision/bayer.h).
 CameraOrderCheck CheckCameraOrder(
     const Rig& rig, const Target& target, const std::vector<std::string>& first,
     const std::vector<std::string>& second,
     const std::function<bool(const ToolPoseResult&)>& passes_gate,
-    const AprilTagOptions& detector, int max_pairs = 6);
+    const AprilTagOptions& detector, int max_pairs = 6,
+    BayerPattern bayer = BayerPattern::kNone);
 
 }  // namespace kincal
 

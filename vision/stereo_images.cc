@@ -11,7 +11,8 @@
 
 namespace kincal {
 
-cv::Mat ReadCameraImage(const std::string& path, const CameraIntrinsics& cam) {
+cv::Mat ReadCameraImage(const std::string& path, const CameraIntrinsics& cam,
+                        BayerPattern bayer, BayerBalance* balance) {
   const cv::Mat im = cv::imread(path, cv::IMREAD_GRAYSCALE);
   if (im.empty()) {
     throw InputError(path +
@@ -24,7 +25,7 @@ cv::Mat ReadCameraImage(const std::string& path, const CameraIntrinsics& cam) {
        << cam.name << "' in the rig is " << cam.width << "x" << cam.height;
     throw InputError(os.str());
   }
-  return im;
+  return BalanceBayerMosaic(im, bayer, balance);
 }
 
 void ForBothCameras(const std::function<void(int camera)>& work) {

@@ -9,12 +9,17 @@
 #include <string>
 
 #include "camcal/camera_model.h"
+#include "vision/bayer.h"
 
 namespace kincal {
 
 // The image at `path` as 8-bit gray. InputError when it cannot be read or
-// its size is not the camera's in the rig.
-cv::Mat ReadCameraImage(const std::string& path, const CameraIntrinsics& cam);
+// its size is not the camera's in the rig. With a Bayer pattern the file
+// holds a camera's raw mosaic, balanced to gray here (vision/bayer.h);
+// `balance` (optional) receives what was measured.
+cv::Mat ReadCameraImage(const std::string& path, const CameraIntrinsics& cam,
+                        BayerPattern bayer = BayerPattern::kNone,
+                        BayerBalance* balance = nullptr);
 
 // Runs work(0) and work(1) on two threads. An exception in either is
 // carried back and thrown here as InputError (the first camera's first).
