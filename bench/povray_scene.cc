@@ -4,6 +4,7 @@
 // and shadows share nothing with synth/render.cc. Three steps:
 //
 //   povray_scene scene --sim S --out P [--light-deg A] [--margin CELLS]
+//       [--light-distance D]
 //       writes P/rig.yaml (S's rig without lens distortion: POV-Ray's camera
 //       is a pinhole), P/target.yaml, P/pov/<camera>_<frame>.pov (one scene
 //       per view: the tags as matte paper on grey anodised plates, the
@@ -40,6 +41,7 @@
 
 #include "camcal/rig.h"
 #include "data/atomic_file.h"
+#include "data/csv.h"
 #include "data/error.h"
 #include "data/rigid3.h"
 #include "synth/render.h"
@@ -57,20 +59,19 @@ struct TruthRow {
   Eigen::Vector3d tip = Eigen::Vector3d::Zero();
 };
 
+// The data rows of a kincal CSV (data/csv.h; header skipped), each as its
+// fields separated by spaces for a stream.
 std::vector<std::string> CsvRows(const std::string& path) {
   std::ifstream in(path);
   if (!in) throw InputError(path + ": cannot open");
+  std::stringstream text;
+  text << in.rdbuf();
+  const std::vector<CsvLine> lines = TokenizeCsv(text.str(), path);
   std::vector<std::string> rows;
-  std::string line;
-  bool header = false;
-  while (std::getline(in, line)) {
-    if (line.empty() || line[0] == '#') continue;
-    if (!header) {
-      header = true;
-      continue;
-    }
-    std::replace(line.begin(), line.end(), ',', ' ');
-    rows.push_back(line);
+  for (size_t i = 1; i < lines.size(); ++i) {
+    std::string row;
+    for (const CsvField& f : lines[i].fields) row += f.text + " ";
+    rows.push_back(row);
   }
   return rows;
 }
@@ -233,6 +234,8 @@ int main(int argc, char** argv) {
       kincal::PovSceneOptions options;
       options.light_deg = std::stod(Arg(argc, argv, "--light-deg", "35"));
       options.margin_cells = std::stod(Arg(argc, argv, "--margin", "0"));
+      options.light_distance =
+          std::stod(Arg(argc, argv, "--light-distance", "1.1"));
       return kincal::Scene(Arg(argc, argv, "--sim", ""), out, options);
     }
     if (mode == "finish" && !out.empty()) {

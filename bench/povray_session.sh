@@ -9,7 +9,8 @@
 #
 #   bench/povray_session.sh [ROBOT_ARGS] [SEED] [POSES] [WORK_DIR]
 #   e.g. bench/povray_session.sh "--robot data/robots/bh7.yaml" 7 120 /tmp/pov
-# Environment: LIGHT_DEG (area light direction, default 35), NOISE (read
+# Environment: LIGHT_DEG (area light direction, default 35), LIGHT_DISTANCE
+# (times the target's depth, default 1.1), NOISE (read
 # noise, levels, default 1.0), GAMMA (POV-Ray's File_Gamma, default 1.0 =
 # linear sensor), WIDTH / HEIGHT (default 640 x 512), AA (POV-Ray's
 # antialiasing, default "+A0.02 +AM2 +R3": adaptive, up to 3 x 3 per pixel).
@@ -38,7 +39,8 @@ awk -v skip="$POSES" '/^#/ {print; next} !h {print; h = 1; next} ++n > skip' \
 "$K" simulate $ROBOT_ARGS --out "$S" --poses "$POSES" --noise 0 --seed "$SEED" \
   --render --render-noise "${NOISE:-1.0}" --render-width "$WIDTH" \
   --render-height "$HEIGHT" >/dev/null
-"$P_SCENE" scene --sim "$S" --out "$P" --light-deg "${LIGHT_DEG:-35}"
+"$P_SCENE" scene --sim "$S" --out "$P" --light-deg "${LIGHT_DEG:-35}" \
+  --light-distance "${LIGHT_DISTANCE:-1.1}"
 for f in "$P"/pov/*_*.pov; do
   b=$(basename "$f" .pov)
   cam=${b%_*}
