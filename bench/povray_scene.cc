@@ -12,9 +12,12 @@
 //       weak light at the rig) and P/session (frames.csv, session.yaml, and
 //       truth.csv / corners.csv for the pinhole rig)
 //   povray +IP/pov/left_000000.pov +OP/raw/left/000000.png ... (the script)
-//   povray_scene finish --out P [--noise SIGMA] [--shot S] [--seed N]
+//   povray_scene finish --out P [--noise SIGMA] [--shot S] [--blur B]
+//       [--seed N]
 //       P/raw/<camera>/*.png -> 8-bit gray with read noise SIGMA (levels)
-//       and shot noise (variance S x level) into P/session/<camera>/
+//       and shot noise (variance S x level), after a Gaussian blur of B px
+//       (a lens; 0 = none, POV-Ray's pinhole is sharp) into
+//       P/session/<camera>/
 //   povray_scene score --out P --points points.csv
 //       the tracked tips against truth.csv: all written tips and those that
 //       pass track's gate (>= 2 tags, <= 0.5 px): count, RMS, max, mm
@@ -140,7 +143,8 @@ int Scene(const std::string& sim, const std::string& out,
 }
 
 // The renders as a sensor gives them (SensorImage).
-int Finish(const std::string& out, double noise, double shot, uint64_t seed) {
+int Finish(const std::string& out, double noise, double shot, double blur,
+           uint64_t seed) {
   const Rig rig = ReadRigYaml(out + "/rig.yaml");
   std::mt19937_64 rng(seed);
   int written = 0;
@@ -151,8 +155,10 @@ int Finish(const std::string& out, double noise, double shot, uint64_t seed) {
       if (e.path().extension() == ".png") files.push_back(e.path());
     std::sort(files.begin(), files.end());
     for (const fs::path& f : files) {
-      const cv::Mat rendered = cv::imread(f.string(), cv::IMREAD_COLOR);
+      cv::Mat rendered = cv::imread(f.string(), cv::IMREAD_COLOR);
       if (rendered.empty()) throw InputError(f.string() + ": cannot read");
+      // The lens's blur, which POV-Ray's pinhole does not have.
+      if (blur > 0) cv::GaussianBlur(rendered, rendered, cv::Size(), blur);
       cv::imwrite(out + "/session/" + name + "/" + f.filename().string(),
                   SensorImage(rendered, noise, shot, &rng));
       ++written;
@@ -241,6 +247,7 @@ int main(int argc, char** argv) {
     if (mode == "finish" && !out.empty()) {
       return kincal::Finish(out, std::stod(Arg(argc, argv, "--noise", "1.0")),
                             std::stod(Arg(argc, argv, "--shot", "0.02")),
+                            std::stod(Arg(argc, argv, "--blur", "0")),
                             std::stoull(Arg(argc, argv, "--seed", "1")));
     }
     if (mode == "detect")

@@ -48,7 +48,8 @@ for f in "$P"/pov/*_*.pov; do
   echo "$f $P/raw/$cam/${b##*_}.png"
 done | xargs -P 1 -n 2 sh -c 'cd "$(dirname "$0")" && povray +I"$(basename "$0")" +O"$1" \
   +W'"$WIDTH"' +H'"$HEIGHT"' +FN8 -D '"${AA:-+A0.02 +AM2 +R3}"' +J Display=off \
-  File_Gamma='"${GAMMA:-1.0}"' -V -GA >/dev/null 2>&1'
+  File_Gamma='"${GAMMA:-1.0}"' -V -GA >/dev/null 2>&1 ||
+  { echo "povray failed on $0" >&2; exit 255; }'
 "$P_SCENE" finish --out "$P" --noise "${NOISE:-1.0}" --seed "$SEED"
 
 rms() { "$K" evaluate --robot "$1" --obs "$WORK/fresh.csv" --json |
