@@ -221,23 +221,11 @@ std::string TagList(const Rig& rig, const ToolPoseResult& r, bool used) {
   return out;
 }
 
-// The quality gate: enough tags, a tight fit, and with a rig of two or more
-// cameras the tags seen by at least two of them (a frame seen by one camera
-// of a stereo rig has a weak depth, tens of mm at 2 m, where the rig's
-// other frames have a fraction of a mm). A one-camera rig has nothing
-// better: its tips are valid with their depth sigma.
+// The quality gate with the command's --min-tags and --max-reproj
+// (vision/tool_pose.h PassesTrackGate).
 bool PassesGate(const TrackArgs& args, size_t num_cameras,
                 const ToolPoseResult& r) {
-  std::vector<bool> cameras(num_cameras, false);
-  for (const TagObservationResult& t : r.tags) {
-    if (t.used && t.camera >= 0 && t.camera < static_cast<int>(num_cameras)) {
-      cameras[t.camera] = true;
-    }
-  }
-  const size_t seen = std::count(cameras.begin(), cameras.end(), true);
-  return r.found && r.tags_used >= args.min_tags &&
-         r.rms_px <= args.max_reproj_px &&
-         seen >= std::min<size_t>(2, num_cameras);
+  return PassesTrackGate(r, num_cameras, args.min_tags, args.max_reproj_px);
 }
 
 bool SeesTargetTag(const Target& target,

@@ -126,9 +126,9 @@ int Scene(const std::string& sim, const std::string& out,
       char name[64];
       std::snprintf(name, sizeof name, "%s_%06d.pov",
                     cam.intrinsics.name.c_str(), t.frame);
-      std::ofstream pov(out + "/pov/" + name);
-      pov << PovViewScene(cam.intrinsics, cam.cam_from_rig, target,
-                          t.rig_from_tool, depth, options);
+      WriteFileAtomic(out + "/pov/" + name,
+                      PovViewScene(cam.intrinsics, cam.cam_from_rig, target,
+                                   t.rig_from_tool, depth, options));
       ViewTruth view;
       view.tags = ProjectTargetCorners(cam, target, t.rig_from_tool);
       frame.views.push_back(view);
@@ -260,9 +260,11 @@ int main(int argc, char** argv) {
     return 2;
   }
   std::fprintf(stderr,
-               "usage: povray_scene scene --sim S --out P [--light-deg A]\n"
+               "usage: povray_scene scene --sim S --out P [--light-deg A] "
+               "[--margin CELLS] [--light-distance D]\n"
                "       povray_scene finish --out P [--noise L] [--shot S] "
-               "[--seed N]\n"
-               "       povray_scene score --out P --points points.csv\n");
+               "[--blur B] [--seed N]\n"
+               "       povray_scene score --out P --points points.csv\n"
+               "       povray_scene detect --image IMG [--decimate D]\n");
   return 2;
 }

@@ -33,12 +33,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-double Rms(const std::vector<double>& v) {
-  double s = 0;
-  for (double x : v) s += x * x;
-  return v.empty() ? 0 : std::sqrt(s / v.size());
-}
-
 // Renders `scene` with POV-Ray into `png`: 3 x 3 adaptive antialiasing, or
 // the options in KINCAL_POVRAY_AA (e.g. "+A0.0 +AM1 +R5": 5 x 5 on every
 // pixel) for a measurement of what the antialiasing costs.
@@ -115,11 +109,8 @@ PovErrors RunPovrayFrames(int frames, uint64_t seed, const std::string& dir) {
     ++e.frames;
     const Eigen::Vector3d tip_truth = rig_from_tool * target.tip_in_tool;
     const ToolPoseResult r = EstimateToolPose(rig, target, a);
-    bool cameras[2] = {false, false};
-    for (const TagObservationResult& t : r.tags)
-      if (t.used) cameras[t.camera] = true;
-    if (r.found && r.tags_used >= 2 && r.rms_px <= 0.5 && cameras[0] &&
-        cameras[1]) {
+    // The quality gate of `track` (>= 2 tags, <= 0.5 px, both cameras).
+    if (PassesTrackGate(r, rig.cameras.size(), 2, 0.5)) {
       ++e.good;
       e.good_tips.push_back((r.tip_in_rig - tip_truth).norm());
     }

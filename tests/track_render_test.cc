@@ -37,12 +37,6 @@ struct Errors {
   int frames = 0, gated = 0;
 };
 
-double Rms(const std::vector<double>& v) {
-  double s = 0;
-  for (double x : v) s += x * x;
-  return v.empty() ? 0 : std::sqrt(s / v.size());
-}
-
 Errors RunScene(const Scene& scene, int frames, uint64_t seed) {
   const Rig rig = ExampleStereoRig(640, 512);
   const Target target = ThreeTagHolder(scene.tag_mm, scene.family);
@@ -158,13 +152,8 @@ LightErrors RunLightScene(const RenderOptions& render, int frames,
     }
     ++e.frames;
     const ToolPoseResult r = EstimateToolPose(rig, target, a);
-    bool cameras[2] = {false, false};
-    for (const TagObservationResult& t : r.tags) {
-      if (t.used) cameras[t.camera] = true;
-    }
     // The quality gate of `track` (>= 2 tags, <= 0.5 px, both cameras).
-    if (r.found && r.tags_used >= 2 && r.rms_px <= 0.5 && cameras[0] &&
-        cameras[1]) {
+    if (PassesTrackGate(r, rig.cameras.size(), 2, 0.5)) {
       ++e.good;
       e.good_tips.push_back((r.tip_in_rig - truth.tip_in_rig).norm());
     }

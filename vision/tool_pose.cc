@@ -374,6 +374,19 @@ bool InitialToolPose(const Rig& rig, const Target& target,
       rig, CollectObservations(rig, target, detections), rig_from_tool);
 }
 
+bool PassesTrackGate(const ToolPoseResult& r, size_t num_cameras, int min_tags,
+                     double max_reproj_px) {
+  std::vector<bool> cameras(num_cameras, false);
+  for (const TagObservationResult& t : r.tags) {
+    if (t.used && t.camera >= 0 && t.camera < static_cast<int>(num_cameras)) {
+      cameras[t.camera] = true;
+    }
+  }
+  const size_t seen = std::count(cameras.begin(), cameras.end(), true);
+  return r.found && r.tags_used >= min_tags && r.rms_px <= max_reproj_px &&
+         seen >= std::min<size_t>(2, num_cameras);
+}
+
 ToolPoseResult EstimateToolPose(
     const Rig& rig, const Target& target,
     const std::vector<std::vector<TagDetection>>& detections,

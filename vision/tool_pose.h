@@ -87,6 +87,15 @@ ToolPoseResult EstimateToolPose(
     const std::vector<std::vector<TagDetection>>& detections,
     const ToolPoseOptions& options = ToolPoseOptions());
 
+// track's quality gate for a tip: a pose was found from at least `min_tags`
+// tag observations, fits them within `max_reproj_px` RMS, and with a rig
+// of two or more cameras uses tags seen by at least two of them (a frame
+// seen by one camera of a stereo rig has a weak depth, tens of mm at 2 m,
+// where the rig's other frames have a fraction of a mm). A one-camera rig
+// has nothing better: its tips are valid with their depth sigma.
+bool PassesTrackGate(const ToolPoseResult& r, size_t num_cameras, int min_tags,
+                     double max_reproj_px);
+
 // Initial pose only (triangulation + Kabsch, or PnP); false when no tag of
 // the target is seen. Exposed for tests.
 bool InitialToolPose(const Rig& rig, const Target& target,

@@ -260,5 +260,31 @@ TEST(ToolPose, UnrefinedTagLeftOutWhileOthersDetermineThePose) {
   EXPECT_EQ(EstimateToolPose(rig, target, dets).tags_used, clean.tags_used);
 }
 
+// track's gate: enough tags, a tight fit, and two cameras where the rig
+// has them (one camera of a stereo rig gives a weak depth).
+TEST(ToolPose, TrackGateNeedsTagsFitAndTwoCameras) {
+  ToolPoseResult r;
+  r.found = true;
+  r.tags_used = 2;
+  r.rms_px = 0.3;
+  TagObservationResult a, b;
+  a.used = b.used = true;
+  a.camera = 0;
+  b.camera = 1;
+  r.tags = {a, b};
+  EXPECT_TRUE(PassesTrackGate(r, 2, 2, 0.5));
+  EXPECT_FALSE(PassesTrackGate(r, 2, 3, 0.5));  // too few tags
+  EXPECT_FALSE(PassesTrackGate(r, 2, 2, 0.2));  // fit too loose
+  r.tags[1].camera = 0;                         // one camera of two
+  EXPECT_FALSE(PassesTrackGate(r, 2, 2, 0.5));
+  EXPECT_TRUE(PassesTrackGate(r, 1, 2, 0.5));  // a one-camera rig
+  r.tags[1].camera = 1;
+  r.tags[1].used = false;  // seen by camera 1 but left out of the fit
+  EXPECT_FALSE(PassesTrackGate(r, 2, 2, 0.5));
+  r.tags[1].used = true;
+  r.found = false;
+  EXPECT_FALSE(PassesTrackGate(r, 2, 2, 0.5));
+}
+
 }  // namespace
 }  // namespace kincal

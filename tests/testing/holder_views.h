@@ -2,10 +2,11 @@
 #define KINCAL_TESTS_TESTING_HOLDER_VIEWS_H_
 
 // Views of a tag holder for the tracker's render tests (our renderer and
-// POV-Ray's): random holder poses in the example rig's common view, and the
-// issue's reference tip from plain corners (triangulation + rigid fit).
+// POV-Ray's): random holder poses in the example rig's common view, the
+// issue's reference tip from plain corners (triangulation + rigid fit), and
+// the RMS of the errors.
 
-#include <Eigen/SVD>
+#include <Eigen/Geometry>
 #include <cmath>
 #include <random>
 #include <vector>
@@ -17,6 +18,12 @@
 #include "vision/triangulate.h"
 
 namespace kincal {
+
+inline double Rms(const std::vector<double>& v) {
+  double s = 0;
+  for (double x : v) s += x * x;
+  return v.empty() ? 0 : std::sqrt(s / v.size());
+}
 
 // The holder facing the rig (tool z into the tags ~ rig z), tilted by up to
 // max_tilt about a random axis in the image plane, turned in-plane at
@@ -36,7 +43,7 @@ inline Rigid3 RandomPose(std::mt19937_64* rng, double max_tilt_deg) {
 }
 
 // The reference: corners seen in both cameras triangulated, then a
-// rigid (Kabsch) fit of the target's corners to them.
+// rigid (Umeyama, no scale) fit of the target's corners to them.
 inline bool TriangulatedRigidTip(
     const Rig& rig, const Target& target,
     const std::vector<std::vector<TagDetection>>& dets, Eigen::Vector3d* tip) {
@@ -50,23 +57,14 @@ inline bool TriangulatedRigidTip(
     b.push_back(p.p_in_rig);
   }
   if (a.size() < 6) return false;
-  Eigen::Vector3d ma = Eigen::Vector3d::Zero(), mb = Eigen::Vector3d::Zero();
+  Eigen::Matrix3Xd from(3, a.size()), to(3, b.size());
   for (size_t i = 0; i < a.size(); ++i) {
-    ma += a[i];
-    mb += b[i];
+    from.col(i) = a[i];
+    to.col(i) = b[i];
   }
-  ma /= a.size();
-  mb /= b.size();
-  Eigen::Matrix3d H = Eigen::Matrix3d::Zero();
-  for (size_t i = 0; i < a.size(); ++i)
-    H += (a[i] - ma) * (b[i] - mb).transpose();
-  Eigen::JacobiSVD<Eigen::Matrix3d> svd(
-      H, Eigen::ComputeFullU | Eigen::ComputeFullV);
-  Eigen::Matrix3d D = Eigen::Matrix3d::Identity();
-  if ((svd.matrixV() * svd.matrixU().transpose()).determinant() < 0)
-    D(2, 2) = -1;
-  const Eigen::Matrix3d R = svd.matrixV() * D * svd.matrixU().transpose();
-  *tip = R * (target.tip_in_tool - ma) + mb;
+  const Eigen::Matrix4d rig_from_tool = Eigen::umeyama(from, to, false);
+  *tip = rig_from_tool.topLeftCorner<3, 3>() * target.tip_in_tool +
+         rig_from_tool.topRightCorner<3, 1>();
   return true;
 }
 
