@@ -3,6 +3,7 @@
 #include <sys/stat.h>
 
 #include <algorithm>
+#include <cctype>
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
@@ -223,13 +224,55 @@ void AddWarnings(const std::vector<Warning>& warnings, nlohmann::json* j) {
 Warnings CommandWarnings() { return Warnings(&std::cerr); }
 
 CLI::Option* AddBayerOption(CLI::App* sub, std::string* pattern) {
-  return sub
-      ->add_option("--bayer", *pattern,
-                   "the images are a colour camera's raw Bayer mosaic "
-                   "(GenICam BayerRG8 = RGGB; RGGB, GRBG, GBRG, BGGR): each "
-                   "pixel phase is white-balanced to gray from the image "
-                   "itself, no demosaic blur (none = gray images)")
-      ->capture_default_str();
+  return sub->add_option(
+      "--bayer", *pattern,
+      "the images are a colour camera's raw Bayer mosaic "
+      "(GenICam BayerRG8 = RGGB; RGGB, GRBG, GBRG, BGGR): each "
+      "pixel phase is white-balanced to gray from the image "
+      "itself, no demosaic blur (none = gray images; default: "
+      "what the session's session.yaml records, else none)");
+}
+
+BayerPattern ChooseBayerPattern(const std::string& option,
+                                const std::vector<std::string>& session_mosaics,
+                                const std::string& session_dir,
+                                Warnings* warnings) {
+  std::string recorded;
+  for (size_t c = 0; c < session_mosaics.size(); ++c) {
+    if (c > 0 && session_mosaics[c] != session_mosaics[0]) {
+      throw InputError(
+          session_dir +
+          "/session.yaml: the cameras record different raw "
+          "mosaics (sources.<camera>.mosaic: '" +
+          session_mosaics[0] + "' and '" + session_mosaics[c] +
+          "'); kincal reads one pattern for all cameras: record them in one "
+          "pixel format, or give --bayer PATTERN to override");
+    }
+    recorded = session_mosaics[0];
+  }
+  if (!option.empty()) {
+    const BayerPattern given = ParseBayerPattern(option);
+    const std::string as_recorded = recorded.empty() ? "NONE" : recorded;
+    std::string upper = option;
+    for (char& ch : upper) ch = static_cast<char>(std::toupper(ch));
+    if (!session_mosaics.empty() && upper != as_recorded) {
+      warnings->Add(
+          "bayer_differs_from_session",
+          "--bayer " + option + " overrides " + session_dir +
+              "/session.yaml, which records " +
+              (recorded.empty() ? std::string("no raw mosaic (gray or "
+                                              "demosaiced images)")
+                                : "raw " + recorded + " mosaics") +
+              "; if the images were recorded by kincal capture, drop "
+              "--bayer");
+    }
+    return given;
+  }
+  if (recorded.empty()) return BayerPattern::kNone;
+  std::cerr << "reading the images as raw " << recorded << " mosaics ("
+            << session_dir << "/session.yaml sources.<camera>.mosaic; "
+            << "--bayer none to read them as gray)\n";
+  return ParseBayerPattern(recorded);
 }
 
 void WarnDoubtfulBayer(int doubtful, int images, BayerPattern pattern,

@@ -117,8 +117,19 @@ void RefuseBlindCameras(const std::vector<int>& tag_counts,
                         const std::string& rig_file, const std::string& frames);
 
 // Adds --bayer PATTERN to `sub` (images are a colour camera's raw mosaic,
-// balanced to gray before detection; vision/bayer.h).
+// balanced to gray before detection; vision/bayer.h). Left empty when not
+// given: ChooseBayerPattern then asks session.yaml.
 CLI::Option* AddBayerOption(CLI::App* sub, std::string* pattern);
+// The pattern to read the images with: --bayer when given (`option`: a
+// pattern or none); else the one session.yaml records for the cameras
+// (`session_mosaics`, Session::mosaics: `capture` with bayer=raw writes
+// it), said on stderr; none when it records none. InputError when the
+// cameras record different patterns (one pattern is read for all); the
+// warning `bayer_differs_from_session` when --bayer contradicts it.
+BayerPattern ChooseBayerPattern(const std::string& option,
+                                const std::vector<std::string>& session_mosaics,
+                                const std::string& session_dir,
+                                Warnings* warnings);
 // The warning for `doubtful` of `images` images whose Bayer balance looked
 // wrong (green phases apart, or no bright flat paper): the images may not be
 // a raw mosaic of `pattern`.

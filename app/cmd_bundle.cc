@@ -46,7 +46,9 @@ struct BundleArgs {
   double max_reproj_px = 0.5;
   // A finding must move the tool row's end by at least this much (RMS, mm).
   double min_effect_mm = 0.005;
-  std::string bayer = "none";  // raw mosaic pattern of the images
+  // Raw mosaic pattern of the images; empty: session.yaml's, else none
+  // (ChooseBayerPattern).
+  std::string bayer;
   bool json = false, quiet = false;
 };
 
@@ -421,7 +423,8 @@ int RunBundleCommand(BundleArgs args) {
 
   BundleRun run;
   ObserveOptions oo;
-  oo.bayer = ParseBayerPattern(args.bayer);
+  oo.bayer =
+      ChooseBayerPattern(args.bayer, session.mosaics, args.session, &warnings);
   oo.progress = [&progress](int done, int total) {
     progress.Update(done, total, "frames (detecting tags)");
   };

@@ -129,6 +129,7 @@ nlohmann::json CapturedCamerasJson(
                    {"uri", c.uri},
                    {"description", c.description},
                    {"dropped", c.dropped}});
+    if (!c.mosaic.empty()) out.back()["mosaic"] = c.mosaic;
   }
   return out;
 }

@@ -34,10 +34,13 @@ struct TargetArgs {
   int min_views = 10;
   bool json = false;
   bool quiet = false;
+  // Raw mosaic pattern of the images; empty: session.yaml's, else none.
+  std::string bayer;
 };
 
 std::vector<LayoutFrame> Detect(const std::string& dir, const Rig& rig,
-                                const TargetArgs& args, Progress* progress) {
+                                const TargetArgs& args, Progress* progress,
+                                Warnings* warnings) {
   SessionReadOptions so;
   so.camera_names = rig.CameraNames();
   const Session session = ReadSession(dir, so);
@@ -46,9 +49,12 @@ std::vector<LayoutFrame> Detect(const std::string& dir, const Rig& rig,
   }
   AprilTagOptions detector;
   detector.family = args.family;
-  return DetectSessionTags(session, rig, detector, [&](int done, int total) {
-    progress->Update(done, total, "frames of " + dir);
-  });
+  const BayerPattern bayer =
+      ChooseBayerPattern(args.bayer, session.mosaics, dir, warnings);
+  return DetectSessionTags(session, rig, detector, bayer,
+                           [&](int done, int total) {
+                             progress->Update(done, total, "frames of " + dir);
+                           });
 }
 
 // The tip by pivot calibration with the measured layout; a refusal names
@@ -162,11 +168,12 @@ int RunTarget(const TargetArgs& args) {
   options.min_views = args.min_views;
   options.Check();
   Progress progress("kincal target", args.quiet || args.json);
+  Warnings warnings = CommandWarnings();
   const std::vector<LayoutFrame> frames =
-      Detect(args.session, rig, args, &progress);
+      Detect(args.session, rig, args, &progress, &warnings);
   std::vector<LayoutFrame> pivot_frames;
   if (!args.pivot.empty()) {
-    pivot_frames = Detect(args.pivot, rig, args, &progress);
+    pivot_frames = Detect(args.pivot, rig, args, &progress, &warnings);
   }
   progress.Stage("bundle over every tag corner");
   const TargetLayoutResult layout = MeasureTargetLayout(rig, frames, options);
@@ -183,7 +190,6 @@ int RunTarget(const TargetArgs& args) {
     target.tip_sigma_mm = pivot->tip_sigma_mm;
   }
   progress.Done();
-  Warnings warnings = CommandWarnings();
   WarnAboutLayoutViews(layout, &warnings);
   WriteTargetYaml(args.out, target);
   const double seconds =
@@ -220,6 +226,7 @@ void AddTargetCommand(CLI::App& app, Runner* run) {
       ->capture_default_str()
       ->check(CLI::Range(0.0, 90.0));
   sub->add_flag("--quiet", args->quiet, "no progress bar on stderr");
+  AddBayerOption(sub, &args->bayer);
   sub->add_flag("--json", args->json, "print one JSON object");
   sub->footer(HelpFooter(
       "Example:\n  kincal target --rig rig.yaml --session tool_session "

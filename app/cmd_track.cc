@@ -51,7 +51,9 @@ struct TrackArgs {
   bool no_tracking = false;
   double decimate = 2.0;
   bool quiet = false;
-  std::string bayer = "none";  // raw mosaic pattern of the images
+  // Raw mosaic pattern of the images; empty: session.yaml's, else none
+  // (ChooseBayerPattern).
+  std::string bayer;
 };
 
 std::string PosesPath(const std::string& out) {
@@ -530,11 +532,15 @@ void RefuseImpossibleDepth(const TrackArgs& args, const Rig& rig,
                    " frames), closer than any lens focuses: " + pair + units);
 }
 
-int RunTrack(const TrackArgs& args) {
+int RunTrack(const TrackArgs& given) {
   const auto start = std::chrono::steady_clock::now();
-  const Rig rig = ReadRigYaml(args.rig);
-  const Target target = ReadTargetYaml(args.target);
-  const FrameSets pairs = ListFrameSets(args, rig);
+  const Rig rig = ReadRigYaml(given.rig);
+  const Target target = ReadTargetYaml(given.target);
+  const FrameSets pairs = ListFrameSets(given, rig);
+  Warnings warnings = CommandWarnings();
+  TrackArgs args = given;
+  args.bayer = BayerPatternName(ChooseBayerPattern(
+      given.bayer, pairs.session.mosaics, given.session, &warnings));
   Merge merge = PrepareMerge(args, pairs);
   const Tracked tracked = TrackFrames(args, rig, target, pairs, &merge);
   // Images without any tag in every camera are read as they are (the tool
@@ -548,7 +554,6 @@ int RunTrack(const TrackArgs& args) {
   const std::string poses_path = PosesPath(args.out);
   WriteFileAtomic(poses_path, tracked.poses);
   const bool merged = !merge.merged.rows.empty();
-  Warnings warnings = CommandWarnings();
   WarnDoubtfulBayer(tracked.bayer_doubtful,
                     static_cast<int>(pairs.size() * rig.cameras.size()),
                     ParseBayerPattern(args.bayer), &warnings);

@@ -73,7 +73,7 @@ void BM_RecordStereoPair(benchmark::State& state) {
   options.png_compression = level;
   SessionRecorder recorder(options);
   SessionInfo info;
-  info.cameras = {{"left", "", ""}, {"right", "", ""}};
+  info.cameras = {{"left", "", "", ""}, {"right", "", "", ""}};
   if (!recorder.Open(dir + "/s", info).ok()) {
     state.SkipWithError("cannot open the session");
     return;

@@ -46,7 +46,8 @@ Figures Record(const std::vector<std::string>& names,
   for (size_t k = 0; k < uris.size(); ++k) {
     sources.push_back(MakeFrameSource(uris[k]));
     pointers.push_back(sources.back().get());
-    info.cameras.push_back({names[k], uris[k], sources.back()->Describe()});
+    info.cameras.push_back({names[k], uris[k], sources.back()->Describe(),
+                            sources.back()->mosaic()});
   }
   FrameGrabber grabber(pointers);
   Figures f;

@@ -102,7 +102,8 @@ class AravisSource : public FrameSource {
         has_gain_(uri.params.count("gain") > 0),
         fps_(uri.GetDouble("fps", 0, 0.1, 1000)),
         n_buffers_(uri.GetInt("buffers", 8, 2, 64)),
-        timeout_ms_(uri.GetInt("timeout_ms", 2000, 1, 600000)) {}
+        timeout_ms_(uri.GetInt("timeout_ms", 2000, 1, 600000)),
+        keep_mosaic_(KeepsMosaic(uri)) {}
   ~AravisSource() override { Close(); }
 
   Status Open() override {
@@ -165,8 +166,10 @@ class AravisSource : public FrameSource {
     if (fps_ > 0) os << " " << fps_ << " fps";
     if (exposure_us_ > 0) os << " exposure " << exposure_us_ << " us";
     if (has_gain_) os << " gain " << gain_;
+    if (!mosaic_.empty()) os << ", raw mosaic";
     return os.str();
   }
+  std::string mosaic() const override { return mosaic_; }
   bool IsLive() const override { return true; }
   TimeBase time_base() const override { return TimeBase::kHostMonotonic; }
 
@@ -222,6 +225,17 @@ class AravisSource : public FrameSource {
                                "' not supported; use format=Mono8, Mono16, "
                                "BayerRG8, ... in the URI");
     }
+    if (keep_mosaic_ && layout != PixelLayout::kBayer8 &&
+        layout != PixelLayout::kBayer16) {
+      return Status::Error(Status::Kind::kUnsupported,
+                           "aravis camera '" + id_ +
+                               "': bayer=raw, but it "
+                               "delivers " +
+                               format_ +
+                               "; give format=BayerRG8 (or the camera's "
+                               "Bayer format) or drop bayer=raw");
+    }
+    mosaic_ = keep_mosaic_ ? MosaicName(bayer) : "";
     gint x = 0, y = 0;
     arv_camera_get_region(camera_, &x, &y, &width_, &height_, &error);
     TakeError(&error);
@@ -270,6 +284,7 @@ class AravisSource : public FrameSource {
     pb.bytes = size;
     pb.width = arv_buffer_get_image_width(buffer);
     pb.height = arv_buffer_get_image_height(buffer);
+    pb.keep_mosaic = keep_mosaic_;
     Status s = ConvertToMat(pb, &frame->image);
     if (!s.ok()) {
       return Status::Error(s.kind(),
@@ -293,6 +308,8 @@ class AravisSource : public FrameSource {
   double fps_;
   int n_buffers_;
   int timeout_ms_;
+  bool keep_mosaic_;    // bayer=raw
+  std::string mosaic_;  // the kept mosaic's pattern, after Open
   std::string model_;
   gint width_ = 0;
   gint height_ = 0;

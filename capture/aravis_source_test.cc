@@ -51,6 +51,25 @@ TEST(AravisSourceTest, Mono16FromTheSimulatedCameraBecomes8Bit) {
   EXPECT_EQ(f.image.type(), CV_8UC1);
 }
 
+TEST(AravisSourceTest, BayerFromTheSimulatedCameraKeptRawWhenAsked) {
+  if (!HaveAravis()) GTEST_SKIP() << "built without Aravis";
+  auto demosaiced = MakeFrameSource("aravis:Fake_1?format=BayerGR8");
+  const Status open = demosaiced->Open();
+  if (!open.ok()) GTEST_SKIP() << "simulated camera: " << open.ToString();
+  Frame f;
+  ASSERT_TRUE(demosaiced->Grab(&f).ok());
+  EXPECT_EQ(f.image.type(), CV_8UC3);
+  EXPECT_EQ(demosaiced->mosaic(), "");
+  ASSERT_TRUE(demosaiced->Close().ok());
+
+  auto raw = MakeFrameSource("aravis:Fake_1?format=BayerGR8&bayer=raw");
+  ASSERT_TRUE(raw->Open().ok());
+  ASSERT_TRUE(raw->Grab(&f).ok());
+  EXPECT_EQ(f.image.type(), CV_8UC1);
+  EXPECT_EQ(raw->mosaic(), "GRBG");
+  EXPECT_NE(raw->Describe().find("raw mosaic"), std::string::npos);
+}
+
 TEST(AravisSourceTest, UnknownCameraIsNotFound) {
   if (!HaveAravis()) GTEST_SKIP() << "built without Aravis";
   auto source = MakeFrameSource("aravis:NoSuchVendor-0000");

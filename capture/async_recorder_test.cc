@@ -47,7 +47,7 @@ FrameSet Copy(const FrameSet& set) {
 
 SessionInfo Info() {
   SessionInfo info;
-  info.cameras = {{"left", "fake:l", ""}, {"right", "fake:r", ""}};
+  info.cameras = {{"left", "fake:l", "", ""}, {"right", "fake:r", "", ""}};
   info.pairing = "timestamp";
   info.time_base = "host_monotonic";
   info.live = true;

@@ -163,7 +163,8 @@ SessionInfo DescribeCameras(const CaptureOptions& options, const Inputs& in,
   SessionInfo info;
   for (size_t k = 0; k < options.cameras.size(); ++k) {
     info.cameras.push_back({options.cameras[k].name, options.cameras[k].uri,
-                            in.sources[k]->Describe()});
+                            in.sources[k]->Describe(),
+                            in.sources[k]->mosaic()});
   }
   info.live = in.live;
   info.pairing = PairingName(grabber.pairing());
@@ -214,7 +215,7 @@ CaptureResult RunStepAndShootMode(const CaptureOptions& options, Inputs* in) {
   for (size_t k = 0; k < step.info.cameras.size(); ++k) {
     const SessionCamera& c = step.info.cameras[k];
     result.cameras.push_back(
-        {c.name, c.uri, c.description, grabber.dropped(k)});
+        {c.name, c.uri, c.description, grabber.dropped(k), c.mosaic});
   }
   grabber.Close();
   if (result.step.outcome == StepAndShootResult::kBadInput) {
@@ -477,7 +478,7 @@ void DescribeRecording(const SessionInfo& info, const FrameGrabber& grabber,
   for (size_t k = 0; k < info.cameras.size(); ++k) {
     const SessionCamera& c = info.cameras[k];
     result->cameras.push_back(
-        {c.name, c.uri, c.description, grabber.dropped(k)});
+        {c.name, c.uri, c.description, grabber.dropped(k), c.mosaic});
   }
   result->pairing = info.pairing;
   result->dropped_sets = writer.dropped_sets();

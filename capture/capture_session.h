@@ -83,6 +83,7 @@ struct CapturedCamera {
   std::string uri;
   std::string description;  // FrameSource::Describe() after opening
   int64_t dropped = 0;      // frames in no set (no partner in time, or extra)
+  std::string mosaic;       // FrameSource::mosaic(): raw pattern, or empty
 };
 
 struct CaptureResult {

@@ -3,8 +3,11 @@
 // at the same rate give identical timestamps, like hardware-triggered
 // ones), paced in real time, 8-bit gray: a checkerboard scene with sensor-
 // like noise (4 noise patterns, cycled) and a bright bar that moves with the
-// frame number. For tests, benchmarks and the lab procedure without
-// cameras; like any live camera it never ends.
+// frame number. With mosaic=RGGB (or GRBG, GBRG, BGGR) the frames are a
+// colour sensor's raw mosaic of that scene: each photosite scaled by its
+// filter's response (red 0.55, green 1, blue 0.75 of the gray scene). For
+// tests, benchmarks and the lab procedure without cameras; like any live
+// camera it never ends.
 
 #include <cmath>
 #include <opencv2/imgproc.hpp>
@@ -15,13 +18,27 @@
 namespace kincal::capture {
 namespace {
 
+// The gray scene seen through the colour filters of `mosaic` (RGGB ...):
+// every photosite scaled by its filter's response to gray.
+void ApplyFilterResponses(const std::string& mosaic, cv::Mat* image) {
+  for (int r = 0; r < image->rows; ++r) {
+    uint8_t* row = image->ptr<uint8_t>(r);
+    for (int c = 0; c < image->cols; ++c) {
+      const char filter = mosaic[2 * (r % 2) + c % 2];
+      const double gain = filter == 'R' ? 0.55 : (filter == 'B' ? 0.75 : 1.0);
+      row[c] = static_cast<uint8_t>(std::lround(gain * row[c]));
+    }
+  }
+}
+
 class FakeSource : public FrameSource {
  public:
   explicit FakeSource(const SourceUri& uri)
       : name_(uri.path),
         width_(uri.GetInt("width", 640, 16, 16384)),
         height_(uri.GetInt("height", 480, 16, 16384)),
-        fps_(uri.GetDouble("fps", 30, 0.1, 1000)) {}
+        fps_(uri.GetDouble("fps", 30, 0.1, 1000)),
+        mosaic_(DeclaredMosaic(uri)) {}
 
   Status Open() override {
     scenes_.clear();
@@ -64,6 +81,7 @@ class FakeSource : public FrameSource {
     const int bar = static_cast<int>((sequence_ * 8) % width_);
     cv::rectangle(frame->image, cv::Rect(bar, 0, 8, height_), cv::Scalar(230),
                   cv::FILLED);
+    if (!mosaic_.empty()) ApplyFilterResponses(mosaic_, &frame->image);
     frame->timestamp_s = t;
     frame->sequence = sequence_++;
     ++next_tick_;
@@ -76,15 +94,19 @@ class FakeSource : public FrameSource {
   }
   std::string Describe() const override {
     return "fake camera '" + name_ + "' " + std::to_string(width_) + "x" +
-           std::to_string(height_) + " gray " + std::to_string(fps_) + " fps";
+           std::to_string(height_) +
+           (mosaic_.empty() ? " gray " : " raw " + mosaic_ + " ") +
+           std::to_string(fps_) + " fps";
   }
   bool IsLive() const override { return true; }
   TimeBase time_base() const override { return TimeBase::kHostMonotonic; }
+  std::string mosaic() const override { return mosaic_; }
 
  private:
   std::string name_;
   int width_, height_;
   double fps_;
+  std::string mosaic_;  // raw mosaic pattern, empty for gray frames
   std::vector<cv::Mat> scenes_;
   int64_t next_tick_ = 0;
   int64_t sequence_ = 0;

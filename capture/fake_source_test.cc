@@ -43,6 +43,30 @@ TEST(FakeSourceTest, TheBrightBarMovesWithTheFrameNumber) {
   EXPECT_NE(second.image.at<uint8_t>(10, 3), 230);
 }
 
+TEST(FakeSourceTest, MosaicFramesScaleEachPhotositeByItsFilter) {
+  auto gray = MakeFrameSource("fake:m?width=64&height=32&fps=200");
+  auto raw = MakeFrameSource("fake:m?width=64&height=32&fps=200&mosaic=GRBG");
+  EXPECT_EQ(gray->mosaic(), "");
+  EXPECT_EQ(raw->mosaic(), "GRBG");
+  ASSERT_TRUE(gray->Open().ok());
+  ASSERT_TRUE(raw->Open().ok());
+  Frame g, r;
+  ASSERT_TRUE(gray->Grab(&g).ok());
+  ASSERT_TRUE(raw->Grab(&r).ok());
+  ASSERT_EQ(r.image.type(), CV_8UC1);
+  // GRBG: green at (0, 0) and (1, 1), red at (0, 1), blue at (1, 0).
+  for (int y = 20; y < 24; y += 2) {
+    for (int x = 20; x < 24; x += 2) {
+      EXPECT_EQ(r.image.at<uint8_t>(y, x), g.image.at<uint8_t>(y, x));
+      EXPECT_NEAR(r.image.at<uint8_t>(y, x + 1),
+                  0.55 * g.image.at<uint8_t>(y, x + 1), 0.51);
+      EXPECT_NEAR(r.image.at<uint8_t>(y + 1, x),
+                  0.75 * g.image.at<uint8_t>(y + 1, x), 0.51);
+    }
+  }
+  EXPECT_NE(raw->Describe().find("raw GRBG"), std::string::npos);
+}
+
 TEST(FakeSourceTest, GrabBeforeOpenIsAnIoError) {
   auto source = MakeFrameSource("fake:closed");
   Frame frame;

@@ -27,7 +27,9 @@ bool IsImageName(const std::string& path) {
 class FolderSource : public FrameSource {
  public:
   explicit FolderSource(const SourceUri& uri)
-      : pattern_(uri.path), fps_(uri.GetDouble("fps", 30, 0.001, 1e6)) {}
+      : pattern_(uri.path),
+        fps_(uri.GetDouble("fps", 30, 0.001, 1e6)),
+        mosaic_(DeclaredMosaic(uri)) {}
 
   Status Open() override {
     files_.clear();
@@ -65,6 +67,13 @@ class FolderSource : public FrameSource {
       return Status::Error(Status::Kind::kIoError,
                            path + ": cannot read the image");
     }
+    if (!mosaic_.empty() && image.channels() != 1) {
+      return Status::Error(Status::Kind::kIoError,
+                           path + ": a colour image, but the source says " +
+                               "mosaic=" + mosaic_ +
+                               " (a raw mosaic is one gray channel; drop "
+                               "mosaic= for demosaiced images)");
+    }
     frame->image = image;
     frame->sequence = static_cast<int64_t>(next_);
     frame->timestamp_s = static_cast<double>(next_) / fps_;
@@ -82,14 +91,17 @@ class FolderSource : public FrameSource {
     os << "folder " << pattern_;
     if (open_) os << " (" << files_.size() << " images)";
     os << " at " << fps_ << " fps";
+    if (!mosaic_.empty()) os << ", raw " << mosaic_ << " mosaics";
     return os.str();
   }
   bool IsLive() const override { return false; }
   TimeBase time_base() const override { return TimeBase::kMedia; }
+  std::string mosaic() const override { return mosaic_; }
 
  private:
   std::string pattern_;
   double fps_;
+  std::string mosaic_;
   std::vector<std::string> files_;
   size_t next_ = 0;
   bool open_ = false;

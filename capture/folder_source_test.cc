@@ -45,6 +45,27 @@ TEST(FolderSourceTest, ReplaysImagesSortedByNameThenEnds) {
   EXPECT_NE(source->Describe().find("4 images"), std::string::npos);
 }
 
+TEST(FolderSourceTest, DeclaredMosaicIsReportedAndColourImagesRefused) {
+  const std::string dir = MakeTempDir("folder_mosaic");
+  WriteImages(dir, "raw", {0, 1});
+  auto source = MakeFrameSource("folder:" + dir + "/raw*.png?mosaic=BGGR");
+  EXPECT_EQ(source->mosaic(), "BGGR");
+  ASSERT_TRUE(source->Open().ok());
+  Frame f;
+  ASSERT_TRUE(source->Grab(&f).ok());
+  EXPECT_EQ(f.image.type(), CV_8UC1);
+  EXPECT_NE(source->Describe().find("raw BGGR mosaics"), std::string::npos);
+
+  cv::imwrite(dir + "/colour000.png",
+              cv::Mat(8, 12, CV_8UC3, cv::Scalar(1, 2, 3)));
+  auto colour = MakeFrameSource("folder:" + dir + "/colour*.png?mosaic=RGGB");
+  ASSERT_TRUE(colour->Open().ok());
+  const Status s = colour->Grab(&f);
+  EXPECT_EQ(s.kind(), Status::Kind::kIoError);
+  EXPECT_NE(s.message().find("a raw mosaic is one gray channel"),
+            std::string::npos);
+}
+
 TEST(FolderSourceTest, FolderPathTakesAllImagesAndEmptyGlobIsNotFound) {
   const std::string dir = MakeTempDir("folder_all");
   WriteImages(dir, "a", {0, 1});

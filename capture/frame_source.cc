@@ -14,12 +14,14 @@ namespace {
 
 const std::map<std::string, std::set<std::string>>& AllowedKeys() {
   static const auto* keys = new std::map<std::string, std::set<std::string>>{
-      {"v4l2", {"width", "height", "fps", "format", "buffers", "timeout_ms"}},
+      {"v4l2",
+       {"width", "height", "fps", "format", "buffers", "timeout_ms", "bayer"}},
       {"aravis",
-       {"exposure_us", "gain", "fps", "format", "buffers", "timeout_ms"}},
-      {"folder", {"fps"}},
+       {"exposure_us", "gain", "fps", "format", "buffers", "timeout_ms",
+        "bayer"}},
+      {"folder", {"fps", "mosaic"}},
       {"video", {}},
-      {"fake", {"width", "height", "fps"}},
+      {"fake", {"width", "height", "fps", "mosaic"}},
   };
   return *keys;
 }
@@ -123,6 +125,25 @@ std::string SourceUri::GetString(const std::string& key,
   return it == params.end() ? fallback : it->second;
 }
 
+bool KeepsMosaic(const SourceUri& uri) {
+  const std::string b = uri.GetString("bayer", "demosaic");
+  if (b != "raw" && b != "demosaic") {
+    throw InputError("source '" + uri.text + "': bayer=" + b +
+                     ": expected raw (keep the mosaic) or demosaic");
+  }
+  return b == "raw";
+}
+
+std::string DeclaredMosaic(const SourceUri& uri) {
+  const std::string m = uri.GetString("mosaic", "");
+  if (!m.empty() && m != "RGGB" && m != "GRBG" && m != "GBRG" && m != "BGGR") {
+    throw InputError("source '" + uri.text + "': mosaic=" + m +
+                     ": expected RGGB, GRBG, GBRG or BGGR (the top-left 2x2 "
+                     "cell row by row; GenICam BayerRG8 = RGGB)");
+  }
+  return m;
+}
+
 SourceUri ParseSourceUri(const std::string& text) {
   SourceUri uri;
   uri.text = text;
@@ -195,11 +216,21 @@ SourceUri ParseSourceUri(const std::string& text) {
     }
     uri.GetDouble("fps", 0, 0.1, 1000);
     const std::string f = uri.GetString("format", "YUYV");
-    if (f != "GREY" && f != "YUYV" && f != "MJPG") {
-      Fail(text, "format=" + f + ": expected GREY, YUYV or MJPG");
+    static const std::set<std::string> kV4l2Formats = {
+        "GREY", "YUYV", "MJPG", "RGGB", "GRBG", "GBRG", "BA81"};
+    if (!kV4l2Formats.count(f)) {
+      Fail(text, "format=" + f +
+                     ": expected GREY, YUYV, MJPG or an 8-bit Bayer format "
+                     "(RGGB, GRBG, GBRG, BA81 = BGGR)");
     }
     uri.GetInt("buffers", 4, 2, 32);
     uri.GetInt("timeout_ms", 2000, 1, 600000);
+    if (KeepsMosaic(uri) && (f == "GREY" || f == "YUYV" || f == "MJPG")) {
+      Fail(text,
+           "bayer=raw needs a Bayer format (format=RGGB, GRBG, GBRG or "
+           "BA81), got format=" +
+               f);
+    }
   } else if (uri.scheme == "aravis") {
     uri.GetDouble("exposure_us", 0, 1, 1e7);
     uri.GetDouble("gain", 0, 0, 100);
@@ -214,12 +245,20 @@ SourceUri ParseSourceUri(const std::string& text) {
     }
     uri.GetInt("buffers", 8, 2, 64);
     uri.GetInt("timeout_ms", 2000, 1, 600000);
+    if (KeepsMosaic(uri) && !f.empty() && f.compare(0, 5, "Bayer") != 0) {
+      Fail(text,
+           "bayer=raw needs a Bayer format (format=BayerRG8, ...), "
+           "got format=" +
+               f);
+    }
   } else if (uri.scheme == "folder") {
     uri.GetDouble("fps", 30, 0.001, 1e6);
+    DeclaredMosaic(uri);
   } else if (uri.scheme == "fake") {
     uri.GetInt("width", 640, 16, 16384);
     uri.GetInt("height", 480, 16, 16384);
     uri.GetDouble("fps", 30, 0.1, 1000);
+    DeclaredMosaic(uri);
   }
   return uri;
 }

@@ -52,6 +52,12 @@ class FrameSource {
   // false for replay (frames paired in lock step).
   virtual bool IsLive() const = 0;
   virtual TimeBase time_base() const = 0;
+  // The colour filter pattern (RGGB, GRBG, GBRG or BGGR: the top-left 2x2
+  // cell row by row) when the source delivers a colour sensor's raw mosaic
+  // (one photosite per pixel, CV_8UC1; URI bayer=raw or mosaic=...); empty
+  // for gray and demosaiced colour images. session.yaml records it, and
+  // `track`/`bundle` read such images without a demosaic.
+  virtual std::string mosaic() const { return {}; }
 };
 
 // A parsed source URI: "scheme:path?key=value&key=value".
@@ -74,16 +80,28 @@ struct SourceUri {
 // scheme's keys, values well-formed). Throws kincal::InputError with a message
 // naming the URI and what was expected. Touches neither devices nor files.
 //
-//   v4l2:/dev/video0?width=1280&height=1024&fps=30&format=GREY|YUYV|MJPG
-//        (&buffers=4&timeout_ms=2000)
+//   v4l2:/dev/video0?width=1280&height=1024&fps=30&format=GREY|YUYV|MJPG|
+//        RGGB|GRBG|GBRG|BA81 (&buffers=4&timeout_ms=2000&bayer=raw|demosaic)
 //   aravis:<camera id>?exposure_us=..&gain=..&fps=..&format=Mono8|Mono16|
-//        BayerRG8|...&timeout_ms=2000
+//        BayerRG8|...&timeout_ms=2000&bayer=raw|demosaic
 //   folder:/path/left*.png?fps=30      (a folder path alone: all its images)
+//        (&mosaic=RGGB|GRBG|GBRG|BGGR: the images are raw mosaics)
 //   video:/path/file.mp4
+//
+// bayer=raw keeps a Bayer format's mosaic (FrameSource::mosaic) instead of
+// demosaicing it to BGR (bayer=demosaic, the default); it needs a Bayer
+// format (v4l2: RGGB, GRBG, GBRG, BA81 = BGGR; aravis: Bayer??8/16).
 //
 // For folder: and video: a '?' is a glob wildcard unless what follows it is
 // key=value pairs, so "folder:/d/img?.png" is a glob.
 SourceUri ParseSourceUri(const std::string& text);
+
+// The URI's bayer= setting: true for bayer=raw (keep a Bayer format's
+// mosaic), false for bayer=demosaic or none given; InputError otherwise.
+bool KeepsMosaic(const SourceUri& uri);
+// The URI's mosaic= setting (folder:, fake:): the pattern of the raw mosaics
+// the images hold, empty when not given; InputError for another value.
+std::string DeclaredMosaic(const SourceUri& uri);
 
 // ParseSourceUri + the matching source (not yet opened). Throws InputError on
 // a bad URI, and for aravis: when kincal was built without Aravis.

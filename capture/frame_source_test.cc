@@ -69,9 +69,25 @@ TEST(SourceUriTest, RejectsBadUrisWithClearMessages) {
   EXPECT_NE(
       ParseError("v4l2:/dev/video0?width=640").find("both width and height"),
       std::string::npos);
-  EXPECT_NE(
-      ParseError("v4l2:/dev/video0?format=RGB3").find("GREY, YUYV or MJPG"),
-      std::string::npos);
+  EXPECT_NE(ParseError("v4l2:/dev/video0?format=RGB3")
+                .find("GREY, YUYV, MJPG or an 8-bit Bayer"),
+            std::string::npos);
+  // bayer=raw keeps a Bayer format's mosaic: a gray or YUYV format has none.
+  EXPECT_NE(ParseError("v4l2:/dev/video0?format=YUYV&bayer=raw")
+                .find("bayer=raw needs a Bayer format"),
+            std::string::npos);
+  EXPECT_NE(ParseError("aravis:cam?format=Mono8&bayer=raw")
+                .find("bayer=raw needs a Bayer format"),
+            std::string::npos);
+  EXPECT_NE(ParseError("aravis:cam?bayer=yes").find("expected raw"),
+            std::string::npos);
+  EXPECT_NE(ParseError("folder:/d?mosaic=RGB").find("RGGB, GRBG, GBRG or BGGR"),
+            std::string::npos);
+  EXPECT_NE(ParseError("video:/a.mp4?mosaic=RGGB").find("unknown setting"),
+            std::string::npos);
+  EXPECT_NO_THROW(ParseSourceUri("v4l2:/dev/video0?format=BA81&bayer=raw"));
+  EXPECT_NO_THROW(ParseSourceUri("aravis:cam?format=BayerRG16&bayer=raw"));
+  EXPECT_NO_THROW(ParseSourceUri("aravis:cam?bayer=raw"));  // checked at Open
   EXPECT_NE(ParseError("v4l2:/dev/video0?fps=abc").find("fps=abc"),
             std::string::npos);
   EXPECT_NE(ParseError("v4l2:/dev/video0?fps=0").find("[0.1, 1000]"),

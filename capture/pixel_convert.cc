@@ -125,14 +125,19 @@ Status ConvertToMat(const PixelBuffer& b, cv::Mat* out) {
                    cv::COLOR_YUV2BGR_YUY2);
       break;
     case PixelLayout::kBayer8:
-      cv::cvtColor(cv::Mat(b.height, b.width, CV_8UC1, data, stride), *out,
-                   OpenCvBayerCode(b.bayer));
+    case PixelLayout::kBayer16: {
+      cv::Mat mosaic =
+          b.layout == PixelLayout::kBayer8
+              ? cv::Mat(b.height, b.width, CV_8UC1, data, stride)
+              : To8Bit(cv::Mat(b.height, b.width, CV_16UC1, data, stride),
+                       b.bits);
+      if (b.keep_mosaic) {
+        *out = b.layout == PixelLayout::kBayer8 ? mosaic.clone() : mosaic;
+      } else {
+        cv::cvtColor(mosaic, *out, OpenCvBayerCode(b.bayer));
+      }
       break;
-    case PixelLayout::kBayer16:
-      cv::cvtColor(
-          To8Bit(cv::Mat(b.height, b.width, CV_16UC1, data, stride), b.bits),
-          *out, OpenCvBayerCode(b.bayer));
-      break;
+    }
     case PixelLayout::kRgb8:
       cv::cvtColor(cv::Mat(b.height, b.width, CV_8UC3, data, stride), *out,
                    cv::COLOR_RGB2BGR);
@@ -144,6 +149,20 @@ Status ConvertToMat(const PixelBuffer& b, cv::Mat* out) {
       break;  // handled above
   }
   return Status::Ok();
+}
+
+const char* MosaicName(BayerPattern pattern) {
+  switch (pattern) {
+    case BayerPattern::kRG:
+      return "RGGB";
+    case BayerPattern::kGR:
+      return "GRBG";
+    case BayerPattern::kGB:
+      return "GBRG";
+    case BayerPattern::kBG:
+      return "BGGR";
+  }
+  return "RGGB";
 }
 
 bool LayoutFromGenicamName(const std::string& name, PixelLayout* layout,

@@ -35,14 +35,21 @@ struct PixelBuffer {
   PixelLayout layout = PixelLayout::kGray8;
   BayerPattern bayer = BayerPattern::kRG;
   int bits = 16;  // significant bits of 16-bit layouts (10, 12 or 16)
+  // Bayer layouts: keep the raw mosaic (CV_8UC1, one photosite per pixel)
+  // instead of demosaicing to BGR. The mosaic corners more accurately than
+  // a demosaiced image (`track`/`bundle --bayer`, docs/VISION.md).
+  bool keep_mosaic = false;
 };
 
+// The pattern's name as `track --bayer` and session.yaml's `mosaic` spell
+// it, the top-left 2x2 cell row by row: RGGB, GRBG, GBRG, BGGR.
+const char* MosaicName(BayerPattern pattern);
+
 // Converts a buffer to an 8-bit image that owns its data: CV_8UC1 for gray
-// layouts, CV_8UC3 BGR for colour ones. 16-bit data keeps its top 8
-// significant bits (value / 2^(bits - 8),
-// rounded, saturated). kIoError for a short or corrupt
-// buffer (a truncated frame, an undecodable JPEG), kUnsupported for
-// nonsensical parameters.
+// layouts and kept mosaics, CV_8UC3 BGR for colour ones. 16-bit data keeps its
+// top 8 significant bits (value / 2^(bits - 8), rounded, saturated). kIoError
+// for a short or corrupt buffer (a truncated frame, an undecodable JPEG),
+// kUnsupported for nonsensical parameters.
 Status ConvertToMat(const PixelBuffer& buffer, cv::Mat* out);
 
 // Parses GenICam pixel format names used in URIs ("Mono8", "BayerRG16", ...)

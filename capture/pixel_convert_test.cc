@@ -126,6 +126,44 @@ TEST(PixelConvertTest, BayerPatternsFollowGenicamNaming) {
   }
 }
 
+TEST(PixelConvertTest, KeptMosaicIsTheRawPhotositesWithTheirPatternName) {
+  const cv::Vec3b colour(20, 120, 220);
+  const std::vector<uint8_t> raw = Mosaic(BayerPattern::kGB, 8, 6, colour);
+  PixelBuffer b = Buffer(raw, 8, 6, PixelLayout::kBayer8);
+  b.bayer = BayerPattern::kGB;
+  b.keep_mosaic = true;
+  cv::Mat out;
+  ASSERT_TRUE(ConvertToMat(b, &out).ok());
+  ASSERT_EQ(out.type(), CV_8UC1);
+  for (int r = 0; r < 6; ++r) {
+    for (int c = 0; c < 8; ++c) {
+      ASSERT_EQ(out.at<uint8_t>(r, c), raw[r * 8 + c]) << r << "," << c;
+    }
+  }
+  EXPECT_NE(static_cast<const void*>(out.data), raw.data());  // owns a copy
+
+  // 12-bit samples keep their top 8 bits, still undemosaiced.
+  std::vector<uint8_t> wide;
+  for (uint8_t v : raw) {
+    const uint16_t s = static_cast<uint16_t>(v) << 4;
+    wide.push_back(s & 0xff);
+    wide.push_back(s >> 8);
+  }
+  PixelBuffer b16 = Buffer(wide, 8, 6, PixelLayout::kBayer16);
+  b16.bits = 12;
+  b16.keep_mosaic = true;
+  ASSERT_TRUE(ConvertToMat(b16, &out).ok());
+  ASSERT_EQ(out.type(), CV_8UC1);
+  EXPECT_EQ(out.at<uint8_t>(0, 0), 120);  // G at the top-left of GBRG
+  EXPECT_EQ(out.at<uint8_t>(0, 1), 20);   // B
+  EXPECT_EQ(out.at<uint8_t>(1, 0), 220);  // R
+
+  EXPECT_STREQ(MosaicName(BayerPattern::kRG), "RGGB");
+  EXPECT_STREQ(MosaicName(BayerPattern::kGR), "GRBG");
+  EXPECT_STREQ(MosaicName(BayerPattern::kGB), "GBRG");
+  EXPECT_STREQ(MosaicName(BayerPattern::kBG), "BGGR");
+}
+
 TEST(PixelConvertTest, RgbIsSwappedToBgr) {
   const std::vector<uint8_t> raw = {200, 100, 50};
   cv::Mat out;

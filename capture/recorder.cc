@@ -410,6 +410,9 @@ std::string SessionRecorder::SessionYaml(const SessionSummary* summary) const {
     y << YAML::Key << c.name << YAML::Value << YAML::BeginMap;
     y << YAML::Key << "uri" << YAML::Value << c.uri;
     y << YAML::Key << "description" << YAML::Value << c.description;
+    if (!c.mosaic.empty()) {
+      y << YAML::Key << "mosaic" << YAML::Value << c.mosaic;
+    }
     y << YAML::EndMap;
   }
   y << YAML::EndMap;

@@ -20,6 +20,9 @@ struct SessionCamera {
   std::string name;
   std::string uri;          // the source (capture/frame_source.h)
   std::string description;  // FrameSource::Describe()
+  // FrameSource::mosaic(): the images are raw mosaics of this pattern
+  // (session.yaml `sources.<name>.mosaic`); empty for gray or colour.
+  std::string mosaic;
 };
 
 // What session.yaml records about how a session was made.

@@ -41,8 +41,8 @@ FrameSet Pair(int i) { return Set(i, 2); }
 
 SessionInfo Info() {
   SessionInfo info;
-  info.cameras = {{"left", "folder:/x/left*.png", "left cam"},
-                  {"right", "folder:/x/right*.png", "right cam"}};
+  info.cameras = {{"left", "folder:/x/left*.png", "left cam", ""},
+                  {"right", "folder:/x/right*.png", "right cam", ""}};
   info.pairing = "lockstep";
   info.time_base = "media";
   info.settings["frames"] = "3";
@@ -132,7 +132,7 @@ TEST(RecorderTest, ThreeCamerasGetAFolderAndTwoColumnsEach) {
   SetCommandLine("kincal capture --three");
   const std::string dir = MakeTempDir("rec3") + "/s";
   SessionInfo info = Info();
-  info.cameras.push_back({"top", "folder:/x/top*.png", "top cam"});
+  info.cameras.push_back({"top", "folder:/x/top*.png", "top cam", ""});
   info.joint_names = {"j1"};
   SessionRecorder rec;
   ASSERT_TRUE(rec.Open(dir, info).ok());
@@ -184,7 +184,7 @@ TEST(RecorderTest, OneCameraAndCameraNamesAreChecked) {
            {}, {"a", "a"}, {"a", "b/c"}, {".."}}) {
     SessionInfo bad = Info();
     bad.cameras.clear();
-    for (const std::string& n : names) bad.cameras.push_back({n, "", ""});
+    for (const std::string& n : names) bad.cameras.push_back({n, "", "", ""});
     SessionRecorder r;
     const std::string d = MakeTempDir("rec_names") + "/s";
     EXPECT_EQ(r.Open(d, bad).kind(), Status::Kind::kUnsupported)

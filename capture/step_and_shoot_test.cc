@@ -84,8 +84,8 @@ StepAndShootOptions Options(int port, const std::string& out) {
   options.timeout_s = 10;
   options.out = out;
   options.announce = false;
-  options.info.cameras = {{"left", "folder:l", "l"},
-                          {"right", "folder:r", "r"}};
+  options.info.cameras = {{"left", "folder:l", "l", ""},
+                          {"right", "folder:r", "r", ""}};
   return options;
 }
 
@@ -161,8 +161,9 @@ TEST(StepAndShootTest, ThreeCamerasRecordOneAveragedSetPerPose) {
   });
   const std::string out = dir + "/session";
   StepAndShootOptions options = Options(port, out);
-  options.info.cameras = {
-      {"a", "folder:l", ""}, {"b", "folder:r", ""}, {"c", "folder:t", ""}};
+  options.info.cameras = {{"a", "folder:l", "", ""},
+                          {"b", "folder:r", "", ""},
+                          {"c", "folder:t", "", ""}};
   const StepAndShootResult r = RunStepAndShoot(&grabber, false, options);
   robot.join();
   EXPECT_EQ(r.outcome, StepAndShootResult::kOk) << r.message;

@@ -66,7 +66,28 @@ std::string FourCc(uint32_t code) {
 uint32_t FourCcCode(const std::string& name) {
   if (name == "GREY") return V4L2_PIX_FMT_GREY;
   if (name == "MJPG") return V4L2_PIX_FMT_MJPEG;
+  if (name == "RGGB") return V4L2_PIX_FMT_SRGGB8;
+  if (name == "GRBG") return V4L2_PIX_FMT_SGRBG8;
+  if (name == "GBRG") return V4L2_PIX_FMT_SGBRG8;
+  if (name == "BA81") return V4L2_PIX_FMT_SBGGR8;
   return V4L2_PIX_FMT_YUYV;
+}
+
+// The 8-bit Bayer fourccs (V4L2's names for the top-left 2x2 cell; BA81 is
+// BGGR); false for other formats.
+bool BayerOfFourCc(const std::string& name, BayerPattern* pattern) {
+  if (name == "RGGB") {
+    *pattern = BayerPattern::kRG;
+  } else if (name == "GRBG") {
+    *pattern = BayerPattern::kGR;
+  } else if (name == "GBRG") {
+    *pattern = BayerPattern::kGB;
+  } else if (name == "BA81") {
+    *pattern = BayerPattern::kBG;
+  } else {
+    return false;
+  }
+  return true;
 }
 
 // Opens a device and checks it speaks V4L2 (VIDIOC_QUERYCAP) before handing
@@ -132,7 +153,8 @@ class V4l2Source : public FrameSource {
         height_(uri.GetInt("height", 0, 16, 16384)),
         fps_(uri.GetDouble("fps", 0, 0.1, 1000)),
         n_buffers_(uri.GetInt("buffers", 4, 2, 32)),
-        timeout_ms_(uri.GetInt("timeout_ms", 2000, 1, 600000)) {}
+        timeout_ms_(uri.GetInt("timeout_ms", 2000, 1, 600000)),
+        keep_mosaic_(KeepsMosaic(uri)) {}
   ~V4l2Source() override { Close(); }
 
   Status Open() override {
@@ -227,9 +249,14 @@ class V4l2Source : public FrameSource {
     os << " " << format_name_;
     if (width_ > 0) os << " " << width_ << "x" << height_;
     if (fps_ > 0) os << " " << fps_ << " fps";
+    if (!mosaic().empty()) os << ", raw mosaic";
     return os.str();
   }
   bool IsLive() const override { return true; }
+  std::string mosaic() const override {
+    BayerPattern p;
+    return keep_mosaic_ && BayerOfFourCc(format_name_, &p) ? MosaicName(p) : "";
+  }
   TimeBase time_base() const override { return TimeBase::kHostMonotonic; }
 
  private:
@@ -365,6 +392,10 @@ class V4l2Source : public FrameSource {
     pixels.layout = format_name_ == "GREY"   ? PixelLayout::kGray8
                     : format_name_ == "MJPG" ? PixelLayout::kMjpg
                                              : PixelLayout::kYuyv;
+    if (BayerOfFourCc(format_name_, &pixels.bayer)) {
+      pixels.layout = PixelLayout::kBayer8;
+      pixels.keep_mosaic = keep_mosaic_;
+    }
     Status s = ConvertToMat(pixels, &frame->image);
     if (!s.ok()) {
       return Status::Error(s.kind(), device_ + ": frame " +
@@ -388,6 +419,7 @@ class V4l2Source : public FrameSource {
   double fps_;
   int n_buffers_;
   int timeout_ms_;
+  bool keep_mosaic_;  // bayer=raw
   uint32_t stride_ = 0;
   std::string card_;
   int fd_ = -1;

@@ -38,7 +38,7 @@ TEST(V4l2SourceTest, UnknownPixelFormatIsRefusedBeforeOpening) {
     MakeFrameSource("v4l2:/dev/video0?format=XYZW");
     FAIL() << "format=XYZW accepted";
   } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("expected GREY, YUYV or MJPG"),
+    EXPECT_NE(std::string(e.what()).find("expected GREY, YUYV, MJPG"),
               std::string::npos)
         << e.what();
   }

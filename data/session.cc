@@ -335,8 +335,37 @@ void RequireJointReadings(const SessionReadOptions& options, const Session& s) {
   }
 }
 
-// session.yaml: version and status.
-std::string ReadSessionStatus(const std::string& yaml_path) {
+// What session.yaml says that the readers use.
+struct SessionYaml {
+  std::string status;
+  // sources.<folder>.mosaic: the pattern of raw mosaics, by image folder.
+  std::map<std::string, std::string> mosaics;
+};
+
+// sources.<name>.mosaic where given (RGGB, GRBG, GBRG or BGGR).
+std::map<std::string, std::string> ReadSourceMosaics(const YamlReader& reader,
+                                                     const YAML::Node& root) {
+  std::map<std::string, std::string> out;
+  const YAML::Node sources = root["sources"];
+  if (!sources || !sources.IsMap()) return out;
+  for (const auto& entry : sources) {
+    const YAML::Node source = entry.second;
+    if (!source.IsMap() || !source["mosaic"]) continue;
+    const YAML::Node node = source["mosaic"];
+    const std::string m = reader.String(node, "mosaic");
+    if (m != "RGGB" && m != "GRBG" && m != "GBRG" && m != "BGGR") {
+      reader.Fail(node, "sources." + entry.first.as<std::string>() +
+                            ".mosaic: expected RGGB, GRBG, GBRG or BGGR (the "
+                            "raw mosaic's top-left 2x2 cell), got '" +
+                            m + "'");
+    }
+    out[entry.first.as<std::string>()] = m;
+  }
+  return out;
+}
+
+// session.yaml: version, status and the sources' raw mosaics.
+SessionYaml ReadSessionYaml(const std::string& yaml_path) {
   std::error_code ec;
   if (!std::filesystem::exists(yaml_path, ec)) {
     throw InputError(yaml_path +
@@ -355,13 +384,17 @@ std::string ReadSessionStatus(const std::string& yaml_path) {
                 "kincal reads)");
   }
   const YAML::Node status = reader.Required(root, "status", "session.yaml");
-  const std::string s = reader.String(status, "status");
-  if (s != "complete" && s != "failed" && s != "recording") {
-    reader.Fail(
-        status,
-        "status: expected complete, failed or recording, got '" + s + "'");
+  SessionYaml out;
+  out.status = reader.String(status, "status");
+  if (out.status != "complete" && out.status != "failed" &&
+      out.status != "recording") {
+    reader.Fail(status,
+                "status: expected complete, failed or recording, "
+                "got '" +
+                    out.status + "'");
   }
-  return s;
+  out.mosaics = ReadSourceMosaics(reader, root);
+  return out;
 }
 
 using ImageIndex = std::map<std::string, std::string>;
@@ -482,7 +515,8 @@ Session ReadSession(const std::string& dir_in,
   }
   Session s;
   s.dir = dir;
-  s.status = ReadSessionStatus(dir + "/session.yaml");
+  const SessionYaml yaml = ReadSessionYaml(dir + "/session.yaml");
+  s.status = yaml.status;
   const bool partial = s.status != "complete";
   // frames.csv (or the journal of an unfinished session).
   s.frames_csv = dir + "/frames.csv";
@@ -502,6 +536,10 @@ Session ReadSession(const std::string& dir_in,
   // folders' names; the cameras take the rig's.
   s.folders = s.cameras;
   if (!options.camera_names.empty()) s.cameras = options.camera_names;
+  for (const std::string& folder : s.folders) {
+    const auto m = yaml.mosaics.find(folder);
+    s.mosaics.push_back(m == yaml.mosaics.end() ? "" : m->second);
+  }
   std::vector<ImageIndex> images;
   for (const std::string& name : s.folders) {
     const std::string folder = dir + "/" + name;

@@ -14,7 +14,10 @@
 //                               camera, [<joint columns>], in any order;
 //                               '#' lines are comments
 //     session.yaml              kincal_session: 1, status: complete |
-//                               failed | recording, ... (other keys free)
+//                               failed | recording, ... (other keys free;
+//                               sources.<camera>.mosaic: RGGB | GRBG |
+//                               GBRG | BGGR when its images are a colour
+//                               sensor's raw mosaic)
 //
 // Columns are found by name. A camera is a name with both a t_<name> and a
 // seq_<name> column; every other column but `frame` is a joint column.
@@ -60,6 +63,9 @@ struct Session {
   // left/right session read for a two-camera rig named otherwise).
   std::vector<std::string> cameras;
   std::vector<std::string> folders;
+  // Per camera (cameras order): the raw mosaic pattern its images hold
+  // (session.yaml sources.<folder>.mosaic), empty for gray or colour.
+  std::vector<std::string> mosaics;
   std::vector<std::string> joint_columns;  // as in frames.csv, file order
   std::vector<SessionFrame> frames;        // in file order
   int dropped_tail = 0;  // incomplete trailing rows of an unfinished session

@@ -74,6 +74,24 @@ TEST(Session, ReadsFramesJointsAndImagePairs) {
   EXPECT_FALSE(plain.frames[0].HasJoints());
 }
 
+TEST(Session, RawMosaicPatternsComeFromSessionYamlSources) {
+  const std::string dir = MakeSession("mosaic", kCsv, 3);
+  EXPECT_EQ(ReadSession(dir, {}).mosaics,
+            (std::vector<std::string>{"", ""}));  // gray images
+  Write(dir + "/session.yaml",
+        "kincal_session: 1\nstatus: complete\nsources:\n"
+        "  left: {uri: 'v4l2:/dev/video0?format=RGGB&bayer=raw', mosaic: "
+        "RGGB}\n  right: {uri: 'v4l2:/dev/video1'}\n");
+  EXPECT_EQ(ReadSession(dir, {}).mosaics,
+            (std::vector<std::string>{"RGGB", ""}));
+  Write(dir + "/session.yaml",
+        "kincal_session: 1\nstatus: complete\nsources:\n"
+        "  left: {mosaic: RGB}\n");
+  EXPECT_THAT(ErrorOf(dir, {}),
+              HasSubstr("session.yaml:4:18: sources.left.mosaic: expected "
+                        "RGGB, GRBG, GBRG or BGGR"));
+}
+
 TEST(Session, MissingJointColumnIsReportedWithPosition) {
   const std::string dir = MakeSession("missing", kCsv, 3);
   SessionReadOptions o;

@@ -94,6 +94,13 @@ int RenderRecordedSession(const Rig& rig, const Target& target,
     yaml << (j ? ", " : "") << input.joint_names[j];
   }
   yaml << "]\n";
+  // A raw mosaic's pattern, as capture records it (data/session.h).
+  if (options.bayer && options.bayer_raw) {
+    yaml << "sources:\n";
+    for (const std::string& name : cameras) {
+      yaml << "  " << name << ": {mosaic: RGGB}\n";
+    }
+  }
   WriteFileAtomic(dir + "/session.yaml", yaml.str());
   return static_cast<int>(n);
 }

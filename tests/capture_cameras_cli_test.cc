@@ -38,6 +38,7 @@ struct Rendered {
   std::vector<std::string> header;   // frames.csv's header
   int frames = 0;
   double period_s = 1;  // between frames (the folders replay at 1 / period)
+  std::string mosaic;   // the images are raw mosaics of this pattern
 };
 
 // `kincal simulate --render` of BH-7 with `cameras` cameras, and a
@@ -46,8 +47,9 @@ struct Rendered {
 // is 1 s) from a quarter second after the previous frame's half period to a
 // quarter second before the next's, so the robot is still at every
 // frame's time.
-Rendered RenderWithJointLog(int cameras) {
+Rendered RenderWithJointLog(int cameras, bool raw_mosaic = false) {
   Rendered r;
+  r.mosaic = raw_mosaic ? "RGGB" : "";
   r.dir = testing::MakeTempDir("capture_cameras") + "/sim";
   const RunResult sim = RunKincal(
       "simulate --robot " + testing::SourceDir() +
@@ -55,7 +57,7 @@ Rendered RenderWithJointLog(int cameras) {
       std::to_string(kPoses) +
       " --noise 0 --seed 3 --render --render-width 640 --render-height 512 "
       "--render-cameras " +
-      std::to_string(cameras));
+      std::to_string(cameras) + (raw_mosaic ? " --render-bayer-raw" : ""));
   EXPECT_EQ(sim.exit_code, 0) << sim.err;
   const auto rows = ReadCsvRows(r.dir + "/session/frames.csv");
   if (rows.empty()) return r;
@@ -95,7 +97,8 @@ RunResult CaptureReplay(const Rendered& r, const std::string& out) {
   std::string cameras;
   for (const std::string& c : r.cameras) {
     cameras += " --camera " + c + "='folder:" + r.dir + "/session/" + c +
-               "/*.png?fps=" + std::to_string(1 / r.period_s) + "'";
+               "/*.png?fps=" + std::to_string(1 / r.period_s) +
+               (r.mosaic.empty() ? "" : "&mosaic=" + r.mosaic) + "'";
   }
   return RunKincal("capture" + cameras + " --out " + out + " --joints " +
                    r.dir + "/joints.csv --joints-offset 0 --robot " + r.dir +
@@ -175,6 +178,7 @@ void CaptureAndCompare(const Rendered& r) {
     EXPECT_NE(j["cameras"][k]["uri"].get<std::string>().find(r.cameras[k]),
               std::string::npos);
     EXPECT_TRUE(testing::Exists(out + "/" + r.cameras[k] + "/000007.png"));
+    EXPECT_EQ(j["cameras"][k].value("mosaic", ""), r.mosaic);
   }
   // Left/right fields only for a pair.
   EXPECT_EQ(j.contains("dropped_left"), r.cameras.size() == 2);
@@ -195,6 +199,27 @@ void CaptureAndCompare(const Rendered& r) {
   EXPECT_EQ(b1["used_frames"], b2["used_frames"]);
   const double rms = b1["reproj_rms_px"].get<double>();
   EXPECT_NEAR(b2["reproj_rms_px"].get<double>(), rms, 1e-4 * rms);
+}
+
+// A colour camera's raw mosaic replayed with mosaic=RGGB: session.yaml
+// records it, and track and bundle read the captured session as raw
+// mosaics without --bayer, alike with the rendered one (which records it
+// too).
+TEST(CaptureCamerasCli, RawMosaicCamerasReplayIntoASessionTrackAndBundleAlike) {
+  const Rendered r = RenderWithJointLog(2, true);
+  CaptureAndCompare(r);
+  std::ifstream yaml(r.dir + "/captured/session.yaml");
+  std::stringstream text;
+  text << yaml.rdbuf();
+  EXPECT_NE(text.str().find("mosaic: RGGB"), std::string::npos) << text.str();
+  // Read as raw, not as gray: no warning that the images look like a mosaic.
+  const RunResult t =
+      RunKincal("track --rig " + r.dir + "/rig.yaml --target " + r.dir +
+                "/target.yaml --session " + r.dir + "/captured --out " + r.dir +
+                "/p.csv --quiet --json");
+  ASSERT_EQ(t.exit_code, 0) << t.err;
+  EXPECT_EQ(t.out.find("images_look_raw_bayer"), std::string::npos) << t.out;
+  EXPECT_NE(t.err.find("raw RGGB mosaics"), std::string::npos) << t.err;
 }
 
 TEST(CaptureCamerasCli, ThreeCamerasReplayIntoASessionTrackAndBundleReadAlike) {

@@ -201,11 +201,13 @@ TEST(RenderPipelineTest, LightShadowAndBayerOptions) {
   EXPECT_NE(r.err.find("4 tags"), std::string::npos) << r.err;
 }
 
-// A colour camera's raw mosaic (--render-bayer-raw): `track --bayer RGGB`
-// balances it to gray and fits the tags as on a gray render; read as gray
-// the mosaic's pattern skews every corner, and track says so; a pattern
-// whose greens are not the mosaic's is named doubtful; an unknown one is
-// refused.
+// A colour camera's raw mosaic (--render-bayer-raw; session.yaml records
+// sources.<camera>.mosaic: RGGB, as `capture ... bayer=raw` does): `track`
+// reads the pattern from session.yaml (or --bayer RGGB), balances it to gray
+// and fits the tags as on a gray render; read as gray (--bayer none) the
+// mosaic's pattern skews every corner, and track says so and that --bayer
+// contradicts session.yaml; a pattern whose greens are not the mosaic's is
+// named doubtful; an unknown one is refused.
 TEST(RenderPipelineTest, RawBayerMosaicTrackedWithItsPattern) {
   const std::string dir = MakeTempDir("render_raw");
   RunResult r = RunKincal("simulate --robot " + SourceDir() +
@@ -227,10 +229,17 @@ TEST(RenderPipelineTest, RawBayerMosaicTrackedWithItsPattern) {
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const auto balanced = nlohmann::json::parse(r.out);
   EXPECT_FALSE(balanced.contains("warnings")) << r.out;
-  r = RunKincal(track);
+  r = RunKincal(track);  // the pattern from session.yaml
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.err.find("raw RGGB mosaics"), std::string::npos) << r.err;
+  const auto recorded = nlohmann::json::parse(r.out);
+  EXPECT_FALSE(recorded.contains("warnings")) << r.out;
+  EXPECT_EQ(recorded["median_reproj_px"], balanced["median_reproj_px"]);
+  r = RunKincal(track + " --bayer none");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const auto as_gray = nlohmann::json::parse(r.out);
   EXPECT_TRUE(warned(as_gray, "images_look_raw_bayer")) << r.out;
+  EXPECT_TRUE(warned(as_gray, "bayer_differs_from_session")) << r.out;
   ASSERT_GT(balanced["found"].get<int>(), 2);
   // Measured: 0.021 px balanced, 0.158 px read as gray.
   EXPECT_LT(balanced["median_reproj_px"].get<double>(), 0.04);
@@ -238,8 +247,9 @@ TEST(RenderPipelineTest, RawBayerMosaicTrackedWithItsPattern) {
             0.3 * as_gray["median_reproj_px"].get<double>());
   r = RunKincal(track + " --bayer GRBG");
   ASSERT_EQ(r.exit_code, 0) << r.err;
-  EXPECT_TRUE(warned(nlohmann::json::parse(r.out), "bayer_balance_doubtful"))
-      << r.out;
+  const auto wrong = nlohmann::json::parse(r.out);
+  EXPECT_TRUE(warned(wrong, "bayer_balance_doubtful")) << r.out;
+  EXPECT_TRUE(warned(wrong, "bayer_differs_from_session")) << r.out;
   r = RunKincal(track + " --bayer RGB");
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_NE(r.err.find("expected RGGB"), std::string::npos) << r.err;

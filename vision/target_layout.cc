@@ -1019,7 +1019,7 @@ PivotTipResult MeasurePivotTip(const Rig& rig, const TargetLayoutResult& layout,
 
 std::vector<LayoutFrame> DetectSessionTags(
     const Session& session, const Rig& rig, const AprilTagOptions& detector,
-    const std::function<void(int, int)>& progress) {
+    BayerPattern bayer, const std::function<void(int, int)>& progress) {
   const int nc = static_cast<int>(rig.cameras.size());
   if (session.cameras.size() != rig.cameras.size()) {
     throw InputError(session.dir + ": the session has " +
@@ -1039,7 +1039,7 @@ std::vector<LayoutFrame> DetectSessionTags(
     f.detections.resize(nc);
     ForEachCamera(nc, [&](int c) {
       f.detections[c] = detectors[c]->Detect(
-          ReadCameraImage(sf.images[c], rig.cameras[c].intrinsics));
+          ReadCameraImage(sf.images[c], rig.cameras[c].intrinsics, bayer));
     });
     frames.push_back(std::move(f));
     if (progress) progress(static_cast<int>(frames.size()), total);

@@ -34,6 +34,7 @@
 #include "camcal/rig.h"
 #include "data/session.h"
 #include "vision/apriltag_detector.h"
+#include "vision/bayer.h"
 #include "vision/pivot.h"
 #include "vision/target.h"
 #include "vision/tool_pose.h"
@@ -212,10 +213,13 @@ PivotTipResult MeasurePivotTip(const Rig& rig, const TargetLayoutResult& layout,
                                const PivotTipOptions& options);
 
 // Every complete frame of a two-camera session, tags detected at full
-// frame in both cameras. progress (optional) gets (done, total) per frame.
-// InputError naming an image that cannot be read or has the wrong size.
+// frame in both cameras; with a Bayer pattern the images are raw mosaics,
+// balanced to gray first (vision/bayer.h). progress (optional) gets (done,
+// total) per frame. InputError naming an image that cannot be read or has
+// the wrong size.
 std::vector<LayoutFrame> DetectSessionTags(
     const Session& session, const Rig& rig, const AprilTagOptions& detector,
+    BayerPattern bayer = BayerPattern::kNone,
     const std::function<void(int, int)>& progress = nullptr);
 
 }  // namespace kincal
