@@ -311,6 +311,7 @@ nlohmann::json SummaryJson(const BundleArgs& args, const Target& target,
   j["frames_without_tags"] = run.obs.without_tags;
   j["corners"] = r.corners;
   j["dropped_tags"] = r.dropped_tags;
+  j["dropped_corners"] = r.dropped_corners;
   j["start_reproj_rms_px"] = r.start_reproj_rms_px;
   j["reproj_rms_px"] = r.reproj_rms_px;
   j["heldout_reproj_rms_px"] = r.heldout_reproj_rms_px;
@@ -516,6 +517,12 @@ void AddBundleCommand(CLI::App& app, Runner* run) {
                   "per-corner Huber scale, px; 0 = automatic (3 sigma of "
                   "the corners after a first fit, at least 0.05 px; JSON "
                   "huber_px)")
+      ->capture_default_str()
+      ->check(CLI::NonNegativeNumber);
+  sub->add_option("--outlier-sigmas", args->options.outlier_sigmas,
+                  "drop single corners farther than this many sigma of the "
+                  "corners' noise after a first fit (at least 0.2 px); 0 = "
+                  "keep every corner of a kept tag (JSON dropped_corners)")
       ->capture_default_str()
       ->check(CLI::NonNegativeNumber);
   sub->add_flag("--refine-cameras", args->options.refine_cameras,

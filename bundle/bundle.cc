@@ -200,7 +200,17 @@ struct Obs {      // the fit's view of one frame
   std::vector<Eigen::Vector3d> points;
   std::vector<int> cameras;
   std::vector<Eigen::Vector2d> pixels;
-  std::vector<int> tag_of;  // per corner: key camera * 1000 + tag index
+  std::vector<int> tag_of;     // per corner: key camera * 1000 + tag index
+  std::vector<int> corner_of;  // per corner: its index in the tag (0..3)
+};
+
+// A single corner's key: its tag observation's key (Obs::tag_of) and corner.
+int CornerKey(int tag_key, int corner) { return tag_key * 4 + corner; }
+
+// Tag observations and single corners the fit leaves out.
+struct Dropped {
+  std::set<int> tags;     // Obs::tag_of keys
+  std::set<int> corners;  // CornerKey keys
 };
 
 Built Build(State* st, const std::vector<Obs>& obs,
@@ -582,22 +592,26 @@ HoldoutSplit SplitFrames(const std::vector<BundleFrame>& frames,
 }
 
 // The fit's view of frames `indices`: tool corners, cameras and pixels,
-// without the tag observations in `dropped` (key: (frame * 8 + camera) *
-// 1000 + tag).
+// without the tag observations and corners in `dropped` (tag key: (frame *
+// 8 + camera) * 1000 + tag).
 std::vector<Obs> MakeObs(const std::vector<BundleFrame>& frames,
                          const Target& target, const std::vector<int>& indices,
-                         const std::set<int>& dropped) {
+                         const Dropped& dropped) {
   std::vector<Obs> out;
   for (int i : indices) {
     Obs o;
     o.index = i;
     for (const BundleCorner& c : frames[i].corners) {
       const int key = (i * 8 + c.camera) * 1000 + c.tag;
-      if (dropped.count(key)) continue;
+      if (dropped.tags.count(key) ||
+          dropped.corners.count(CornerKey(key, c.corner))) {
+        continue;
+      }
       o.points.push_back(target.tags.at(c.tag).CornerInTool(c.corner));
       o.cameras.push_back(c.camera);
       o.pixels.push_back(c.px);
       o.tag_of.push_back(key);
+      o.corner_of.push_back(c.corner);
     }
     if (!o.points.empty()) out.push_back(std::move(o));
   }
@@ -788,6 +802,28 @@ void DropOutlierTags(State* st, const std::vector<Obs>& train,
   size_t t = 0;
   for (auto& [key, v] : per_tag) {
     if (rms[t++] > limit) dropped->insert(key);
+  }
+}
+
+// Corners of the kept tags whose error exceeds max(outlier_sigmas * sigma,
+// kMinOutlierCornerPx), sigma = median corner error / 1.1774 (the median of
+// a 2-D Gaussian error's norm), added to `*dropped`.
+constexpr double kMinOutlierCornerPx = 0.2;
+void DropOutlierCorners(State* st, const std::vector<Obs>& train,
+                        const std::vector<PoseInput>& inputs, bool with_errors,
+                        const BundleOptions& opt, const Rig& rig,
+                        std::set<int>* dropped) {
+  if (!(opt.outlier_sigmas > 0)) return;
+  const std::vector<double> e =
+      CornerErrors(st, train, inputs, with_errors, rig);
+  if (e.empty()) return;
+  const double limit = std::max(opt.outlier_sigmas * UpperMedian(e) / 1.1774,
+                                kMinOutlierCornerPx);
+  size_t k = 0;
+  for (const Obs& o : train) {
+    for (size_t i = 0; i < o.points.size(); ++i, ++k) {
+      if (e[k] > limit) dropped->insert(CornerKey(o.tag_of[i], o.corner_of[i]));
+    }
   }
 }
 
@@ -1054,7 +1090,7 @@ BundleResult RunBundle(const Robot& nominal, const Rig& rig,
   res.used_frames = static_cast<int>(res.train.size() + res.heldout.size());
   res.train_frames = static_cast<int>(res.train.size());
   res.heldout_frames = static_cast<int>(res.heldout.size());
-  std::set<int> dropped;
+  Dropped dropped;
   std::vector<Obs> train = MakeObs(frames, target, res.train, dropped);
   StartFrames(frames, res, opt, &st);
   Freedom fixed_robot;
@@ -1091,9 +1127,13 @@ BundleResult RunBundle(const Robot& nominal, const Rig& rig,
     Built b = Build(&st, train, res.inputs, fit, opt, rig);
     summary = Solve(b.problem.get(), opt);
     if (round == 1) break;
-    DropOutlierTags(&st, train, res.inputs, with_errors, opt, rig, &dropped);
-    if (dropped.empty() && !auto_huber) break;
-    res.dropped_tags = static_cast<int>(dropped.size());
+    DropOutlierTags(&st, train, res.inputs, with_errors, opt, rig,
+                    &dropped.tags);
+    DropOutlierCorners(&st, MakeObs(frames, target, res.train, dropped),
+                       res.inputs, with_errors, opt, rig, &dropped.corners);
+    if (dropped.tags.empty() && dropped.corners.empty() && !auto_huber) break;
+    res.dropped_tags = static_cast<int>(dropped.tags.size());
+    res.dropped_corners = static_cast<int>(dropped.corners.size());
     train = MakeObs(frames, target, res.train, dropped);
     if (auto_huber) {
       opt.huber_px =
