@@ -6,6 +6,7 @@ extern "C" {
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <map>
 #include <opencv2/imgproc.hpp>
 #include <sstream>
@@ -433,10 +434,46 @@ void PixelProfile(const cv::Mat& gray, const Eigen::Vector2d& p,
   prof->box_px = std::max(std::abs(n.x()), std::abs(n.y()));
 }
 
+// The patterns of the lines beside the one at p (along the side, within
+// 2.5 along_sigma), each weighted by a Gaussian blur along the side of
+// along_sigma: what the image at p mixes in where the pattern changes
+// along the side. Lines whose patterns agree (breaks within 0.05 px) are
+// merged, their weights summed.
+void MixAlongSide(const PatternView& view, const Eigen::Vector2d& p,
+                  const Eigen::Vector2d& n, const Eigen::Vector2d& dir,
+                  double reach, double along_sigma, EdgeProfile* prof) {
+  prof->mixture.clear();
+  const int half = static_cast<int>(std::ceil(2.5 * along_sigma / 0.4));
+  const double step = 2.5 * along_sigma / std::max(1, half);
+  double total = 0;
+  for (int j = -half; j <= half; ++j) {
+    const double s = j * step;
+    EdgeProfile line;
+    PatternAlong(view, p + s * dir, n, -reach - 6.0, reach + 6.0, &line);
+    const double w = std::exp(-0.5 * s * s / (along_sigma * along_sigma));
+    total += w;
+    bool merged = false;
+    for (PatternLine& m : prof->mixture) {
+      if (m.classes != line.classes) continue;
+      bool same = true;
+      for (size_t i = 0; i < m.breaks.size() && same; ++i) {
+        same = std::abs(m.breaks[i] - line.breaks[i]) <= 0.05;
+      }
+      if (!same) continue;
+      m.weight += w;
+      merged = true;
+      break;
+    }
+    if (!merged) prof->mixture.push_back({line.breaks, line.classes, w});
+  }
+  for (PatternLine& m : prof->mixture) m.weight /= total;
+  if (prof->mixture.size() == 1) prof->mixture.clear();
+}
+
 SideProfiles ProfilesOfSide(const cv::Mat& gray, const PatternView& view,
                             const Eigen::Vector2d& a, const Eigen::Vector2d& b,
                             const Eigen::Vector2d& n, double cell, double cells,
-                            double along_px,
+                            double along_px, double along_sigma,
                             const std::vector<NeighbourTag>& others,
                             bool phased) {
   SideProfiles out;
@@ -448,7 +485,7 @@ SideProfiles ProfilesOfSide(const cv::Mat& gray, const PatternView& view,
   const double reach = std::max(2.0, std::min(1.5 * cell, cell + 2.0));
   const double step = std::clamp(cell / 8.0, 0.25, 1.0);
   const int samples = std::clamp(static_cast<int>(len * 0.8), 6, 32);
-  std::vector<bool> near;
+  std::vector<bool> near, varied;
   for (int s = 0; s < samples; ++s) {
     const double t = 0.1 + 0.8 * (s + 0.5) / samples;
     const Eigen::Vector2d p = a + t * len * dir;
@@ -480,6 +517,7 @@ SideProfiles ProfilesOfSide(const cv::Mat& gray, const PatternView& view,
       varies = varies || !SamePattern(here, beside, 0.25 * cell);
     }
     near.push_back(NearOtherTag(lo, hi, others, cells) || varies);
+    varied.push_back(varies);
     out.near_other_tag += near.back() && !varies ? 1 : 0;
     out.base.push_back(p);
     out.profiles.push_back(std::move(prof));
@@ -497,6 +535,16 @@ SideProfiles ProfilesOfSide(const cv::Mat& gray, const PatternView& view,
       kept.profiles.push_back(std::move(out.profiles[i]));
     }
     return kept;
+  }
+  // Too few clear samples (cells under a few blur widths): the varying
+  // ones stay, with the lines beside them mixed into their model.
+  static const bool no_mix = std::getenv("KINCAL_NO_MIX") != nullptr;
+  if (along_sigma > 0 && !phased && !no_mix) {
+    for (size_t i = 0; i < varied.size(); ++i) {
+      if (!varied[i]) continue;
+      MixAlongSide(view, out.base[i], n, dir, reach, along_sigma,
+                   &out.profiles[i]);
+    }
   }
   return out;
 }
@@ -586,7 +634,8 @@ bool FitSide(const cv::Mat& gray, const SideProfiles& side,
     // of a pixel-integrated step; the model's area in closed form). The rule
     // alone read the white plateau darkened by the border's outer edge and
     // pulled every side inwards: a tag-scale bias.
-    if (!phased && sigma < 0.8 && w >= 0.8 && 0.55 * side.cell >= 2.5 * sigma) {
+    if (!phased && prof.mixture.empty() && sigma < 0.8 && w >= 0.8 &&
+        0.55 * side.cell >= 2.5 * sigma) {
       EdgeProfile fine;
       for (double o = shift - w - 0.25; o <= shift + w + 0.25; o += 0.25) {
         const Eigen::Vector2d q = side.base[i] + o * n;
@@ -687,12 +736,16 @@ bool RefineCornersByEdges(const cv::Mat& gray, const cv::Mat& tag_image,
       Eigen::Vector2d n(-dir.y(), dir.x());
       if (n.dot((a + b) / 2 - centroid) < 0) n = -n;
       normals[k] = n;
+      // The blur along side k: the blur across its neighbours.
+      const double along_sigma =
+          pass == 0 ? 0.0
+                    : 0.5 * (sigma[(k + 1) % 4][0] + sigma[(k + 3) % 4][0]);
       sides[k] = ProfilesOfSide(
           gray, view, a, b, n, cell, cells,
           pass == 0 ? 1.0
                     : std::max(1.0, 2.0 * *std::max_element(sigma[k].begin(),
                                                             sigma[k].end())),
-          others, phased);
+          along_sigma, others, phased);
     }
     if (pass == 0) sigma = SidesBlur(sides, phased);
     std::array<Line2, 4> lines;
