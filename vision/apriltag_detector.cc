@@ -6,7 +6,6 @@ extern "C" {
 
 #include <algorithm>
 #include <cmath>
-#include <cstdlib>
 #include <map>
 #include <opencv2/imgproc.hpp>
 #include <sstream>
@@ -389,7 +388,11 @@ bool NearOtherTag(const Eigen::Vector2d& a, const Eigen::Vector2d& b,
 // image border are skipped, and unless too few would remain, those reaching
 // another tag and those whose pattern changes within along_px along the
 // side (a data bit's edge, the square's corner: the blur mixes the
-// neighbouring pattern into the line's profile, which the 1-D model lacks).
+// neighbouring pattern into the line's profile). When too few clear ones
+// would remain (cells of a few blur widths, where the pattern changes
+// within the blur's reach on most of the side) and along_sigma > 0, the
+// varying profiles are kept with the lines beside them mixed into their
+// model (MixAlongSide, EdgeProfile::mixture).
 struct SideProfiles {
   std::vector<Eigen::Vector2d> base;
   std::vector<EdgeProfile> profiles;
@@ -538,8 +541,7 @@ SideProfiles ProfilesOfSide(const cv::Mat& gray, const PatternView& view,
   }
   // Too few clear samples (cells under a few blur widths): the varying
   // ones stay, with the lines beside them mixed into their model.
-  static const bool no_mix = std::getenv("KINCAL_NO_MIX") != nullptr;
-  if (along_sigma > 0 && !phased && !no_mix) {
+  if (along_sigma > 0 && !phased) {
     for (size_t i = 0; i < varied.size(); ++i) {
       if (!varied[i]) continue;
       MixAlongSide(view, out.base[i], n, dir, reach, along_sigma,
@@ -608,6 +610,14 @@ std::array<PhaseSigmas, 4> SidesBlur(const std::array<SideProfiles, 4>& sides,
   return sigma;
 }
 
+// Whether a side of blur sigma and cells of `cell` px takes the area rule
+// (FitSide): sharp (sigma < 0.8 px) with its neighbouring edges 2.5 sigma
+// clear of the rule's window of +-min(0.45 cell, 3 px).
+bool AreaRuleApplies(double sigma, double cell) {
+  return sigma < 0.8 && std::min(0.45 * cell, 3.0) >= 0.8 &&
+         0.55 * cell >= 2.5 * sigma;
+}
+
 // Edge points of one side: the profiles' shifts along the normal.
 bool FitSide(const cv::Mat& gray, const SideProfiles& side,
              const Eigen::Vector2d& n, const PhaseSigmas& sigmas, bool phased,
@@ -634,8 +644,7 @@ bool FitSide(const cv::Mat& gray, const SideProfiles& side,
     // of a pixel-integrated step; the model's area in closed form). The rule
     // alone read the white plateau darkened by the border's outer edge and
     // pulled every side inwards: a tag-scale bias.
-    if (!phased && prof.mixture.empty() && sigma < 0.8 && w >= 0.8 &&
-        0.55 * side.cell >= 2.5 * sigma) {
+    if (!phased && prof.mixture.empty() && AreaRuleApplies(sigma, side.cell)) {
       EdgeProfile fine;
       for (double o = shift - w - 0.25; o <= shift + w + 0.25; o += 0.25) {
         const Eigen::Vector2d q = side.base[i] + o * n;
@@ -708,7 +717,11 @@ bool FitSide(const cv::Mat& gray, const SideProfiles& side,
 // side (3 MAD outliers dropped) and the corners as intersections. Two
 // passes: the second places the pattern by the first's corners. Samples
 // whose window reaches another detected tag are left out (while enough
-// remain), not the whole side. A sharp side (sigma < 0.8 px, its
+// remain), not the whole side; where too few would remain, the second pass
+// keeps them with the patterns of the lines beside mixed into their model
+// by a Gaussian along the side as wide as the neighbouring sides' blur
+// (the blur along a side is the blur across its neighbours; exact for a
+// Gaussian, which separates). A sharp side (sigma < 0.8 px, its
 // neighbouring edges 2.5 sigma clear of the window) takes the area rule
 // with the plateaus at the window's ends instead (edge_profile.h).
 bool RefineCornersByEdges(const cv::Mat& gray, const cv::Mat& tag_image,
@@ -736,10 +749,14 @@ bool RefineCornersByEdges(const cv::Mat& gray, const cv::Mat& tag_image,
       Eigen::Vector2d n(-dir.y(), dir.x());
       if (n.dot((a + b) / 2 - centroid) < 0) n = -n;
       normals[k] = n;
-      // The blur along side k: the blur across its neighbours.
+      // The blur along side k: the blur across its neighbours. Sides that
+      // take the area rule keep their own line's pattern (the rule, exact
+      // for a sharp pixel-integrated edge, serves them better than the
+      // model; measured: corner_bench's blur 0.5 scenes).
       const double along_sigma =
-          pass == 0 ? 0.0
-                    : 0.5 * (sigma[(k + 1) % 4][0] + sigma[(k + 3) % 4][0]);
+          pass == 0 || phased || AreaRuleApplies(sigma[k][0], cell)
+              ? 0.0
+              : 0.5 * (sigma[(k + 1) % 4][0] + sigma[(k + 3) % 4][0]);
       sides[k] = ProfilesOfSide(
           gray, view, a, b, n, cell, cells,
           pass == 0 ? 1.0
