@@ -1,10 +1,14 @@
 // Where the refined corners err under a blur that is not one Gaussian
-// (tests/target_monte_carlo.h's sessions, seed by seed): each side's edge
-// error against the rendered truth (the mean, over its two corners, of the
-// corner error along the side's outward normal; + = outwards), binned by
-//  - the motion blur's length projected on the side's normal (px),
-//  - the cell size over the side's fitted blur (TagSideQuality::blur_px),
-// with the corner RMS of the usable corners and of libapriltag's.
+// (tests/target_monte_carlo.h's sessions, views and pivot frames, seed by
+// seed), against the rendered truth:
+//  - the usable corners' RMS, split into refined and fallen back to
+//    libapriltag's (and what the fallen-back ones would have been as
+//    refined), and by their sides' line scatter;
+//  - each side's edge error (the mean, over its two corners, of the corner
+//    error along the side's outward normal; + = outwards), binned by the
+//    motion blur's length projected on the side's normal and by the cell
+//    size over the side's fitted blur (TagSideQuality::blur_px);
+//  - the twelve worst corners with their sides' cells, blur and scatter.
 //
 //   build/bin/blur_sides_bench [--plain] [--noise-free] SEED...
 
