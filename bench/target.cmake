@@ -6,3 +6,7 @@ kincal_bench(target_bench SOURCES ${CMAKE_CURRENT_LIST_DIR}/target_bench.cc
 kincal_bench(target_bias_bench
              SOURCES ${CMAKE_CURRENT_LIST_DIR}/target_bias_bench.cc
              DEPS kincal_synth kincal_vision)
+# Each side's edge error by projected motion blur and cell size over blur.
+kincal_bench(blur_sides_bench
+             SOURCES ${CMAKE_CURRENT_LIST_DIR}/blur_sides_bench.cc
+             DEPS kincal_synth kincal_vision)

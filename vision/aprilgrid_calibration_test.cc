@@ -158,8 +158,11 @@ TEST(AprilGridCalibration, DetectionsMatchRenderedBoard) {
 // steeply tilted boards); with the pattern-model corner refinement
 // (vision/edge_profile.h) camera 0's f is 0.176 px low (-3.7 sigma), was
 // 0.065-0.082 px. The focal floor allows that known bias; the rest of the
-// bound is the statistical 3 sigma.
-constexpr double kRenderedFocalBiasPx = 0.06;
+// bound is the statistical 3 sigma. With the along-side mixture of the
+// edge model (corners 0.0272 -> 0.0235 px RMS here) camera 0's fy is
+// 0.152 px low (was 0.166) but its sigma fell from 0.036 to 0.030 px, so
+// the bound fell below the bias it had held by 0.001 px: 0.07.
+constexpr double kRenderedFocalBiasPx = 0.07;
 
 // |x - truth| <= 3 sigma + floor, with a readable failure message.
 void ExpectWithin3Sigma(double estimate, double truth, double sigma,

@@ -388,7 +388,11 @@ bool NearOtherTag(const Eigen::Vector2d& a, const Eigen::Vector2d& b,
 // image border are skipped, and unless too few would remain, those reaching
 // another tag and those whose pattern changes within along_px along the
 // side (a data bit's edge, the square's corner: the blur mixes the
-// neighbouring pattern into the line's profile, which the 1-D model lacks).
+// neighbouring pattern into the line's profile). When too few clear ones
+// would remain (cells of a few blur widths, where the pattern changes
+// within the blur's reach on most of the side) and along_sigma > 0, the
+// varying profiles are kept with the lines beside them mixed into their
+// model (MixAlongSide, EdgeProfile::mixture).
 struct SideProfiles {
   std::vector<Eigen::Vector2d> base;
   std::vector<EdgeProfile> profiles;
@@ -433,10 +437,46 @@ void PixelProfile(const cv::Mat& gray, const Eigen::Vector2d& p,
   prof->box_px = std::max(std::abs(n.x()), std::abs(n.y()));
 }
 
+// The patterns of the lines beside the one at p (along the side, within
+// 2.5 along_sigma), each weighted by a Gaussian blur along the side of
+// along_sigma: what the image at p mixes in where the pattern changes
+// along the side. Lines whose patterns agree (breaks within 0.05 px) are
+// merged, their weights summed.
+void MixAlongSide(const PatternView& view, const Eigen::Vector2d& p,
+                  const Eigen::Vector2d& n, const Eigen::Vector2d& dir,
+                  double reach, double along_sigma, EdgeProfile* prof) {
+  prof->mixture.clear();
+  const int half = static_cast<int>(std::ceil(2.5 * along_sigma / 0.4));
+  const double step = 2.5 * along_sigma / std::max(1, half);
+  double total = 0;
+  for (int j = -half; j <= half; ++j) {
+    const double s = j * step;
+    EdgeProfile line;
+    PatternAlong(view, p + s * dir, n, -reach - 6.0, reach + 6.0, &line);
+    const double w = std::exp(-0.5 * s * s / (along_sigma * along_sigma));
+    total += w;
+    bool merged = false;
+    for (PatternLine& m : prof->mixture) {
+      if (m.classes != line.classes) continue;
+      bool same = true;
+      for (size_t i = 0; i < m.breaks.size() && same; ++i) {
+        same = std::abs(m.breaks[i] - line.breaks[i]) <= 0.05;
+      }
+      if (!same) continue;
+      m.weight += w;
+      merged = true;
+      break;
+    }
+    if (!merged) prof->mixture.push_back({line.breaks, line.classes, w});
+  }
+  for (PatternLine& m : prof->mixture) m.weight /= total;
+  if (prof->mixture.size() == 1) prof->mixture.clear();
+}
+
 SideProfiles ProfilesOfSide(const cv::Mat& gray, const PatternView& view,
                             const Eigen::Vector2d& a, const Eigen::Vector2d& b,
                             const Eigen::Vector2d& n, double cell, double cells,
-                            double along_px,
+                            double along_px, double along_sigma,
                             const std::vector<NeighbourTag>& others,
                             bool phased) {
   SideProfiles out;
@@ -448,7 +488,7 @@ SideProfiles ProfilesOfSide(const cv::Mat& gray, const PatternView& view,
   const double reach = std::max(2.0, std::min(1.5 * cell, cell + 2.0));
   const double step = std::clamp(cell / 8.0, 0.25, 1.0);
   const int samples = std::clamp(static_cast<int>(len * 0.8), 6, 32);
-  std::vector<bool> near;
+  std::vector<bool> near, varied;
   for (int s = 0; s < samples; ++s) {
     const double t = 0.1 + 0.8 * (s + 0.5) / samples;
     const Eigen::Vector2d p = a + t * len * dir;
@@ -480,6 +520,7 @@ SideProfiles ProfilesOfSide(const cv::Mat& gray, const PatternView& view,
       varies = varies || !SamePattern(here, beside, 0.25 * cell);
     }
     near.push_back(NearOtherTag(lo, hi, others, cells) || varies);
+    varied.push_back(varies);
     out.near_other_tag += near.back() && !varies ? 1 : 0;
     out.base.push_back(p);
     out.profiles.push_back(std::move(prof));
@@ -497,6 +538,15 @@ SideProfiles ProfilesOfSide(const cv::Mat& gray, const PatternView& view,
       kept.profiles.push_back(std::move(out.profiles[i]));
     }
     return kept;
+  }
+  // Too few clear samples (cells under a few blur widths): the varying
+  // ones stay, with the lines beside them mixed into their model.
+  if (along_sigma > 0 && !phased) {
+    for (size_t i = 0; i < varied.size(); ++i) {
+      if (!varied[i]) continue;
+      MixAlongSide(view, out.base[i], n, dir, reach, along_sigma,
+                   &out.profiles[i]);
+    }
   }
   return out;
 }
@@ -560,6 +610,14 @@ std::array<PhaseSigmas, 4> SidesBlur(const std::array<SideProfiles, 4>& sides,
   return sigma;
 }
 
+// Whether a side of blur sigma and cells of `cell` px takes the area rule
+// (FitSide): sharp (sigma < 0.8 px) with its neighbouring edges 2.5 sigma
+// clear of the rule's window of +-min(0.45 cell, 3 px).
+bool AreaRuleApplies(double sigma, double cell) {
+  return sigma < 0.8 && std::min(0.45 * cell, 3.0) >= 0.8 &&
+         0.55 * cell >= 2.5 * sigma;
+}
+
 // Edge points of one side: the profiles' shifts along the normal.
 bool FitSide(const cv::Mat& gray, const SideProfiles& side,
              const Eigen::Vector2d& n, const PhaseSigmas& sigmas, bool phased,
@@ -586,7 +644,7 @@ bool FitSide(const cv::Mat& gray, const SideProfiles& side,
     // of a pixel-integrated step; the model's area in closed form). The rule
     // alone read the white plateau darkened by the border's outer edge and
     // pulled every side inwards: a tag-scale bias.
-    if (!phased && sigma < 0.8 && w >= 0.8 && 0.55 * side.cell >= 2.5 * sigma) {
+    if (!phased && prof.mixture.empty() && AreaRuleApplies(sigma, side.cell)) {
       EdgeProfile fine;
       for (double o = shift - w - 0.25; o <= shift + w + 0.25; o += 0.25) {
         const Eigen::Vector2d q = side.base[i] + o * n;
@@ -659,7 +717,11 @@ bool FitSide(const cv::Mat& gray, const SideProfiles& side,
 // side (3 MAD outliers dropped) and the corners as intersections. Two
 // passes: the second places the pattern by the first's corners. Samples
 // whose window reaches another detected tag are left out (while enough
-// remain), not the whole side. A sharp side (sigma < 0.8 px, its
+// remain), not the whole side; where too few would remain, the second pass
+// keeps them with the patterns of the lines beside mixed into their model
+// by a Gaussian along the side as wide as the neighbouring sides' blur
+// (the blur along a side is the blur across its neighbours; exact for a
+// Gaussian, which separates). A sharp side (sigma < 0.8 px, its
 // neighbouring edges 2.5 sigma clear of the window) takes the area rule
 // with the plateaus at the window's ends instead (edge_profile.h).
 bool RefineCornersByEdges(const cv::Mat& gray, const cv::Mat& tag_image,
@@ -687,12 +749,20 @@ bool RefineCornersByEdges(const cv::Mat& gray, const cv::Mat& tag_image,
       Eigen::Vector2d n(-dir.y(), dir.x());
       if (n.dot((a + b) / 2 - centroid) < 0) n = -n;
       normals[k] = n;
+      // The blur along side k: the blur across its neighbours. Sides that
+      // take the area rule keep their own line's pattern (the rule, exact
+      // for a sharp pixel-integrated edge, serves them better than the
+      // model; measured: corner_bench's blur 0.5 scenes).
+      const double along_sigma =
+          pass == 0 || phased || AreaRuleApplies(sigma[k][0], cell)
+              ? 0.0
+              : 0.5 * (sigma[(k + 1) % 4][0] + sigma[(k + 3) % 4][0]);
       sides[k] = ProfilesOfSide(
           gray, view, a, b, n, cell, cells,
           pass == 0 ? 1.0
                     : std::max(1.0, 2.0 * *std::max_element(sigma[k].begin(),
                                                             sigma[k].end())),
-          others, phased);
+          along_sigma, others, phased);
     }
     if (pass == 0) sigma = SidesBlur(sides, phased);
     std::array<Line2, 4> lines;

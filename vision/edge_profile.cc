@@ -47,21 +47,22 @@ inline double IntegralPhi(double x) {
   return x * FastPhi(x) + Gauss(x);
 }
 
-// Basis of the three classes at offset o, and its derivative with respect
-// to e, for shift e and blur sigma.
-void Basis(const EdgeProfile& p, double o, double e, double sigma,
-           Eigen::Vector3d* b, Eigen::Vector3d* db_de) {
-  b->setZero();
-  db_de->setZero();
+// Basis of the three classes at offset o for one line's pattern (breaks,
+// classes), and its derivative with respect to e, for shift e and blur
+// sigma (and the profile's box), added with `weight`.
+void AddLineBasis(const EdgeProfile& p, const std::vector<double>& breaks,
+                  const std::vector<int>& classes, double weight, double o,
+                  double e, double sigma, Eigen::Vector3d* b,
+                  Eigen::Vector3d* db_de) {
   const double inv = 1.0 / sigma;
   // Phi((o - e - break) / sigma) at each break: the class left of a break
   // contributes 1 - Phi there, the right one Phi, so each class sums
   // (Phi(lower break) - Phi(upper break)).
   double prev_phi = 1.0, prev_g = 0.0;  // at -inf: Phi = 1, density 0
-  for (size_t i = 0; i <= p.breaks.size(); ++i) {
+  for (size_t i = 0; i <= breaks.size(); ++i) {
     double phi = 0.0, g = 0.0;  // at +inf
-    if (i < p.breaks.size()) {
-      const double x = (o - e - p.breaks[i]) * inv;
+    if (i < breaks.size()) {
+      const double x = (o - e - breaks[i]) * inv;
       if (p.box_px > 0) {
         const double h = 0.5 * p.box_px * inv;
         phi = (IntegralPhi(x + h) - IntegralPhi(x - h)) / (2 * h);
@@ -71,12 +72,28 @@ void Basis(const EdgeProfile& p, double o, double e, double sigma,
         g = x > -kPhiRange && x < kPhiRange ? Gauss(x) : 0.0;
       }
     }
-    const int c = p.classes[i];
-    (*b)(c) += prev_phi - phi;
+    const int c = classes[i];
+    (*b)(c) += weight * (prev_phi - phi);
     // d/de Phi((o - e - s) / sigma) = -g / sigma.
-    (*db_de)(c) += (-prev_g + g) * inv;
+    (*db_de)(c) += weight * (-prev_g + g) * inv;
     prev_phi = phi;
     prev_g = g;
+  }
+}
+
+// Basis of the three classes at offset o, and its derivative with respect
+// to e, for shift e and blur sigma: the profile's pattern, or its mixture.
+void Basis(const EdgeProfile& p, double o, double e, double sigma,
+           Eigen::Vector3d* b, Eigen::Vector3d* db_de) {
+  b->setZero();
+  db_de->setZero();
+  if (p.mixture.empty()) {
+    AddLineBasis(p, p.breaks, p.classes, 1.0, o, e, sigma, b, db_de);
+    return;
+  }
+  for (const PatternLine& line : p.mixture) {
+    AddLineBasis(p, line.breaks, line.classes, line.weight, o, e, sigma, b,
+                 db_de);
   }
 }
 

@@ -25,6 +25,14 @@
 
 namespace kincal {
 
+// One line's pattern (as EdgeProfile's breaks and classes) with its weight
+// in a mixture.
+struct PatternLine {
+  std::vector<double> breaks;
+  std::vector<int> classes;
+  double weight = 1;
+};
+
 struct EdgeProfile {
   std::vector<double> offsets;  // px along the outward normal
   std::vector<double> values;   // gray levels at those offsets
@@ -42,6 +50,13 @@ struct EdgeProfile {
   // averaged over that box (a pixel integrates the light over its area);
   // 0 for interpolated samples.
   double box_px = 0;
+  // The blur along the side mixes the patterns of the neighbouring lines
+  // (across a data bit's edge, near the square's corner) into this one:
+  // when not empty, the model is the weighted sum (weights summing to 1)
+  // of these lines' patterns blurred across, instead of breaks/classes
+  // alone. For a Gaussian blur that is exact (the blur separates into
+  // along and across).
+  std::vector<PatternLine> mixture;
 };
 
 // Gaussian blur per Bayer phase (index (x % 2) + 2 (y % 2)), px.

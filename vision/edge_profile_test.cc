@@ -114,6 +114,42 @@ TEST(EdgeProfile, PixelBoxIsInTheModel) {
   }
 }
 
+// Beside a data bit's edge along the side, the blur mixes the line through
+// the white bit with the line through the black ring's continuation: a
+// profile that is 60 % the one and 40 % the other. Its own line's pattern
+// alone moves the edge; the mixture in the model puts it back.
+TEST(EdgeProfile, MixtureOfTheLinesBesideRecoversTheShift) {
+  const double cell = 3.0, sigma = 1.1;
+  PatternLine bit{{-cell, 0.0, cell}, {1, 0, 1, 2}, 0.6};
+  PatternLine ring{{0.0, cell}, {0, 1, 2}, 0.4};
+  for (double edge : {-0.4, 0.0, 0.3}) {
+    EdgeProfile p;
+    p.breaks = bit.breaks;
+    p.classes = bit.classes;
+    for (double o = -1.5 * cell; o <= 1.5 * cell + 1e-9; o += 0.25) {
+      p.offsets.push_back(o);
+    }
+    for (const PatternLine& line : {bit, ring}) {
+      EdgeProfile one;
+      one.breaks = line.breaks;
+      one.classes = line.classes;
+      const std::vector<double> v =
+          EdgeProfileModel(one, p.offsets, edge, sigma, {30, 220, 60});
+      p.values.resize(v.size());
+      for (size_t i = 0; i < v.size(); ++i) p.values[i] += line.weight * v[i];
+    }
+    const EdgeProfileFit alone = FitEdgeProfile(p, sigma);
+    ASSERT_TRUE(alone.ok);
+    EXPECT_GT(std::abs(alone.shift_px - edge), 0.05) << edge;
+    p.mixture = {bit, ring};
+    const EdgeProfileFit mixed = FitEdgeProfile(p, sigma);
+    ASSERT_TRUE(mixed.ok);
+    EXPECT_NEAR(mixed.shift_px, edge, 1e-3);
+    EXPECT_NEAR(mixed.levels[0], 30, 0.05);
+    EXPECT_NEAR(mixed.levels[1], 220, 0.05);
+  }
+}
+
 TEST(EdgeProfile, ModelReproducesTheProfileItWasFittedTo) {
   std::mt19937_64 rng(5);
   const EdgeProfile p = Synthetic(0.3, 3.0, 0.9, 30, 220, 60, 0, &rng);
