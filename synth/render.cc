@@ -455,8 +455,20 @@ cv::Mat ExposeAndRecord(cv::Mat radiance, const RenderOptions& options,
   radiance.convertTo(out, CV_8UC1);  // rounds and saturates
   if (options.bayer && !options.bayer_raw) {
     // OpenCV names a mosaic by its second row's pattern: RGGB is "BG".
-    cv::Mat gray;
-    cv::cvtColor(out, gray, cv::COLOR_BayerBG2GRAY);
+    cv::Mat gray, bgr;
+    switch (options.demosaic) {
+      case RenderOptions::Demosaic::kBilinear:
+        cv::cvtColor(out, gray, cv::COLOR_BayerBG2GRAY);
+        break;
+      case RenderOptions::Demosaic::kVng:
+        cv::cvtColor(out, bgr, cv::COLOR_BayerBG2BGR_VNG);
+        cv::cvtColor(bgr, gray, cv::COLOR_BGR2GRAY);
+        break;
+      case RenderOptions::Demosaic::kEdgeAware:
+        cv::cvtColor(out, bgr, cv::COLOR_BayerBG2BGR_EA);
+        cv::cvtColor(bgr, gray, cv::COLOR_BGR2GRAY);
+        break;
+    }
     out = gray;
   }
   if (options.jpeg_quality > 0) {
