@@ -360,10 +360,9 @@ int RunSimulate(SimulateArgs args) {
     }
     if (args.render_options.bayer_raw) args.render_options.bayer = true;
     args.render_options.demosaic =
-        args.render_demosaic == "vng" ? RenderOptions::Demosaic::kVng
-        : args.render_demosaic == "ea"
-            ? RenderOptions::Demosaic::kEdgeAware
-            : RenderOptions::Demosaic::kBilinear;
+        args.render_demosaic == "vng"  ? RenderOptions::Demosaic::kVng
+        : args.render_demosaic == "ea" ? RenderOptions::Demosaic::kEdgeAware
+                                       : RenderOptions::Demosaic::kBilinear;
     if (args.render_options.shadow_tag >= 0) {
       args.render_options.shadow_angle_deg = 30.0;
       args.render_options.shadow_offset = 0.1;

@@ -80,8 +80,7 @@ std::map<Key, Eigen::Vector2d> ReadCorners(const std::string& path) {
 }
 
 int Run(const std::string& session_dir, const std::string& rig_path,
-        const std::string& target_path, BayerPattern bayer,
-        bool fit_demosaic) {
+        const std::string& target_path, BayerPattern bayer, bool fit_demosaic) {
   const Rig rig = ReadRigYaml(rig_path);
   const Target target = ReadTargetYaml(target_path);
   SessionReadOptions ro;

@@ -112,7 +112,7 @@ struct RenderOptions {
   //    refinement must not depend on it): kBilinear (the default) OpenCV's
   //    Bayer to gray (bilinear colour, then OpenCV's gray weights), kVng
   //    and kEdgeAware OpenCV's VNG and edge-aware demosaics to colour, then
-  //    to gray.
+  //    to gray (VNG's two-row shift in OpenCV < 4.12 undone).
   Eigen::Vector3d light_in_rig = Eigen::Vector3d::Zero();
   double ambient = 0.15;
   std::vector<double> tag_gain;

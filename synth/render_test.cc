@@ -234,8 +234,8 @@ TEST(Render, BayerSensorOtherDemosaics) {
                                .Render(ExampleToolPose(0), &rng0)
                                .views[0]
                                .image;
-  for (const auto d : {RenderOptions::Demosaic::kVng,
-                       RenderOptions::Demosaic::kEdgeAware}) {
+  for (const auto d :
+       {RenderOptions::Demosaic::kVng, RenderOptions::Demosaic::kEdgeAware}) {
     o.demosaic = d;
     StereoRenderer renderer(rig, ExampleTarget(), o);
     std::mt19937_64 rng(2);

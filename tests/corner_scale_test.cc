@@ -166,15 +166,16 @@ TEST(CornerScale, OtherDemosaicsNoWorseThanBlurPerPhase) {
   bayer.bayer = true;
   AprilTagOptions per_phase;
   per_phase.fit_demosaic = false;
-  for (const auto d : {RenderOptions::Demosaic::kVng,
-                       RenderOptions::Demosaic::kEdgeAware}) {
+  for (const auto d :
+       {RenderOptions::Demosaic::kVng, RenderOptions::Demosaic::kEdgeAware}) {
     bayer.demosaic = d;
     const ScaleBias b = MeasureScaleBias(40, 1000, bayer);
     const ScaleBias phase = MeasureScaleBias(40, 1000, bayer, per_phase);
-    std::printf("%s, 35 px: rms %.4f radial %+.4f | blur per phase rms %.4f "
-                "radial %+.4f px\n",
-                d == RenderOptions::Demosaic::kVng ? "VNG" : "edge-aware",
-                b.rms_px, b.mean_radial_px, phase.rms_px, phase.mean_radial_px);
+    std::printf(
+        "%s, 35 px: rms %.4f radial %+.4f | blur per phase rms %.4f "
+        "radial %+.4f px\n",
+        d == RenderOptions::Demosaic::kVng ? "VNG" : "edge-aware", b.rms_px,
+        b.mean_radial_px, phase.rms_px, phase.mean_radial_px);
     ASSERT_GE(b.corners, 100);
     EXPECT_LT(b.rms_px, 1.02 * phase.rms_px);
   }

@@ -695,8 +695,8 @@ bool FitSide(const cv::Mat& gray, const SideProfiles& side,
 // with the plateaus at the window's ends instead (edge_profile.h).
 bool RefineCornersByEdges(const cv::Mat& gray, const cv::Mat& tag_image,
                           int cells, TagDetection* det,
-                          const std::vector<NeighbourTag>& others,
-                          bool phased, const DemosaicKernels* demosaic) {
+                          const std::vector<NeighbourTag>& others, bool phased,
+                          const DemosaicKernels* demosaic) {
   const double start = 0.5 * (tag_image.cols - cells);
   std::array<Eigen::Vector2d, 4> c = det->corners;
   std::array<TagSideQuality, 4> quality{};
@@ -726,8 +726,9 @@ bool RefineCornersByEdges(const cv::Mat& gray, const cv::Mat& tag_image,
           others, phased);
     }
     if (pass == 0) {
-      sigma = phased && demosaic ? DemosaicedSidesBlur(sides, normals, *demosaic)
-                                 : SidesBlur(sides, phased);
+      sigma = phased && demosaic
+                  ? DemosaicedSidesBlur(sides, normals, *demosaic)
+                  : SidesBlur(sides, phased);
     }
     std::array<Line2, 4> lines;
     for (int k = 0; k < 4; ++k) {
@@ -781,8 +782,8 @@ bool DemosaicedSides(const cv::Mat& gray, const cv::Mat& tag_image, int cells,
     Eigen::Vector2d n(-dir.y(), dir.x());
     if (n.dot((a + b) / 2 - centroid) < 0) n = -n;
     (*normals)[k] = n;
-    (*sides)[k] = ProfilesOfSide(gray, view, a, b, n, cell, cells, 1.0, others,
-                                 true);
+    (*sides)[k] =
+        ProfilesOfSide(gray, view, a, b, n, cell, cells, 1.0, others, true);
   }
   return true;
 }

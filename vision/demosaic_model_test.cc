@@ -124,8 +124,7 @@ TEST(DemosaicModel, FitFindsTheEdgeOfADemosaicedImage) {
     const Eigen::Vector2d n(std::cos(deg * M_PI / 180),
                             std::sin(deg * M_PI / 180));
     for (const double edge : {-0.4, 0.0, 0.25, 0.6}) {
-      const DemosaicedEdge e =
-          RenderEdge(n, edge, 0.5, cv::COLOR_BayerBG2GRAY);
+      const DemosaicedEdge e = RenderEdge(n, edge, 0.5, cv::COLOR_BayerBG2GRAY);
       for (const double along : {-1.0, 0.0, 1.25}) {
         const EdgeProfileFit f =
             FitDemosaicedProfile(PixelStrip(e, n, along), n, k, 0.5);
