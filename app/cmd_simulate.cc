@@ -45,6 +45,7 @@ struct SimulateArgs {
   // --render-light: a distant light at this angle from the reference
   // camera's axis (turned about its y axis); NaN = even light.
   double render_light_deg = std::numeric_limits<double>::quiet_NaN();
+  std::string render_demosaic = "bilinear";  // with --render-bayer
 };
 
 // Cameras on the flange: where the rig sits on the tool and the board in
@@ -358,6 +359,10 @@ int RunSimulate(SimulateArgs args) {
           Eigen::Vector3d(std::sin(a), 0.0, std::cos(a));
     }
     if (args.render_options.bayer_raw) args.render_options.bayer = true;
+    args.render_options.demosaic =
+        args.render_demosaic == "vng"  ? RenderOptions::Demosaic::kVng
+        : args.render_demosaic == "ea" ? RenderOptions::Demosaic::kEdgeAware
+                                       : RenderOptions::Demosaic::kBilinear;
     if (args.render_options.shadow_tag >= 0) {
       args.render_options.shadow_angle_deg = 30.0;
       args.render_options.shadow_offset = 0.1;
@@ -523,6 +528,12 @@ void AddSimulateCommand(CLI::App& app, Runner* run) {
   sub->add_flag("--render-bayer", args->render_options.bayer,
                 "a colour sensor: RGGB photosites with their own gains and "
                 "noise, demosaiced to gray by OpenCV");
+  sub->add_option("--render-demosaic", args->render_demosaic,
+                  "with --render-bayer: the driver's demosaic, OpenCV's "
+                  "bilinear Bayer to gray, or its VNG or edge-aware (ea) "
+                  "demosaic to colour, then to gray")
+      ->check(CLI::IsMember({"bilinear", "vng", "ea"}))
+      ->capture_default_str();
   sub->add_flag("--render-bayer-raw", args->render_options.bayer_raw,
                 "a colour sensor's raw mosaic (as --render-bayer, not "
                 "demosaiced: one photosite per pixel; read it with track/"

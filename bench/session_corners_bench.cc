@@ -7,9 +7,10 @@
 // fit keeps (what the bundle takes).
 //
 //   build/bin/session_corners_bench --session S/session --rig S/rig.yaml
-//       --target S/target.yaml [--bayer RGGB]
+//       --target S/target.yaml [--bayer RGGB] [--fit-demosaic 0]
 // (--bayer: the images are raw mosaics, balanced to gray as track and
-// bundle --bayer do.)
+// bundle --bayer do; --fit-demosaic 0: demosaiced images take the blur per
+// phase, not the linear demosaic's model, AprilTagOptions::fit_demosaic.)
 
 #include <algorithm>
 #include <cmath>
@@ -79,7 +80,7 @@ std::map<Key, Eigen::Vector2d> ReadCorners(const std::string& path) {
 }
 
 int Run(const std::string& session_dir, const std::string& rig_path,
-        const std::string& target_path, BayerPattern bayer) {
+        const std::string& target_path, BayerPattern bayer, bool fit_demosaic) {
   const Rig rig = ReadRigYaml(rig_path);
   const Target target = ReadTargetYaml(target_path);
   SessionReadOptions ro;
@@ -88,6 +89,7 @@ int Run(const std::string& session_dir, const std::string& rig_path,
   const auto truth = ReadCorners(session_dir + "/corners.csv");
   AprilTagOptions dopt;
   dopt.family = target.family;
+  dopt.fit_demosaic = fit_demosaic;
   AprilTagDetector detector(dopt);
   std::map<std::string, Stat> stats;
   std::vector<double> phase_ratios;
@@ -173,17 +175,22 @@ int Run(const std::string& session_dir, const std::string& rig_path,
 
 int main(int argc, char** argv) {
   std::string session, rig, target, bayer = "none";
+  bool fit_demosaic = true;
   for (int i = 1; i + 1 < argc; i += 2) {
     if (!std::strcmp(argv[i], "--session")) session = argv[i + 1];
     if (!std::strcmp(argv[i], "--rig")) rig = argv[i + 1];
     if (!std::strcmp(argv[i], "--target")) target = argv[i + 1];
     if (!std::strcmp(argv[i], "--bayer")) bayer = argv[i + 1];
+    if (!std::strcmp(argv[i], "--fit-demosaic")) {
+      fit_demosaic = std::strcmp(argv[i + 1], "0") != 0;
+    }
   }
   if (session.empty() || rig.empty() || target.empty()) {
     std::fprintf(stderr,
                  "usage: session_corners_bench --session DIR --rig RIG.yaml "
-                 "--target TARGET.yaml [--bayer RGGB]\n");
+                 "--target TARGET.yaml [--bayer RGGB] [--fit-demosaic 0]\n");
     return 2;
   }
-  return kincal::Run(session, rig, target, kincal::ParseBayerPattern(bayer));
+  return kincal::Run(session, rig, target, kincal::ParseBayerPattern(bayer),
+                     fit_demosaic);
 }

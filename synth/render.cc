@@ -350,6 +350,43 @@ void DrawNeedle(const Needle& needle, const Camera& camera, cv::Mat* radiance) {
 
 // Disk of radius `radius_px`, anti-aliased by 8x8 supersampling per kernel
 // cell, normalised to sum 1.
+// OpenCV's VNG demosaic shifts its output up by two rows in versions
+// before 4.12 (opencv/opencv#5089, #27225): the rows a test mosaic's
+// horizontal edge moves by against the bilinear demosaic (0 once fixed).
+int VngRowShift() {
+  static const int shift = [] {
+    cv::Mat raw(32, 16, CV_8UC1, cv::Scalar(40));
+    raw.rowRange(16, 32).setTo(220);
+    cv::Mat bilinear, bgr, vng;
+    cv::cvtColor(raw, bilinear, cv::COLOR_BayerBG2GRAY);
+    cv::cvtColor(raw, bgr, cv::COLOR_BayerBG2BGR_VNG);
+    cv::cvtColor(bgr, vng, cv::COLOR_BGR2GRAY);
+    const auto edge_row = [](const cv::Mat& g) {
+      int y = 4;
+      while (y < 28 && g.at<uint8_t>(y, 8) < 130) ++y;
+      return y;
+    };
+    return edge_row(vng) - edge_row(bilinear);
+  }();
+  return shift;
+}
+
+// VNG's gray image with its rows where the scene has them.
+cv::Mat VngToGray(const cv::Mat& mosaic) {
+  cv::Mat bgr, gray;
+  cv::cvtColor(mosaic, bgr, cv::COLOR_BayerBG2BGR_VNG);
+  cv::cvtColor(bgr, gray, cv::COLOR_BGR2GRAY);
+  const int s = VngRowShift();
+  if (s == 0) return gray;
+  // out(y) = gray(y + s), the rows beyond the image repeated.
+  cv::Mat out;
+  const cv::Mat m = (cv::Mat_<double>(2, 3) << 1, 0, 0, 0, 1, s);
+  cv::warpAffine(gray, out, m, gray.size(),
+                 cv::INTER_NEAREST | cv::WARP_INVERSE_MAP,
+                 cv::BORDER_REPLICATE);
+  return out;
+}
+
 cv::Mat DefocusKernel(double radius_px) {
   const double R = radius_px;
   const int h = static_cast<int>(std::ceil(R));
@@ -455,8 +492,19 @@ cv::Mat ExposeAndRecord(cv::Mat radiance, const RenderOptions& options,
   radiance.convertTo(out, CV_8UC1);  // rounds and saturates
   if (options.bayer && !options.bayer_raw) {
     // OpenCV names a mosaic by its second row's pattern: RGGB is "BG".
-    cv::Mat gray;
-    cv::cvtColor(out, gray, cv::COLOR_BayerBG2GRAY);
+    cv::Mat gray, bgr;
+    switch (options.demosaic) {
+      case RenderOptions::Demosaic::kBilinear:
+        cv::cvtColor(out, gray, cv::COLOR_BayerBG2GRAY);
+        break;
+      case RenderOptions::Demosaic::kVng:
+        gray = VngToGray(out);
+        break;
+      case RenderOptions::Demosaic::kEdgeAware:
+        cv::cvtColor(out, bgr, cv::COLOR_BayerBG2BGR_EA);
+        cv::cvtColor(bgr, gray, cv::COLOR_BGR2GRAY);
+        break;
+    }
     out = gray;
   }
   if (options.jpeg_quality > 0) {

@@ -107,7 +107,12 @@ struct RenderOptions {
   //    image is demosaiced to gray by OpenCV (cvtColor, Bayer to gray), as
   //    a colour camera's driver delivers it; with bayer_raw the mosaic
   //    itself (one 8-bit photosite per pixel, not demosaiced), as a colour
-  //    camera delivers it in its raw formats (GenICam BayerRG8, V4L2 RGGB).
+  //    camera delivers it in its raw formats (GenICam BayerRG8, V4L2 RGGB);
+  //    demosaic: how the mosaic becomes gray (a driver's choice; the
+  //    refinement must not depend on it): kBilinear (the default) OpenCV's
+  //    Bayer to gray (bilinear colour, then OpenCV's gray weights), kVng
+  //    and kEdgeAware OpenCV's VNG and edge-aware demosaics to colour, then
+  //    to gray (VNG's two-row shift in OpenCV < 4.12 undone).
   Eigen::Vector3d light_in_rig = Eigen::Vector3d::Zero();
   double ambient = 0.15;
   std::vector<double> tag_gain;
@@ -117,6 +122,8 @@ struct RenderOptions {
   double shadow_gain = 0.35;
   bool bayer = false;
   bool bayer_raw = false;  // with bayer: write the mosaic, not demosaiced
+  enum class Demosaic { kBilinear, kVng, kEdgeAware };
+  Demosaic demosaic = Demosaic::kBilinear;
   std::array<double, 3> bayer_gains = {0.55, 1.0, 0.75};  // R, G, B
   // The needle: a cylinder from needle_base_in_tool to the target's tip.
   bool draw_needle = false;

@@ -221,6 +221,41 @@ TEST(Render, BayerSensorDemosaicsToGray) {
   EXPECT_LT(s.Rms(), 0.15);
 }
 
+// The other demosaics (VNG, edge-aware, to colour then to gray): flat gray
+// paper at the same gray weights, the tags found, and images that differ
+// from the bilinear one (each driver's demosaic is its own).
+TEST(Render, BayerSensorOtherDemosaics) {
+  const Rig rig = ExampleStereoRig(640, 512);
+  RenderOptions o;
+  o.bayer = true;
+  o.blur_sigma_px = 0.6;
+  std::mt19937_64 rng0(2);
+  const cv::Mat bilinear = StereoRenderer(rig, ExampleTarget(), o)
+                               .Render(ExampleToolPose(0), &rng0)
+                               .views[0]
+                               .image;
+  for (const auto d :
+       {RenderOptions::Demosaic::kVng, RenderOptions::Demosaic::kEdgeAware}) {
+    o.demosaic = d;
+    StereoRenderer renderer(rig, ExampleTarget(), o);
+    std::mt19937_64 rng(2);
+    const StereoFrameTruth f = renderer.Render(ExampleToolPose(0), &rng);
+    const cv::Mat& im = f.views[0].image;
+    const double want =
+        o.background * (0.299 * o.bayer_gains[0] + 0.587 * o.bayer_gains[1] +
+                        0.114 * o.bayer_gains[2]);
+    EXPECT_NEAR(im.at<uint8_t>(5, 5), want, 1.5);
+    EXPECT_NEAR(im.at<uint8_t>(6, 6), want, 1.5);
+    EXPECT_GT(cv::norm(im, bilinear, cv::NORM_L1), 1000.0);
+    AprilTagDetector detector;
+    CornerStats s;
+    for (const ViewTruth& v : f.views)
+      Accumulate(detector.Detect(v.image), v.tags, &s);
+    EXPECT_EQ(s.tags_found, s.tags_expected);
+    EXPECT_LT(s.Rms(), 0.15);
+  }
+}
+
 // The raw mosaic (bayer_raw): each photosite of flat gray paper carries its
 // channel's gain (RGGB: R at even x and y, B at odd x and y).
 TEST(Render, BayerRawWritesTheMosaic) {

@@ -195,6 +195,22 @@ TEST(RenderPipelineTest, LightShadowAndBayerOptions) {
     }
     EXPECT_GT(differ, 0) << extra << " left every image as it was";
   }
+  // The driver's demosaic (--render-demosaic): VNG's and edge-aware's
+  // images are not the bilinear one's (lit2); an unknown one is refused.
+  for (const std::string d : {"vng", "ea"}) {
+    const std::string out = dir + "/" + d;
+    r = RunKincal(common + out + " --render-bayer --render-demosaic " + d);
+    ASSERT_EQ(r.exit_code, 0) << d << ": " << r.err;
+    int differ = 0;
+    for (int f = 0; f < 3; ++f) {
+      const std::string name =
+          "/session/left/00000" + std::to_string(f) + ".png";
+      differ += ReadFile(dir + "/lit2" + name) != ReadFile(out + name) ? 1 : 0;
+    }
+    EXPECT_EQ(differ, 3) << d;
+  }
+  r = RunKincal(common + dir + "/bad --render-bayer --render-demosaic cubic");
+  EXPECT_EQ(r.exit_code, 2) << r.err;
   r = RunKincal(common + dir + "/bad --render-shadow 9");
   EXPECT_EQ(r.exit_code, 2) << r.err;
   EXPECT_NE(r.err.find("--render-shadow 9"), std::string::npos) << r.err;

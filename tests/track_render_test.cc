@@ -74,7 +74,8 @@ Errors RunScene(const Scene& scene, int frames, uint64_t seed) {
 
 std::vector<Scene> Scenes() {
   std::vector<Scene> s;
-  Scene issue{"three tags, outer two turned 35 deg, blur + noise", {}};
+  Scene issue;
+  issue.name = "three tags, outer two turned 35 deg, blur + noise";
   issue.render.blur_sigma_px = 0.7;
   issue.render.noise_sigma = 2.0;
   s.push_back(issue);

@@ -212,6 +212,15 @@ void AprilTagDetector::RefineByEdges(const cv::Mat& gray,
   const int cells = static_cast<int>(impl_->family.family->width_at_border);
   const bool phased = !dets->empty() && PhaseSharpnessRatio(gray, *dets) >
                                             options_.demosaiced_ratio;
+  DemosaicKernels kernels;
+  bool linear_demosaic = false;
+  if (phased && options_.fit_demosaic) {
+    std::vector<const cv::Mat*> images;
+    for (const TagDetection& t : *dets) images.push_back(&Pattern(t.id));
+    const TagsDemosaicFit fit = FitTagsDemosaic(gray, images, cells, *dets);
+    linear_demosaic = fit.better;
+    kernels = fit.model.Kernels();
+  }
   for (size_t i = 0; i < dets->size(); ++i) {
     TagDetection& t = (*dets)[i];
     std::vector<NeighbourTag> others;
@@ -220,7 +229,8 @@ void AprilTagDetector::RefineByEdges(const cv::Mat& gray,
         others.push_back({(*dets)[j].detector_corners});
       }
     }
-    if (!RefineCornersByEdges(gray, Pattern(t.id), cells, &t, others, phased)) {
+    if (!RefineCornersByEdges(gray, Pattern(t.id), cells, &t, others, phased,
+                              linear_demosaic ? &kernels : nullptr)) {
       continue;
     }
     const TagDetection judged = t;  // every corner against the refined ones
@@ -618,17 +628,38 @@ bool AreaRuleApplies(double sigma, double cell) {
          0.55 * cell >= 2.5 * sigma;
 }
 
+// With a linear demosaic's kernels: one (optical) blur per pair of
+// opposite sides, the demosaic's own blur being in the kernels.
+std::array<PhaseSigmas, 4> DemosaicedSidesBlur(
+    const std::array<SideProfiles, 4>& sides,
+    const std::array<Eigen::Vector2d, 4>& normals,
+    const DemosaicKernels& kernels) {
+  std::array<PhaseSigmas, 4> sigma;
+  for (int k = 0; k < 2; ++k) {
+    const double s = DemosaicedBlur({{&sides[k].profiles, normals[k]},
+                                     {&sides[k + 2].profiles, normals[k + 2]}},
+                                    kernels);
+    sigma[k] = sigma[k + 2] = {s, s, s, s};
+  }
+  return sigma;
+}
+
 // Edge points of one side: the profiles' shifts along the normal.
+// `demosaic`: the profiles are fitted with a linear demosaic's kernels and
+// the blur sigmas[0].
 bool FitSide(const cv::Mat& gray, const SideProfiles& side,
              const Eigen::Vector2d& n, const PhaseSigmas& sigmas, bool phased,
-             Line2* line, TagSideQuality* quality) {
+             Line2* line, TagSideQuality* quality,
+             const DemosaicKernels* demosaic = nullptr) {
   const double sigma = sigmas[0];
   std::vector<Eigen::Vector2d> pts;
   std::vector<double> contrast, fit_rms;
   const double w = std::min(0.45 * side.cell, 3.0);
   for (size_t i = 0; i < side.profiles.size(); ++i) {
     const EdgeProfile& prof = side.profiles[i];
-    const EdgeProfileFit f = FitEdgeProfile(prof, sigmas);
+    const EdgeProfileFit f =
+        demosaic ? FitDemosaicedProfile(prof, n, *demosaic, sigma)
+                 : FitEdgeProfile(prof, sigmas);
     if (!f.ok) continue;
     double shift = f.shift_px;
     // A sharp side (sigma < 0.8 px, its neighbouring edges one cell away):
@@ -726,8 +757,8 @@ bool FitSide(const cv::Mat& gray, const SideProfiles& side,
 // with the plateaus at the window's ends instead (edge_profile.h).
 bool RefineCornersByEdges(const cv::Mat& gray, const cv::Mat& tag_image,
                           int cells, TagDetection* det,
-                          const std::vector<NeighbourTag>& others,
-                          bool phased) {
+                          const std::vector<NeighbourTag>& others, bool phased,
+                          const DemosaicKernels* demosaic) {
   const double start = 0.5 * (tag_image.cols - cells);
   std::array<Eigen::Vector2d, 4> c = det->corners;
   std::array<TagSideQuality, 4> quality{};
@@ -764,11 +795,15 @@ bool RefineCornersByEdges(const cv::Mat& gray, const cv::Mat& tag_image,
                                                             sigma[k].end())),
           along_sigma, others, phased);
     }
-    if (pass == 0) sigma = SidesBlur(sides, phased);
+    if (pass == 0) {
+      sigma = phased && demosaic
+                  ? DemosaicedSidesBlur(sides, normals, *demosaic)
+                  : SidesBlur(sides, phased);
+    }
     std::array<Line2, 4> lines;
     for (int k = 0; k < 4; ++k) {
       if (!FitSide(gray, sides[k], normals[k], sigma[k], phased, &lines[k],
-                   &quality[k])) {
+                   &quality[k], phased ? demosaic : nullptr)) {
         return false;
       }
     }
@@ -791,6 +826,115 @@ bool RefineCornersByEdges(const cv::Mat& gray, const cv::Mat& tag_image,
   Eigen::Vector2d center;
   if (Intersect(d0, d1, &center)) det->center = center;
   return true;
+}
+
+namespace {
+
+// Pass 0 of RefineCornersByEdges for a demosaiced image: the profiles of
+// the four sides placed by `corners`, and their outward normals.
+bool DemosaicedSides(const cv::Mat& gray, const cv::Mat& tag_image, int cells,
+                     const std::array<Eigen::Vector2d, 4>& c,
+                     const std::vector<NeighbourTag>& others,
+                     std::array<SideProfiles, 4>* sides,
+                     std::array<Eigen::Vector2d, 4>* normals) {
+  const double start = 0.5 * (tag_image.cols - cells);
+  PatternView view{&tag_image, ImageFromTemplate(c, start, cells).inverse()};
+  const Eigen::Vector2d centroid = (c[0] + c[1] + c[2] + c[3]) / 4.0;
+  double shortest = 1e9;
+  for (int j = 0; j < 4; ++j) {
+    shortest = std::min(shortest, (c[(j + 1) % 4] - c[j]).norm());
+  }
+  const double cell = shortest / cells;
+  if (shortest < 8.0 || cell < 1.5) return false;
+  for (int k = 0; k < 4; ++k) {
+    const Eigen::Vector2d a = c[k], b = c[(k + 1) % 4];
+    const Eigen::Vector2d dir = (b - a).normalized();
+    Eigen::Vector2d n(-dir.y(), dir.x());
+    if (n.dot((a + b) / 2 - centroid) < 0) n = -n;
+    (*normals)[k] = n;
+    (*sides)[k] =
+        ProfilesOfSide(gray, view, a, b, n, cell, cells, 1.0, 0.0, others,
+                       true);
+  }
+  return true;
+}
+
+// Sum of squared residual RMS of the sides' profiles that both fits take,
+// with the linear demosaic (one blur per side pair) and with the blur per
+// phase; their count.
+void CompareDemosaicFits(const std::array<SideProfiles, 4>& sides,
+                         const std::array<Eigen::Vector2d, 4>& normals,
+                         const DemosaicKernels& kernels, double* model_ss,
+                         double* phase_ss, int* profiles) {
+  const std::array<PhaseSigmas, 4> model_sigma =
+      DemosaicedSidesBlur(sides, normals, kernels);
+  const std::array<PhaseSigmas, 4> phase_sigma = SidesBlur(sides, true);
+  for (int k = 0; k < 4; ++k) {
+    for (const EdgeProfile& p : sides[k].profiles) {
+      const EdgeProfileFit m =
+          FitDemosaicedProfile(p, normals[k], kernels, model_sigma[k][0]);
+      const EdgeProfileFit f = FitEdgeProfile(p, phase_sigma[k]);
+      if (!m.ok || !f.ok) continue;
+      *model_ss += m.rms * m.rms;
+      *phase_ss += f.rms * f.rms;
+      ++*profiles;
+    }
+  }
+}
+
+}  // namespace
+
+TagsDemosaicFit FitTagsDemosaic(const cv::Mat& gray,
+                                const std::vector<const cv::Mat*>& tag_images,
+                                int cells,
+                                const std::vector<TagDetection>& dets,
+                                int max_tags) {
+  // The largest tags first: most pixels across their edges.
+  std::vector<std::pair<double, size_t>> by_size;
+  for (size_t i = 0; i < dets.size(); ++i) {
+    double perimeter = 0;
+    for (int k = 0; k < 4; ++k) {
+      perimeter += (dets[i].corners[(k + 1) % 4] - dets[i].corners[k]).norm();
+    }
+    by_size.emplace_back(-perimeter, i);
+  }
+  std::sort(by_size.begin(), by_size.end());
+  std::vector<std::array<SideProfiles, 4>> tags;
+  std::vector<std::array<Eigen::Vector2d, 4>> normals;
+  for (const auto& [size, i] : by_size) {
+    if (static_cast<int>(tags.size()) == max_tags) break;
+    std::vector<NeighbourTag> others;
+    for (size_t j = 0; j < dets.size(); ++j) {
+      if (j != i) others.push_back({dets[j].corners});
+    }
+    std::array<SideProfiles, 4> sides;
+    std::array<Eigen::Vector2d, 4> n;
+    if (DemosaicedSides(gray, *tag_images[i], cells, dets[i].corners, others,
+                        &sides, &n)) {
+      tags.push_back(std::move(sides));
+      normals.push_back(n);
+    }
+  }
+  TagsDemosaicFit out;
+  if (tags.empty()) return out;
+  std::vector<std::vector<DemosaicSide>> groups;
+  for (size_t t = 0; t < tags.size(); ++t) {
+    groups.emplace_back();
+    for (int k = 0; k < 4; ++k) {
+      groups.back().push_back({&tags[t][k].profiles, normals[t][k]});
+    }
+  }
+  out.model = FitBilinearDemosaic(groups).model;
+  double model_ss = 0, phase_ss = 0;
+  for (size_t t = 0; t < tags.size(); ++t) {
+    CompareDemosaicFits(tags[t], normals[t], out.model.Kernels(), &model_ss,
+                        &phase_ss, &out.profiles);
+  }
+  if (out.profiles == 0) return out;
+  out.model_rms = std::sqrt(model_ss / out.profiles);
+  out.phase_rms = std::sqrt(phase_ss / out.profiles);
+  out.better = out.profiles >= 16 && out.model_rms < out.phase_rms;
+  return out;
 }
 
 bool RefineCornersBySubPix(const cv::Mat& gray, TagDetection* det) {

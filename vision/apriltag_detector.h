@@ -24,6 +24,8 @@
 #include <string>
 #include <vector>
 
+#include "vision/demosaic_model.h"
+
 namespace kincal {
 
 // The edge refinement's view of one side of a tag (corner k to k + 1).
@@ -118,6 +120,13 @@ struct AprilTagOptions {
   // per phase (edge_profile.h). Measured: gray renders 1.0-1.3 (any blur,
   // motion, defocus, JPEG), OpenCV-demosaiced Bayer renders 3-12.
   double demosaiced_ratio = 2.0;
+  // A demosaiced image's tags are first fitted with a linear (bilinear)
+  // demosaic's model (vision/demosaic_model.h: each pixel a known sum of its
+  // neighbours' blurred samples, the channels' shares fitted on the image's
+  // largest tags); the model refines the image when its profiles' residual
+  // is below the blur per phase's, else the blur per phase does (another
+  // demosaic: VNG, edge-aware). false: the blur per phase always.
+  bool fit_demosaic = true;
 
   // Throws InputError naming the bad option and its value.
   void Check() const;
@@ -171,10 +180,30 @@ class AprilTagDetector {
 // Returns false and leaves `det` unchanged when the refinement fails (a
 // side too short, too close to the image border, or with fewer than four
 // edge points); fills det->sides otherwise.
+// `demosaic` (with `phased`): the linear demosaic's kernels
+// (FitTagsDemosaic) replace the blur per phase, one blur per side pair.
 bool RefineCornersByEdges(const cv::Mat& gray, const cv::Mat& tag_image,
                           int cells, TagDetection* det,
                           const std::vector<NeighbourTag>& others = {},
-                          bool phased = false);
+                          bool phased = false,
+                          const DemosaicKernels* demosaic = nullptr);
+
+// For a demosaiced image: the bilinear demosaic (FitBilinearDemosaic) that
+// fits the sides of up to `max_tags` of the largest detections (`tag_images`
+// per detection, libapriltag's corners), and whether its profiles'
+// residual is below the blur per phase's on the same profiles.
+struct TagsDemosaicFit {
+  bool better = false;  // the model fits better than the blur per phase
+  BilinearDemosaic model;
+  double model_rms = 0;  // profile residual RMS, gray levels
+  double phase_rms = 0;  // the same with the blur per phase
+  int profiles = 0;      // compared
+};
+TagsDemosaicFit FitTagsDemosaic(const cv::Mat& gray,
+                                const std::vector<const cv::Mat*>& tag_images,
+                                int cells,
+                                const std::vector<TagDetection>& dets,
+                                int max_tags = 6);
 bool RefineCornersBySubPix(const cv::Mat& gray, TagDetection* det);
 
 // How differently the four Bayer phases ((x % 2, y % 2)) of `gray` are

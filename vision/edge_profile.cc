@@ -130,6 +130,12 @@ ProfileSums Sums(const EdgeProfile& p, double e, const PhaseSigmas& sigma) {
 
 }  // namespace
 
+void EdgeProfileBasis(const EdgeProfile& profile, double offset,
+                      double shift_px, double sigma_px, Eigen::Vector3d* basis,
+                      Eigen::Vector3d* d_basis_d_shift) {
+  Basis(profile, offset, shift_px, sigma_px, basis, d_basis_d_shift);
+}
+
 double AreaRuleShift(const EdgeProfile& p, double inside, double outside,
                      double centre, double w) {
   const double a = centre - w, b = centre + w;

@@ -20,6 +20,7 @@
 // edge, as they do in an area rule or a gradient centroid under wide blur.
 // e is found by Gauss-Newton with the levels projected out.
 
+#include <Eigen/Core>
 #include <array>
 #include <vector>
 
@@ -110,6 +111,14 @@ std::vector<double> EdgeProfileModel(const EdgeProfile& profile,
 double EdgeProfileModelArea(const EdgeProfile& profile, double lo, double hi,
                             double shift_px, double sigma_px,
                             const std::array<double, 3>& levels);
+
+// The model's basis at offset o for shift e and blur sigma: per class
+// (black, white, outside) its weight in m(o) (the box-averaged step when
+// box_px > 0), and the derivative of that by e. For models built from the
+// same pattern (vision/demosaic_model.h).
+void EdgeProfileBasis(const EdgeProfile& profile, double offset,
+                      double shift_px, double sigma_px, Eigen::Vector3d* basis,
+                      Eigen::Vector3d* d_basis_d_shift);
 
 // Standard normal CDF from a table (|error| < 2e-5), for the model's speed.
 double FastPhi(double x);
