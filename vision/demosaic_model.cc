@@ -36,17 +36,11 @@ std::array<double, 9> GreenSite(double green, double horizontal,
   return w;
 }
 
-// The profile's sums for shift e (as edge_profile.cc's Sums; see there).
-struct DemosaicSums {
-  Eigen::Matrix3d B = Eigen::Matrix3d::Zero(), D = Eigen::Matrix3d::Zero(),
-                  DD = Eigen::Matrix3d::Zero();
-  Eigen::Vector3d bv = Eigen::Vector3d::Zero(), dv = Eigen::Vector3d::Zero();
-  double vv = 0;
-};
-
-DemosaicSums Sums(const EdgeProfile& p, const std::array<double, 9>& delta,
-                  const DemosaicKernels& k, double e, double sigma) {
-  DemosaicSums s;
+// The profile's sums at shift e (EdgeProfileSums), each sample's model
+// being its phase's kernel over the blurred pattern at the 3x3 pixels.
+EdgeProfileSums Sums(const EdgeProfile& p, const std::array<double, 9>& delta,
+                     const DemosaicKernels& k, double e, double sigma) {
+  EdgeProfileSums s;
   Eigen::Vector3d b, db, bt, dbt;
   const bool phased = p.phases.size() == p.offsets.size();
   for (size_t i = 0; i < p.offsets.size(); ++i) {
@@ -148,27 +142,9 @@ EdgeProfileFit FitDemosaicedProfile(const EdgeProfile& profile,
       delta[Tap(dx, dy)] = normal.x() * dx + normal.y() * dy;
     }
   }
-  double e = 0, sse = 0;
-  Eigen::Vector3d levels = Eigen::Vector3d::Zero();
-  for (int it = 0;; ++it) {
-    const DemosaicSums s = Sums(profile, delta, kernels, e, sigma_px);
-    levels = s.B.ldlt().solve(s.bv);
-    sse = s.vv - 2 * levels.dot(s.bv) + levels.dot(s.B * levels);
-    if (it == iterations) break;
-    // Gauss-Newton on e with the levels held.
-    const double jtj = levels.dot(s.DD * levels);
-    const double jtr = -levels.dot(s.dv) + levels.dot(s.D * levels);
-    if (!(jtj > 0)) return fit;
-    const double step = std::clamp(-jtr / jtj, -0.5, 0.5);
-    e += step;
-    if (std::abs(e) > max_shift_px) return fit;
-    if (std::abs(step) < 1e-4) iterations = it + 1;
-  }
-  fit.shift_px = e;
-  fit.levels = {levels(0), levels(1), levels(2)};
-  fit.rms = std::sqrt(std::max(0.0, sse) / profile.offsets.size());
-  fit.ok = std::isfinite(e) && std::abs(levels(1) - levels(0)) >= 5.0;
-  return fit;
+  return FitShiftFromSums(
+      [&](double e) { return Sums(profile, delta, kernels, e, sigma_px); },
+      profile.offsets.size(), iterations, max_shift_px);
 }
 
 double DemosaicedBlur(const std::vector<DemosaicSide>& sides,

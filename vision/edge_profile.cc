@@ -97,20 +97,9 @@ void Basis(const EdgeProfile& p, double o, double e, double sigma,
   }
 }
 
-// The profile's sums for shift e in one pass: with B = sum b b^T,
-// D = sum db b^T, DD = sum db db^T, bv = sum b v, dv = sum db v, vv =
-// sum v^2, the levels L solve B L = bv, and with r = v - b.L, j = -db.L:
-// SSE = vv - 2 L.bv + L^T B L, sum j j = L^T DD L,
-// sum j r = -L.dv + L^T D L.
-struct ProfileSums {
-  Eigen::Matrix3d B = Eigen::Matrix3d::Zero(), D = Eigen::Matrix3d::Zero(),
-                  DD = Eigen::Matrix3d::Zero();
-  Eigen::Vector3d bv = Eigen::Vector3d::Zero(), dv = Eigen::Vector3d::Zero();
-  double vv = 0;
-};
-
-ProfileSums Sums(const EdgeProfile& p, double e, const PhaseSigmas& sigma) {
-  ProfileSums s;
+// The profile's sums at shift e (EdgeProfileSums), in one pass.
+EdgeProfileSums Sums(const EdgeProfile& p, double e, const PhaseSigmas& sigma) {
+  EdgeProfileSums s;
   Eigen::Vector3d b, db;
   const bool phased = p.phases.size() == p.offsets.size();
   for (size_t i = 0; i < p.offsets.size(); ++i) {
@@ -217,11 +206,19 @@ EdgeProfileFit FitEdgeProfile(const EdgeProfile& profile,
       !(*std::min_element(sigma_px.begin(), sigma_px.end()) > 0)) {
     return fit;
   }
+  return FitShiftFromSums([&](double e) { return Sums(profile, e, sigma_px); },
+                          profile.offsets.size(), iterations, max_shift_px);
+}
+
+EdgeProfileFit FitShiftFromSums(
+    const std::function<EdgeProfileSums(double)>& sums_at, size_t samples,
+    int iterations, double max_shift_px) {
+  EdgeProfileFit fit;
   double e = 0;
   Eigen::Vector3d levels = Eigen::Vector3d::Zero();
   double sse = 0;
   for (int it = 0;; ++it) {
-    const ProfileSums s = Sums(profile, e, sigma_px);
+    const EdgeProfileSums s = sums_at(e);
     levels = s.B.ldlt().solve(s.bv);
     sse = s.vv - 2 * levels.dot(s.bv) + levels.dot(s.B * levels);
     if (it == iterations) break;
@@ -236,7 +233,7 @@ EdgeProfileFit FitEdgeProfile(const EdgeProfile& profile,
   }
   fit.shift_px = e;
   fit.levels = {levels(0), levels(1), levels(2)};
-  fit.rms = std::sqrt(std::max(0.0, sse) / profile.offsets.size());
+  fit.rms = std::sqrt(std::max(0.0, sse) / samples);
   fit.ok = std::isfinite(e) && std::abs(levels(1) - levels(0)) >= 5.0;
   return fit;
 }

@@ -22,6 +22,7 @@
 
 #include <Eigen/Core>
 #include <array>
+#include <functional>
 #include <vector>
 
 namespace kincal {
@@ -83,6 +84,29 @@ EdgeProfileFit FitEdgeProfile(const EdgeProfile& profile, double sigma_px,
 EdgeProfileFit FitEdgeProfile(const EdgeProfile& profile,
                               const PhaseSigmas& sigma_px, int iterations = 6,
                               double max_shift_px = 2.0);
+
+// A model's sums over a profile's samples at shift e, from which the
+// levels L and the Gauss-Newton step on e follow (b: the basis of the
+// three classes at a sample, db its derivative in e, v the sample):
+// B = sum b b^T (plus a tiny ridge for classes the profile does not
+// reach), D = sum db b^T, DD = sum db db^T, bv = sum b v, dv = sum db v,
+// vv = sum v^2. Then B L = bv, and with r = v - b.L, j = -db.L:
+// SSE = vv - 2 L.bv + L^T B L, sum j j = L^T DD L, sum j r = -L.dv + L^T D L.
+struct EdgeProfileSums {
+  Eigen::Matrix3d B = Eigen::Matrix3d::Zero(), D = Eigen::Matrix3d::Zero(),
+                  DD = Eigen::Matrix3d::Zero();
+  Eigen::Vector3d bv = Eigen::Vector3d::Zero(), dv = Eigen::Vector3d::Zero();
+  double vv = 0;
+};
+
+// The shift e by Gauss-Newton from 0 with the levels projected out, for any
+// model whose sums at e `sums_at` gives (FitEdgeProfile's, or a demosaic's,
+// vision/demosaic_model.h): each step clamped to +-0.5 px, at most
+// `iterations` steps, not ok when e leaves +-max_shift_px or the black and
+// white levels are less than 5 apart; rms over `samples` samples.
+EdgeProfileFit FitShiftFromSums(
+    const std::function<EdgeProfileSums(double)>& sums_at, size_t samples,
+    int iterations, double max_shift_px);
 
 // The area rule on the profile's samples (linearly interpolated) over
 // [centre - w, centre + w]: edge = centre + w - integral (v - inside) /
