@@ -620,6 +620,27 @@ std::array<PhaseSigmas, 4> SidesBlur(const std::array<SideProfiles, 4>& sides,
   return sigma;
 }
 
+// The cell of quad `c` (its shortest side over the `cells` across it), 0
+// when the quad is too small to refine (a side under 8 px or cells under
+// 1.5 px).
+double RefinableCell(const std::array<Eigen::Vector2d, 4>& c, int cells) {
+  double shortest = 1e9;
+  for (int j = 0; j < 4; ++j) {
+    shortest = std::min(shortest, (c[(j + 1) % 4] - c[j]).norm());
+  }
+  const double cell = shortest / cells;
+  return shortest < 8.0 || cell < 1.5 ? 0.0 : cell;
+}
+
+// The outward unit normal of side k (corner k to k + 1) of quad `c`.
+Eigen::Vector2d OutwardNormal(const std::array<Eigen::Vector2d, 4>& c, int k) {
+  const Eigen::Vector2d a = c[k], b = c[(k + 1) % 4];
+  const Eigen::Vector2d dir = (b - a).normalized();
+  const Eigen::Vector2d centroid = (c[0] + c[1] + c[2] + c[3]) / 4.0;
+  Eigen::Vector2d n(-dir.y(), dir.x());
+  return n.dot((a + b) / 2 - centroid) < 0 ? Eigen::Vector2d(-n) : n;
+}
+
 // Whether a side of blur sigma and cells of `cell` px takes the area rule
 // (FitSide): sharp (sigma < 0.8 px) with its neighbouring edges 2.5 sigma
 // clear of the rule's window of +-min(0.45 cell, 3 px).
@@ -765,20 +786,13 @@ bool RefineCornersByEdges(const cv::Mat& gray, const cv::Mat& tag_image,
   std::array<PhaseSigmas, 4> sigma{};
   for (int pass = 0; pass < 2; ++pass) {
     PatternView view{&tag_image, ImageFromTemplate(c, start, cells).inverse()};
-    const Eigen::Vector2d centroid = (c[0] + c[1] + c[2] + c[3]) / 4.0;
-    double shortest = 1e9;
-    for (int j = 0; j < 4; ++j) {
-      shortest = std::min(shortest, (c[(j + 1) % 4] - c[j]).norm());
-    }
-    const double cell = shortest / cells;
-    if (shortest < 8.0 || cell < 1.5) return false;
+    const double cell = RefinableCell(c, cells);
+    if (cell == 0) return false;
     std::array<SideProfiles, 4> sides;
     std::array<Eigen::Vector2d, 4> normals;
     for (int k = 0; k < 4; ++k) {
       const Eigen::Vector2d a = c[k], b = c[(k + 1) % 4];
-      const Eigen::Vector2d dir = (b - a).normalized();
-      Eigen::Vector2d n(-dir.y(), dir.x());
-      if (n.dot((a + b) / 2 - centroid) < 0) n = -n;
+      const Eigen::Vector2d n = OutwardNormal(c, k);
       normals[k] = n;
       // The blur along side k: the blur across its neighbours. Sides that
       // take the area rule keep their own line's pattern (the rule, exact
@@ -839,22 +853,14 @@ bool DemosaicedSides(const cv::Mat& gray, const cv::Mat& tag_image, int cells,
                      std::array<Eigen::Vector2d, 4>* normals) {
   const double start = 0.5 * (tag_image.cols - cells);
   PatternView view{&tag_image, ImageFromTemplate(c, start, cells).inverse()};
-  const Eigen::Vector2d centroid = (c[0] + c[1] + c[2] + c[3]) / 4.0;
-  double shortest = 1e9;
-  for (int j = 0; j < 4; ++j) {
-    shortest = std::min(shortest, (c[(j + 1) % 4] - c[j]).norm());
-  }
-  const double cell = shortest / cells;
-  if (shortest < 8.0 || cell < 1.5) return false;
+  const double cell = RefinableCell(c, cells);
+  if (cell == 0) return false;
   for (int k = 0; k < 4; ++k) {
     const Eigen::Vector2d a = c[k], b = c[(k + 1) % 4];
-    const Eigen::Vector2d dir = (b - a).normalized();
-    Eigen::Vector2d n(-dir.y(), dir.x());
-    if (n.dot((a + b) / 2 - centroid) < 0) n = -n;
+    const Eigen::Vector2d n = OutwardNormal(c, k);
     (*normals)[k] = n;
-    (*sides)[k] =
-        ProfilesOfSide(gray, view, a, b, n, cell, cells, 1.0, 0.0, others,
-                       true);
+    (*sides)[k] = ProfilesOfSide(gray, view, a, b, n, cell, cells, 1.0, 0.0,
+                                 others, true);
   }
   return true;
 }
