@@ -252,19 +252,16 @@ BayerPattern ChooseBayerPattern(const std::string& option,
   }
   if (!option.empty()) {
     const BayerPattern given = ParseBayerPattern(option);
-    const std::string as_recorded = recorded.empty() ? "NONE" : recorded;
+    // A session.yaml without a pattern says nothing (recorded elsewhere,
+    // or before capture recorded it): --bayer then stands alone.
     std::string upper = option;
     for (char& ch : upper) ch = static_cast<char>(std::toupper(ch));
-    if (!session_mosaics.empty() && upper != as_recorded) {
-      warnings->Add(
-          "bayer_differs_from_session",
-          "--bayer " + option + " overrides " + session_dir +
-              "/session.yaml, which records " +
-              (recorded.empty() ? std::string("no raw mosaic (gray or "
-                                              "demosaiced images)")
-                                : "raw " + recorded + " mosaics") +
-              "; if the images were recorded by kincal capture, drop "
-              "--bayer");
+    if (!recorded.empty() && upper != recorded) {
+      warnings->Add("bayer_differs_from_session",
+                    "--bayer " + option + " overrides " + session_dir +
+                        "/session.yaml, which records raw " + recorded +
+                        " mosaics (sources.<camera>.mosaic); if capture "
+                        "recorded these images, drop --bayer");
     }
     return given;
   }

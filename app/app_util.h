@@ -125,7 +125,8 @@ CLI::Option* AddBayerOption(CLI::App* sub, std::string* pattern);
 // (`session_mosaics`, Session::mosaics: `capture` with bayer=raw writes
 // it), said on stderr; none when it records none. InputError when the
 // cameras record different patterns (one pattern is read for all); the
-// warning `bayer_differs_from_session` when --bayer contradicts it.
+// warning `bayer_differs_from_session` when --bayer contradicts a pattern
+// it records (a session.yaml without one says nothing either way).
 BayerPattern ChooseBayerPattern(const std::string& option,
                                 const std::vector<std::string>& session_mosaics,
                                 const std::string& session_dir,

@@ -269,6 +269,21 @@ TEST(RenderPipelineTest, RawBayerMosaicTrackedWithItsPattern) {
   r = RunKincal(track + " --bayer RGB");
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_NE(r.err.find("expected RGGB"), std::string::npos) << r.err;
+
+  // A session.yaml without the pattern (recorded elsewhere) says nothing:
+  // --bayer alone decides, without a warning; without --bayer the mosaic is
+  // read as gray and track says the images look like one.
+  const std::string yaml_path = dir + "/s/session/session.yaml";
+  const std::string yaml = ReadFile(yaml_path);
+  ASSERT_NE(yaml.find("sources:"), std::string::npos);
+  WriteFileAtomic(yaml_path, yaml.substr(0, yaml.find("sources:")));
+  r = RunKincal(track + " --bayer RGGB");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_FALSE(nlohmann::json::parse(r.out).contains("warnings")) << r.out;
+  r = RunKincal(track);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_TRUE(warned(nlohmann::json::parse(r.out), "images_look_raw_bayer"))
+      << r.out;
 }
 
 }  // namespace kincal::testing
