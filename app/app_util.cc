@@ -3,7 +3,6 @@
 #include <sys/stat.h>
 
 #include <algorithm>
-#include <cctype>
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
@@ -254,9 +253,7 @@ BayerPattern ChooseBayerPattern(const std::string& option,
     const BayerPattern given = ParseBayerPattern(option);
     // A session.yaml without a pattern says nothing (recorded elsewhere,
     // or before capture recorded it): --bayer then stands alone.
-    std::string upper = option;
-    for (char& ch : upper) ch = static_cast<char>(std::toupper(ch));
-    if (!recorded.empty() && upper != recorded) {
+    if (!recorded.empty() && given != ParseBayerPattern(recorded)) {
       warnings->Add("bayer_differs_from_session",
                     "--bayer " + option + " overrides " + session_dir +
                         "/session.yaml, which records raw " + recorded +

@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "data/error.h"
+#include "data/session.h"
 
 namespace kincal::capture {
 namespace {
@@ -136,7 +137,7 @@ bool KeepsMosaic(const SourceUri& uri) {
 
 std::string DeclaredMosaic(const SourceUri& uri) {
   const std::string m = uri.GetString("mosaic", "");
-  if (!m.empty() && m != "RGGB" && m != "GRBG" && m != "GBRG" && m != "BGGR") {
+  if (!m.empty() && !IsMosaicPattern(m)) {
     throw InputError("source '" + uri.text + "': mosaic=" + m +
                      ": expected RGGB, GRBG, GBRG or BGGR (the top-left 2x2 "
                      "cell row by row; GenICam BayerRG8 = RGGB)");

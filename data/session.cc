@@ -353,7 +353,7 @@ std::map<std::string, std::string> ReadSourceMosaics(const YamlReader& reader,
     if (!source.IsMap() || !source["mosaic"]) continue;
     const YAML::Node node = source["mosaic"];
     const std::string m = reader.String(node, "mosaic");
-    if (m != "RGGB" && m != "GRBG" && m != "GBRG" && m != "BGGR") {
+    if (!IsMosaicPattern(m)) {
       reader.Fail(node, "sources." + entry.first.as<std::string>() +
                             ".mosaic: expected RGGB, GRBG, GBRG or BGGR (the "
                             "raw mosaic's top-left 2x2 cell), got '" +
@@ -554,6 +554,10 @@ Session ReadSession(const std::string& dir_in,
   if (!PairImagesInOrder(images, &s)) PairImagesByNumber(images, partial, &s);
   RequireJointReadings(options, s);
   return s;
+}
+
+bool IsMosaicPattern(const std::string& name) {
+  return name == "RGGB" || name == "GRBG" || name == "GBRG" || name == "BGGR";
 }
 
 std::string SessionFramesHeader(const std::vector<std::string>& cameras,

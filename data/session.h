@@ -39,6 +39,11 @@
 
 namespace kincal {
 
+// Whether `name` names a raw mosaic's pattern as session.yaml records it
+// (sources.<camera>.mosaic): RGGB, GRBG, GBRG or BGGR, the top-left 2x2
+// cell row by row.
+bool IsMosaicPattern(const std::string& name);
+
 struct SessionFrame {
   int frame = 0;  // the `frame` column
   // Per camera, in Session::cameras order: time (s; 0 = unknown), the

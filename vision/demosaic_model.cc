@@ -53,15 +53,9 @@ EdgeProfileSums Sums(const EdgeProfile& p, const std::array<double, 9>& delta,
       b += w[t] * bt;
       db += w[t] * dbt;
     }
-    const double v = p.values[i];
-    s.B.noalias() += b * b.transpose();
-    s.D.noalias() += db * b.transpose();
-    s.DD.noalias() += db * db.transpose();
-    s.bv += b * v;
-    s.dv += db * v;
-    s.vv += v * v;
+    s.Add(b, db, p.values[i]);
   }
-  s.B += Eigen::Matrix3d::Identity() * 1e-6;  // classes out of reach
+  s.AddRidge();  // classes out of reach
   return s;
 }
 

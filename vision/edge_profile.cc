@@ -104,16 +104,9 @@ EdgeProfileSums Sums(const EdgeProfile& p, double e, const PhaseSigmas& sigma) {
   const bool phased = p.phases.size() == p.offsets.size();
   for (size_t i = 0; i < p.offsets.size(); ++i) {
     Basis(p, p.offsets[i], e, sigma[phased ? p.phases[i] : 0], &b, &db);
-    const double v = p.values[i];
-    s.B.noalias() += b * b.transpose();
-    s.D.noalias() += db * b.transpose();
-    s.DD.noalias() += db * db.transpose();
-    s.bv += b * v;
-    s.dv += db * v;
-    s.vv += v * v;
+    s.Add(b, db, p.values[i]);
   }
-  // A tiny ridge for classes the profile does not reach.
-  s.B += Eigen::Matrix3d::Identity() * 1e-6;
+  s.AddRidge();  // classes the profile does not reach
   return s;
 }
 

@@ -97,6 +97,18 @@ struct EdgeProfileSums {
                   DD = Eigen::Matrix3d::Zero();
   Eigen::Vector3d bv = Eigen::Vector3d::Zero(), dv = Eigen::Vector3d::Zero();
   double vv = 0;
+
+  // One sample: its basis b, db/de and value v.
+  void Add(const Eigen::Vector3d& b, const Eigen::Vector3d& db, double v) {
+    B.noalias() += b * b.transpose();
+    D.noalias() += db * b.transpose();
+    DD.noalias() += db * db.transpose();
+    bv += b * v;
+    dv += db * v;
+    vv += v * v;
+  }
+  // The tiny ridge, after the last sample.
+  void AddRidge() { B += Eigen::Matrix3d::Identity() * 1e-6; }
 };
 
 // The shift e by Gauss-Newton from 0 with the levels projected out, for any
