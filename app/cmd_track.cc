@@ -294,7 +294,9 @@ Tracked TrackFrames(const TrackArgs& args, const Rig& rig, const Target& target,
   const BayerPattern bayer = ParseBayerPattern(args.bayer);
   std::vector<std::unique_ptr<TagTracker>> trackers;
   for (int c = 0; c < nc; ++c) {
-    trackers.push_back(std::make_unique<TagTracker>(topt));
+    TrackerOptions camera_options = topt;
+    camera_options.detector.lens = rig.cameras[c].intrinsics;
+    trackers.push_back(std::make_unique<TagTracker>(camera_options));
   }
 
   const size_t n = pairs.size();

@@ -7,10 +7,12 @@
 // fit keeps (what the bundle takes).
 //
 //   build/bin/session_corners_bench --session S/session --rig S/rig.yaml
-//       --target S/target.yaml [--bayer RGGB] [--fit-demosaic 0]
+//       --target S/target.yaml [--bayer RGGB] [--fit-demosaic 0] [--lens 0]
 // (--bayer: the images are raw mosaics, balanced to gray as track and
 // bundle --bayer do; --fit-demosaic 0: demosaiced images take the blur per
-// phase, not the linear demosaic's model, AprilTagOptions::fit_demosaic.)
+// phase, not the linear demosaic's model, AprilTagOptions::fit_demosaic;
+// --lens 0: the sides' lines fitted in the distorted image, not in the
+// rig camera's pinhole image, AprilTagOptions::lens.)
 
 #include <algorithm>
 #include <cmath>
@@ -80,7 +82,8 @@ std::map<Key, Eigen::Vector2d> ReadCorners(const std::string& path) {
 }
 
 int Run(const std::string& session_dir, const std::string& rig_path,
-        const std::string& target_path, BayerPattern bayer, bool fit_demosaic) {
+        const std::string& target_path, BayerPattern bayer, bool fit_demosaic,
+        bool lens) {
   const Rig rig = ReadRigYaml(rig_path);
   const Target target = ReadTargetYaml(target_path);
   SessionReadOptions ro;
@@ -90,7 +93,12 @@ int Run(const std::string& session_dir, const std::string& rig_path,
   AprilTagOptions dopt;
   dopt.family = target.family;
   dopt.fit_demosaic = fit_demosaic;
-  AprilTagDetector detector(dopt);
+  Rig lenses = rig;
+  if (!lens) {
+    for (Camera& c : lenses.cameras) c.intrinsics.distortion.clear();
+  }
+  const std::vector<std::unique_ptr<AprilTagDetector>> detectors =
+      CameraDetectors(lenses, dopt);
   std::map<std::string, Stat> stats;
   std::vector<double> phase_ratios;
   for (const SessionFrame& sf : session.frames) {
@@ -98,7 +106,7 @@ int Run(const std::string& session_dir, const std::string& rig_path,
     for (size_t c = 0; c < rig.cameras.size(); ++c) {
       const cv::Mat image =
           ReadCameraImage(sf.images[c], rig.cameras[c].intrinsics, bayer);
-      dets[c] = detector.Detect(image);
+      dets[c] = detectors[c]->Detect(image);
       if (!dets[c].empty()) {
         phase_ratios.push_back(PhaseSharpnessRatio(image, dets[c]));
       }
@@ -175,7 +183,7 @@ int Run(const std::string& session_dir, const std::string& rig_path,
 
 int main(int argc, char** argv) {
   std::string session, rig, target, bayer = "none";
-  bool fit_demosaic = true;
+  bool fit_demosaic = true, lens = true;
   for (int i = 1; i + 1 < argc; i += 2) {
     if (!std::strcmp(argv[i], "--session")) session = argv[i + 1];
     if (!std::strcmp(argv[i], "--rig")) rig = argv[i + 1];
@@ -184,13 +192,15 @@ int main(int argc, char** argv) {
     if (!std::strcmp(argv[i], "--fit-demosaic")) {
       fit_demosaic = std::strcmp(argv[i + 1], "0") != 0;
     }
+    if (!std::strcmp(argv[i], "--lens")) lens = std::strcmp(argv[i + 1], "0");
   }
   if (session.empty() || rig.empty() || target.empty()) {
     std::fprintf(stderr,
                  "usage: session_corners_bench --session DIR --rig RIG.yaml "
-                 "--target TARGET.yaml [--bayer RGGB] [--fit-demosaic 0]\n");
+                 "--target TARGET.yaml [--bayer RGGB] [--fit-demosaic 0] "
+                 "[--lens 0]\n");
     return 2;
   }
   return kincal::Run(session, rig, target, kincal::ParseBayerPattern(bayer),
-                     fit_demosaic);
+                     fit_demosaic, lens);
 }

@@ -158,7 +158,10 @@ void BM_TrackStereo(benchmark::State& state) {
   const Sequence& seq = GetSequence();
   TrackerOptions o;
   o.enabled = state.range(0) != 0;
-  TagTracker left(o), right(o);
+  TrackerOptions left_options = o, right_options = o;
+  left_options.detector.lens = scene.rig.cameras[0].intrinsics;
+  right_options.detector.lens = scene.rig.cameras[1].intrinsics;
+  TagTracker left(left_options), right(right_options);
   size_t i = 0;
   int found = 0;
   for (auto _ : state) {

@@ -24,10 +24,8 @@ SessionObservations ObserveSession(const Session& session, const Rig& rig,
   AprilTagOptions dopt = options.detector;
   dopt.family = target.family;
   dopt.Check();
-  std::vector<std::unique_ptr<AprilTagDetector>> detectors;
-  for (int c = 0; c < nc; ++c) {
-    detectors.push_back(std::make_unique<AprilTagDetector>(dopt));
-  }
+  const std::vector<std::unique_ptr<AprilTagDetector>> detectors =
+      CameraDetectors(rig, dopt);
   int done = 0;
   const int total = session.CountWithJoints();
   for (const SessionFrame& sf : session.frames) {

@@ -142,6 +142,22 @@ inline Eigen::Vector2d Project(const CameraIntrinsics& cam,
 Eigen::Vector2d UndistortPixel(const CameraIntrinsics& cam,
                                const Eigen::Vector2d& pixel);
 
+// The pixel of `cam` without its distortion (the ideal pinhole image,
+// fx, fy, cx, cy kept), where straight lines in space are straight:
+// K * UndistortPixel(cam, pixel).
+inline Eigen::Vector2d PinholePixel(const CameraIntrinsics& cam,
+                                    const Eigen::Vector2d& pixel) {
+  const Eigen::Vector2d xy = UndistortPixel(cam, pixel);
+  return Eigen::Vector2d(cam.fx * xy.x() + cam.cx, cam.fy * xy.y() + cam.cy);
+}
+
+// Inverse of PinholePixel: the distorted pixel of a pinhole pixel.
+inline Eigen::Vector2d DistortedPixel(const CameraIntrinsics& cam,
+                                      const Eigen::Vector2d& pinhole) {
+  return Project(cam, Eigen::Vector3d((pinhole.x() - cam.cx) / cam.fx,
+                                      (pinhole.y() - cam.cy) / cam.fy, 1.0));
+}
+
 // The unit-length ray in `cam` through `pixel` (z > 0).
 inline Eigen::Vector3d Unproject(const CameraIntrinsics& cam,
                                  const Eigen::Vector2d& pixel) {

@@ -91,6 +91,27 @@ TEST_P(ProjectVsOpenCV, UndistortMatchesOpenCV) {
   }
 }
 
+// The pinhole image is OpenCV's undistorted image with the same K, and
+// DistortedPixel inverts PinholePixel.
+TEST_P(ProjectVsOpenCV, PinholePixelIsOpenCVsUndistortedPixel) {
+  const CameraIntrinsics cam = MakeCamera(GetParam());
+  const std::vector<cv::Point2d> px = {
+      {10, 12}, {640, 512}, {1200, 1000}, {300, 800}};
+  std::vector<cv::Point2d> und;
+  const cv::Mat K =
+      (cv::Mat_<double>(3, 3) << cam.fx, 0, cam.cx, 0, cam.fy, cam.cy, 0, 0, 1);
+  cv::undistortPoints(px, und, K, cv::Mat(cam.distortion, true), cv::noArray(),
+                      K, cv::TermCriteria(cv::TermCriteria::COUNT, 200, 0));
+  for (size_t i = 0; i < px.size(); ++i) {
+    const Eigen::Vector2d pinhole = PinholePixel(cam, {px[i].x, px[i].y});
+    EXPECT_NEAR(pinhole.x(), und[i].x, 1e-4);
+    EXPECT_NEAR(pinhole.y(), und[i].y, 1e-4);
+    const Eigen::Vector2d back = DistortedPixel(cam, pinhole);
+    EXPECT_NEAR(back.x(), px[i].x, 1e-6);
+    EXPECT_NEAR(back.y(), px[i].y, 1e-6);
+  }
+}
+
 INSTANTIATE_TEST_SUITE_P(Distortion, ProjectVsOpenCV,
                          ::testing::Values(0, 4, 5, 8));
 

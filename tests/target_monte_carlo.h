@@ -123,7 +123,8 @@ inline std::vector<LayoutFrame> RenderAndDetect(
   const StereoRenderer renderer(rig, target, options);
   AprilTagOptions detector_options;
   detector_options.family = target.family;
-  AprilTagDetector detector(detector_options);
+  const std::vector<std::unique_ptr<AprilTagDetector>> detectors =
+      CameraDetectors(rig, detector_options);
   std::vector<LayoutFrame> frames;
   for (size_t i = 0; i < poses.size(); ++i) {
     const StereoFrameTruth truth = renderer.Render(poses[i], rng);
@@ -131,7 +132,8 @@ inline std::vector<LayoutFrame> RenderAndDetect(
     f.frame = static_cast<int>(i);
     if (truth_corners) truth_corners->emplace_back();
     for (const ViewTruth& view : truth.views) {
-      f.detections.push_back(detector.Detect(view.image));
+      f.detections.push_back(
+          detectors[f.detections.size()]->Detect(view.image));
       if (truth_corners) truth_corners->back().emplace_back();
       for (const TagDetection& d : f.detections.back()) {
         std::array<Eigen::Vector2d, 4> nan;

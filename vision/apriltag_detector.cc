@@ -205,6 +205,20 @@ double PhaseSharpnessRatio(const cv::Mat& gray,
   return lo > 0 ? hi / lo : 1.0;
 }
 
+// The lens whose pinhole image the sides are fitted in: options.lens when
+// it has distortion (nullptr otherwise: the image is its own pinhole image).
+namespace {
+
+const CameraIntrinsics* DistortingLens(const AprilTagOptions& options) {
+  if (!options.lens) return nullptr;
+  for (double k : options.lens->distortion) {
+    if (k != 0) return &*options.lens;
+  }
+  return nullptr;
+}
+
+}  // namespace
+
 // Each detection refined with the others' quads known (its sampling skips
 // them), then checked corner by corner against libapriltag's.
 void AprilTagDetector::RefineByEdges(const cv::Mat& gray,
@@ -230,7 +244,8 @@ void AprilTagDetector::RefineByEdges(const cv::Mat& gray,
       }
     }
     if (!RefineCornersByEdges(gray, Pattern(t.id), cells, &t, others, phased,
-                              linear_demosaic ? &kernels : nullptr)) {
+                              linear_demosaic ? &kernels : nullptr,
+                              DistortingLens(options_))) {
       continue;
     }
     const TagDetection judged = t;  // every corner against the refined ones
@@ -251,6 +266,17 @@ void AprilTagDetector::RefineByEdges(const cv::Mat& gray,
   }
 }
 
+std::vector<std::unique_ptr<AprilTagDetector>> CameraDetectors(
+    const Rig& rig, const AprilTagOptions& options) {
+  std::vector<std::unique_ptr<AprilTagDetector>> detectors;
+  for (const Camera& camera : rig.cameras) {
+    AprilTagOptions o = options;
+    o.lens = camera.intrinsics;
+    detectors.push_back(std::make_unique<AprilTagDetector>(o));
+  }
+  return detectors;
+}
+
 std::vector<TagDetection> AprilTagDetector::Detect(const cv::Mat& gray) {
   return DetectInRegion(gray, cv::Rect(0, 0, gray.cols, gray.rows));
 }
@@ -259,6 +285,16 @@ std::vector<TagDetection> AprilTagDetector::DetectInRegion(const cv::Mat& gray,
                                                            cv::Rect roi) {
   if (gray.type() != CV_8UC1) {
     throw InputError("apriltag detector: expected an 8-bit gray image");
+  }
+  const std::optional<CameraIntrinsics>& lens = options_.lens;
+  if (lens && lens->width > 0 &&
+      (lens->width != gray.cols || lens->height != gray.rows)) {
+    std::ostringstream os;
+    os << "apriltag detector: the image is " << gray.cols << "x" << gray.rows
+       << " px, camera '" << lens->name << "' " << lens->width << "x"
+       << lens->height << ": the image is not that camera's (check the "
+       << "rig's camera order and resolution)";
+    throw InputError(os.str());
   }
   roi &= cv::Rect(0, 0, gray.cols, gray.rows);
   std::vector<TagDetection> out;
@@ -670,7 +706,7 @@ std::array<PhaseSigmas, 4> DemosaicedSidesBlur(
 // the blur sigmas[0].
 bool FitSide(const cv::Mat& gray, const SideProfiles& side,
              const Eigen::Vector2d& n, const PhaseSigmas& sigmas, bool phased,
-             Line2* line, TagSideQuality* quality,
+             const CameraIntrinsics* lens, Line2* line, TagSideQuality* quality,
              const DemosaicKernels* demosaic = nullptr) {
   const double sigma = sigmas[0];
   std::vector<Eigen::Vector2d> pts;
@@ -732,6 +768,10 @@ bool FitSide(const cv::Mat& gray, const SideProfiles& side,
     fit_rms.push_back(f.rms);
   }
   if (pts.size() < 4) return false;
+  // Where the side is straight: the lens's pinhole image.
+  if (lens) {
+    for (Eigen::Vector2d& q : pts) q = PinholePixel(*lens, q);
+  }
   *line = FitLine(pts);
   // Drop points far from the line (another edge, a glint) and refit.
   std::vector<double> res;
@@ -779,7 +819,8 @@ bool FitSide(const cv::Mat& gray, const SideProfiles& side,
 bool RefineCornersByEdges(const cv::Mat& gray, const cv::Mat& tag_image,
                           int cells, TagDetection* det,
                           const std::vector<NeighbourTag>& others, bool phased,
-                          const DemosaicKernels* demosaic) {
+                          const DemosaicKernels* demosaic,
+                          const CameraIntrinsics* lens) {
   const double start = 0.5 * (tag_image.cols - cells);
   std::array<Eigen::Vector2d, 4> c = det->corners;
   std::array<TagSideQuality, 4> quality{};
@@ -816,8 +857,8 @@ bool RefineCornersByEdges(const cv::Mat& gray, const cv::Mat& tag_image,
     }
     std::array<Line2, 4> lines;
     for (int k = 0; k < 4; ++k) {
-      if (!FitSide(gray, sides[k], normals[k], sigma[k], phased, &lines[k],
-                   &quality[k], phased ? demosaic : nullptr)) {
+      if (!FitSide(gray, sides[k], normals[k], sigma[k], phased, lens,
+                   &lines[k], &quality[k], phased ? demosaic : nullptr)) {
         return false;
       }
     }
@@ -825,7 +866,8 @@ bool RefineCornersByEdges(const cv::Mat& gray, const cv::Mat& tag_image,
     for (int k = 0; k < 4; ++k) {
       // Corner k joins side k-1 (from corner k-1 to k) and side k.
       if (!Intersect(lines[(k + 3) % 4], lines[k], &refined[k])) return false;
-      if ((refined[k] - det->corners[k]).norm() > 3.0) return false;
+      if (lens) refined[k] = DistortedPixel(*lens, refined[k]);
+      if (!((refined[k] - det->corners[k]).norm() <= 3.0)) return false;
     }
     c = refined;
   }

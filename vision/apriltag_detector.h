@@ -21,9 +21,12 @@
 #include <array>
 #include <memory>
 #include <opencv2/core.hpp>
+#include <optional>
 #include <string>
 #include <vector>
 
+#include "camcal/camera_model.h"
+#include "camcal/rig.h"
 #include "vision/demosaic_model.h"
 
 namespace kincal {
@@ -127,6 +130,17 @@ struct AprilTagOptions {
   // is below the blur per phase's, else the blur per phase does (another
   // demosaic: VNG, edge-aware). false: the blur per phase always.
   bool fit_demosaic = true;
+  // The camera whose images are searched (optional). Its lens distortion
+  // bends a tag's straight sides in the image, and lines fitted there meet
+  // off the corners: a side of L px at normalized radius r bends by about
+  // 6 |k1| r L^2 / (8 f) px, 0.03 px for a 40 px side at r = 0.2 with
+  // k1 = -0.12 and f = 900 px, and the bias follows the tag across the
+  // image. With the lens, each side's edge points are mapped to the pinhole
+  // image (PinholePixel), where the sides are straight, the lines fitted and
+  // intersected there and the corners distorted back. Its size must be the
+  // images'. Without it (or without distortion) the lines are fitted in the
+  // image.
+  std::optional<CameraIntrinsics> lens;
 
   // Throws InputError naming the bad option and its value.
   void Check() const;
@@ -168,6 +182,11 @@ class AprilTagDetector {
   std::unique_ptr<Impl> impl_;
 };
 
+// One detector per camera of `rig` (each used by one thread at a time),
+// `options` with that camera as its lens (AprilTagOptions::lens).
+std::vector<std::unique_ptr<AprilTagDetector>> CameraDetectors(
+    const Rig& rig, const AprilTagOptions& options);
+
 // Refines the corners of one detection in place by the pattern model of
 // vision/edge_profile.h (exposed for tests and the bench): `tag_image` is
 // TagImage(family, det->id), `cells` the family's cells across the detected
@@ -182,11 +201,14 @@ class AprilTagDetector {
 // edge points); fills det->sides otherwise.
 // `demosaic` (with `phased`): the linear demosaic's kernels
 // (FitTagsDemosaic) replace the blur per phase, one blur per side pair.
+// `lens` (optional): the lines are fitted in its pinhole image
+// (AprilTagOptions::lens).
 bool RefineCornersByEdges(const cv::Mat& gray, const cv::Mat& tag_image,
                           int cells, TagDetection* det,
                           const std::vector<NeighbourTag>& others = {},
                           bool phased = false,
-                          const DemosaicKernels* demosaic = nullptr);
+                          const DemosaicKernels* demosaic = nullptr,
+                          const CameraIntrinsics* lens = nullptr);
 
 // For a demosaiced image: the bilinear demosaic (FitBilinearDemosaic) that
 // fits the sides of up to `max_tags` of the largest detections (`tag_images`

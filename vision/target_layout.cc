@@ -1027,10 +1027,8 @@ std::vector<LayoutFrame> DetectSessionTags(
                      " cameras, the rig " + std::to_string(nc));
   }
   detector.Check();
-  std::vector<std::unique_ptr<AprilTagDetector>> detectors;
-  for (int c = 0; c < nc; ++c) {
-    detectors.push_back(std::make_unique<AprilTagDetector>(detector));
-  }
+  const std::vector<std::unique_ptr<AprilTagDetector>> detectors =
+      CameraDetectors(rig, detector);
   std::vector<LayoutFrame> frames;
   const int total = static_cast<int>(session.frames.size());
   for (const SessionFrame& sf : session.frames) {
