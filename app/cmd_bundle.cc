@@ -49,6 +49,8 @@ struct BundleArgs {
   // Raw mosaic pattern of the images; empty: session.yaml's, else none
   // (ChooseBayerPattern).
   std::string bayer;
+  // Corners' weights from their tags' contrast (ObserveOptions).
+  double full_weight_contrast = ObserveOptions().full_weight_contrast;
   bool json = false, quiet = false;
 };
 
@@ -424,6 +426,7 @@ int RunBundleCommand(BundleArgs args) {
 
   BundleRun run;
   ObserveOptions oo;
+  oo.full_weight_contrast = args.full_weight_contrast;
   oo.bayer =
       ChooseBayerPattern(args.bayer, session.mosaics, args.session, &warnings);
   oo.progress = [&progress](int done, int total) {
@@ -523,6 +526,13 @@ void AddBundleCommand(CLI::App& app, Runner* run) {
                   "drop single corners farther than this many sigma of the "
                   "corners' noise after a first fit (at least 0.2 px); 0 = "
                   "keep every corner of a kept tag (JSON dropped_corners)")
+      ->capture_default_str()
+      ->check(CLI::NonNegativeNumber);
+  sub->add_option("--weight-contrast", args->full_weight_contrast,
+                  "corners of tags whose weakest side's contrast is below "
+                  "this many gray levels weigh contrast / this (at least "
+                  "0.1): a dim tag's corners err more; 0 = every corner "
+                  "alike")
       ->capture_default_str()
       ->check(CLI::NonNegativeNumber);
   sub->add_flag("--refine-cameras", args->options.refine_cameras,

@@ -45,11 +45,12 @@ struct State {
 };
 
 // All corners of one frame f (every camera c), 2 residuals per corner i:
-//   e_i = ProjectPoint(intrinsics_c, cam_from_rig_c * A * M(q_f) * B * X_i)
-//         - u_i
+//   e_i = w_i (ProjectPoint(intrinsics_c, cam_from_rig_c * A * M(q_f) * B
+//         * X_i) - u_i)
 // with A, M, B as in bundle.h: on a stand A = rig_from_base, M =
 // base_from_flange, B = flange_from_tool; on the flange A = rig_from_flange,
-// M = flange_from_base = base_from_flange^-1, B = base_from_target;
+// M = flange_from_base = base_from_flange^-1, B = base_from_target; w_i the
+// corner's weight (BundleCorner::weight);
 //   r_i = e_i                                 if |e_i| <= h
 //   r_i = e_i * sqrt(2 h |e_i| - h^2) / |e_i|  otherwise (h = huber_px),
 // so |r_i|^2 = rho(|e_i|^2), Huber's loss per corner, and the frame's cost
@@ -62,7 +63,7 @@ class FrameCost {
             bool flange, int num_cameras,
             std::vector<Eigen::Vector3d> points_in_tool,
             std::vector<int> cameras, std::vector<Eigen::Vector2d> pixels,
-            double huber_px)
+            std::vector<double> weights, double huber_px)
       : chain_(chain),
         input_(input),
         with_errors_(with_errors),
@@ -71,6 +72,7 @@ class FrameCost {
         points_(std::move(points_in_tool)),
         cameras_(std::move(cameras)),
         pixels_(std::move(pixels)),
+        weights_(std::move(weights)),
         huber_(huber_px) {}
 
   // The cost function over `block_sizes` (the layout below), 2 residuals per
@@ -79,12 +81,13 @@ class FrameCost {
       const Chain* chain, const PoseInput* input, bool with_errors, bool flange,
       int num_cameras, const std::vector<int>& block_sizes,
       std::vector<Eigen::Vector3d> points_in_tool, std::vector<int> cameras,
-      std::vector<Eigen::Vector2d> pixels, double huber_px) {
+      std::vector<Eigen::Vector2d> pixels, std::vector<double> weights,
+      double huber_px) {
     const int num_residuals = 2 * static_cast<int>(points_in_tool.size());
     auto* cost = new ceres::DynamicAutoDiffCostFunction<FrameCost, kStride>(
         new FrameCost(chain, input, with_errors, flange, num_cameras,
                       std::move(points_in_tool), std::move(cameras),
-                      std::move(pixels), huber_px));
+                      std::move(pixels), std::move(weights), huber_px));
     for (int size : block_sizes) cost->AddParameterBlock(size);
     cost->SetNumResiduals(num_residuals);
     return cost;
@@ -135,8 +138,8 @@ class FrameCost {
       const Vec3<T> pc = r_cr[c] * points_[i].cast<T>() + t_cr[c];
       T px[2];
       if (!ProjectPoint(p[cam0 + 2 * c], pc.data(), px)) return false;
-      T rx = px[0] - T(pixels_[i].x());
-      T ry = px[1] - T(pixels_[i].y());
+      T rx = T(weights_[i]) * (px[0] - T(pixels_[i].x()));
+      T ry = T(weights_[i]) * (px[1] - T(pixels_[i].y()));
       const T s = rx * rx + ry * ry;
       if (s > c2) {
         using std::sqrt;
@@ -160,6 +163,7 @@ class FrameCost {
   const std::vector<Eigen::Vector3d> points_;
   const std::vector<int> cameras_;
   const std::vector<Eigen::Vector2d> pixels_;
+  const std::vector<double> weights_;
   const double huber_;
 };
 
@@ -200,6 +204,7 @@ struct Obs {      // the fit's view of one frame
   std::vector<Eigen::Vector3d> points;
   std::vector<int> cameras;
   std::vector<Eigen::Vector2d> pixels;
+  std::vector<double> weights;
   std::vector<int> tag_of;     // per corner: key camera * 1000 + tag index
   std::vector<int> corner_of;  // per corner: its index in the tag (0..3)
 };
@@ -248,7 +253,7 @@ Built Build(State* st, const std::vector<Obs>& obs,
   for (const Obs& o : obs) {
     ceres::CostFunction* cost = FrameCost::Create(
         &st->chain, &inputs[o.index], fr.with_errors, st->flange, ncam, sizes,
-        o.points, o.cameras, o.pixels, opt.huber_px);
+        o.points, o.cameras, o.pixels, o.weights, opt.huber_px);
     b.blocks.push_back(problem->AddResidualBlock(cost, nullptr, params));
     b.residuals += 2 * static_cast<int>(o.points.size());
   }
@@ -321,10 +326,13 @@ ceres::Solver::Summary Solve(ceres::Problem* problem, const BundleOptions& o) {
   return summary;
 }
 
-// Per-corner pixel residuals (without the Huber scaling) of frames `obs`.
+// Per-corner residuals (without the Huber scaling) of frames `obs`:
+// weighted by BundleCorner::weight (what the Huber scale and the outlier
+// rules judge) or, with `in_pixels`, in pixels (what the RMS report).
 std::vector<double> CornerErrors(State* st, const std::vector<Obs>& obs,
                                  const std::vector<PoseInput>& inputs,
-                                 bool with_errors, const Rig& rig0) {
+                                 bool with_errors, const Rig& rig0,
+                                 bool in_pixels = false) {
   std::vector<double> out;
   if (obs.empty()) return out;
   BundleOptions plain;
@@ -346,7 +354,8 @@ std::vector<double> CornerErrors(State* st, const std::vector<Obs>& obs,
       continue;
     }
     for (size_t k = 0; k + 1 < r.size(); k += 2) {
-      out.push_back(std::hypot(r[k], r[k + 1]));
+      const double w = in_pixels ? obs[i].weights[k / 2] : 1.0;
+      out.push_back(std::hypot(r[k], r[k + 1]) / w);
     }
   }
   return out;
@@ -610,6 +619,7 @@ std::vector<Obs> MakeObs(const std::vector<BundleFrame>& frames,
       o.points.push_back(target.tags.at(c.tag).CornerInTool(c.corner));
       o.cameras.push_back(c.camera);
       o.pixels.push_back(c.px);
+      o.weights.push_back(c.weight);
       o.tag_of.push_back(key);
       o.corner_of.push_back(c.corner);
     }
@@ -1098,7 +1108,7 @@ BundleResult RunBundle(const Robot& nominal, const Rig& rig,
   fixed_robot.error_free.assign(nj, {});
   fixed_robot.with_errors = with_errors;
   res.start_reproj_rms_px =
-      Rms(CornerErrors(&st, train, res.inputs, with_errors, rig));
+      Rms(CornerErrors(&st, train, res.inputs, with_errors, rig, true));
   {
     Built b = Build(&st, train, res.inputs, fixed_robot, opt, rig);
     Solve(b.problem.get(), opt);
@@ -1148,12 +1158,12 @@ BundleResult RunBundle(const Robot& nominal, const Rig& rig,
 
   // Training and held-out statistics, then the solution.
   res.reproj_rms_px =
-      Rms(CornerErrors(&st, train, res.inputs, with_errors, rig));
+      Rms(CornerErrors(&st, train, res.inputs, with_errors, rig, true));
   res.corners = 0;
   for (const Obs& o : train) res.corners += static_cast<int>(o.points.size());
   const std::vector<Obs> heldout = MakeObs(frames, target, res.heldout, {});
   res.heldout_corner_px =
-      CornerErrors(&st, heldout, res.inputs, with_errors, rig);
+      CornerErrors(&st, heldout, res.inputs, with_errors, rig, true);
   res.heldout_reproj_rms_px = Rms(res.heldout_corner_px);
   WriteSolution(nominal, rig, target, with_errors, &st, &res);
   HeldOutTips(frames, target, opt, &res);

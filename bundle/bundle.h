@@ -58,6 +58,12 @@ struct BundleCorner {
   int tag = 0;     // index into Target::tags
   int corner = 0;  // 0..3, libapriltag order
   Eigen::Vector2d px = Eigen::Vector2d::Zero();
+  // The corner's pixel residual is multiplied by this (> 0; 1 = the
+  // reference precision): a corner known to err k times more weighs 1/k
+  // (ObserveOptions::full_weight_contrast sets it from the tag's contrast).
+  // The Huber scale and the outlier rules read weighted residuals; the
+  // reported RMS are in pixels.
+  double weight = 1.0;
 };
 
 // One frame with joint readings and the corners seen in it.

@@ -1,5 +1,6 @@
 #include "bundle/observe.h"
 
+#include <algorithm>
 #include <chrono>
 #include <memory>
 
@@ -7,6 +8,12 @@
 #include "vision/stereo_images.h"
 
 namespace kincal {
+
+double CornerWeight(double contrast, const ObserveOptions& options) {
+  if (options.full_weight_contrast <= 0) return 1.0;
+  return std::clamp(contrast / options.full_weight_contrast,
+                    options.min_corner_weight, 1.0);
+}
 
 SessionObservations ObserveSession(const Session& session, const Rig& rig,
                                    const Target& target,
@@ -63,9 +70,10 @@ SessionObservations ObserveSession(const Session& session, const Rig& rig,
           if (target.tags[k].id == t.tag_id) tag_index = static_cast<int>(k);
         }
         if (tag_index < 0) continue;
+        const double w = CornerWeight(t.contrast, options);
         for (int k = 0; k < 4; ++k) {
           if (t.corner_used[k]) {
-            f.corners.push_back({t.camera, tag_index, k, t.corners_px[k]});
+            f.corners.push_back({t.camera, tag_index, k, t.corners_px[k], w});
           }
         }
       }

@@ -66,5 +66,15 @@ TEST(ObserveSession, DetectsTheToolInEveryFrameWithJoints) {
   }
 }
 
+TEST(ObserveSession, CornerWeightFollowsTheTagsContrast) {
+  ObserveOptions o;  // full weight from 100 gray levels, at least 0.1
+  EXPECT_DOUBLE_EQ(CornerWeight(150, o), 1.0);
+  EXPECT_DOUBLE_EQ(CornerWeight(100, o), 1.0);
+  EXPECT_DOUBLE_EQ(CornerWeight(50, o), 0.5);
+  EXPECT_DOUBLE_EQ(CornerWeight(4, o), 0.1);
+  o.full_weight_contrast = 0;
+  EXPECT_DOUBLE_EQ(CornerWeight(4, o), 1.0);
+}
+
 }  // namespace
 }  // namespace kincal
