@@ -262,17 +262,24 @@ TEST(Bundle, TooFewTrackedFramesIsBadInput) {
   EXPECT_THROW(RunBundle(s.nominal, s.rig, s.target, s.frames, o), InputError);
 }
 
+// 80 synthetic BH-7 frames with 0.03 px corner noise and only the
+// identifiable parameters perturbed: the scene the outlier and weighting
+// tests plant their bad corners in.
+SyntheticBundle QuietBh7(int seed) {
+  SyntheticBundleOptions so;
+  so.frames = 80;
+  so.noise_px = 0.03;
+  so.seed = seed;
+  so.only_identifiable = true;
+  return MakeSyntheticBundle(Bh7(), so);
+}
+
 // A few gross corners among good ones (a dim oblique tag in a light-aware
 // render: corners 0.5-3.4 px off among 0.03 px ones): the automatic Huber
 // scale (3 sigma of the corners after a first fit) keeps them from pulling
 // the robot, where a fixed 1 px scale, ~30 sigma, lets them.
 TEST(Bundle, AutomaticHuberScaleKeepsGrossCornersFromPullingTheRobot) {
-  SyntheticBundleOptions so;
-  so.frames = 80;
-  so.noise_px = 0.03;
-  so.seed = 31;
-  so.only_identifiable = true;
-  SyntheticBundle s = MakeSyntheticBundle(Bh7(), so);
+  SyntheticBundle s = QuietBh7(31);
   // Three corners of one tag 0.8 px off (random directions) in every 4th
   // frame: below the 1 px scale and the 1 px outlier-tag rule, 27 sigma.
   std::mt19937_64 rng(7);
@@ -309,12 +316,7 @@ TEST(Bundle, AutomaticHuberScaleKeepsGrossCornersFromPullingTheRobot) {
 // of the tag good: the automatic Huber loss bounds their pull, the corner
 // rule (BundleOptions::outlier_sigmas) removes them, and exactly them.
 TEST(Bundle, CornersFarOutsideTheNoiseAreDroppedOneByOne) {
-  SyntheticBundleOptions so;
-  so.frames = 80;
-  so.noise_px = 0.03;
-  so.seed = 32;
-  so.only_identifiable = true;
-  SyntheticBundle s = MakeSyntheticBundle(Bh7(), so);
+  SyntheticBundle s = QuietBh7(32);
   std::mt19937_64 rng(9);
   std::uniform_real_distribution<double> angle(0, 2 * M_PI);
   int planted = 0;
@@ -353,12 +355,7 @@ TEST(Bundle, CornersFarOutsideTheNoiseAreDroppedOneByOne) {
 // elsewhere. Weighted by the inverse of their error they no longer pull the
 // robot; the reported RMS stays in pixels.
 TEST(Bundle, CornersWeighInverseToTheirError) {
-  SyntheticBundleOptions so;
-  so.frames = 80;
-  so.noise_px = 0.03;
-  so.seed = 33;
-  so.only_identifiable = true;
-  SyntheticBundle s = MakeSyntheticBundle(Bh7(), so);
+  SyntheticBundle s = QuietBh7(33);
   std::mt19937_64 rng(10);
   std::normal_distribution<double> noise(0, 0.3);
   int dim = 0;
