@@ -153,18 +153,24 @@ std::vector<std::vector<std::string>> ImageFiles(
 
 // Detects the target in every image; each camera takes the image size of
 // its first image. InputError when sizes differ or a camera sees the target
-// in fewer than options.min_views images.
+// in fewer than options.min_views images. `lenses` (one per camera, or
+// empty): the cameras' calibrated lenses, their AprilGrid tags' sides
+// fitted where they are straight (CalibTargetDetector).
 CalibrationProblem DetectTargets(
     const std::vector<CameraGlob>& globs, const CalibTargetSpec& spec,
     const CalibrationOptions& options,
-    const std::vector<std::vector<std::string>>& files, Progress* progress) {
+    const std::vector<std::vector<std::string>>& files, Progress* progress,
+    const std::vector<CameraIntrinsics>& lenses = {}) {
   const size_t nc = files.size();
   const size_t nv = files[0].size();
   CalibrationProblem problem;
+  std::vector<std::unique_ptr<CalibTargetDetector>> detectors;
   for (size_t c = 0; c < nc; ++c) {
     problem.cameras.push_back({globs[c].name, 0, 0, 0, 0, 0, 0, {}});
+    detectors.push_back(std::make_unique<CalibTargetDetector>(
+        spec, lenses.empty() ? std::nullopt
+                             : std::optional<CameraIntrinsics>(lenses[c])));
   }
-  CalibTargetDetector detector(spec);
   std::vector<int> found(nc, 0);
   for (size_t v = 0; v < nv; ++v) {
     progress->Update(static_cast<long>(v + 1), static_cast<long>(nv),
@@ -183,7 +189,7 @@ CalibrationProblem DetectTargets(
             std::to_string(img.rows) + ", the camera's " + "other images are " +
             std::to_string(cam.width) + "x" + std::to_string(cam.height));
       }
-      view.observations.push_back(detector.Detect(img));
+      view.observations.push_back(detectors[c]->Detect(img));
       if (static_cast<int>(view.observations.back().pixels.size()) >=
           options.min_points_per_view) {
         ++found[c];
@@ -201,6 +207,23 @@ CalibrationProblem DetectTargets(
   }
 
   return problem;
+}
+
+// The calibrated cameras as lenses for a second detection (named and sized
+// as the images), or empty when no camera has distortion.
+std::vector<CameraIntrinsics> CalibratedLenses(
+    const CalibrationProblem& problem, const CalibrationSummary& sum) {
+  std::vector<CameraIntrinsics> lenses;
+  bool distorted = false;
+  for (size_t c = 0; c < sum.cameras.size(); ++c) {
+    CameraIntrinsics lens = sum.cameras[c].intrinsics;
+    lens.name = problem.cameras[c].name;
+    lens.width = problem.cameras[c].width;
+    lens.height = problem.cameras[c].height;
+    for (double k : lens.distortion) distorted = distorted || k != 0;
+    lenses.push_back(lens);
+  }
+  return distorted ? lenses : std::vector<CameraIntrinsics>{};
 }
 
 nlohmann::json PixelJson(const Eigen::Vector2d& pixel) {
@@ -490,11 +513,23 @@ int RunCamcal(const CamcalArgs& args) {
   const std::vector<CameraGlob> globs = Globs(args);
   const std::vector<std::vector<std::string>> files = ImageFiles(globs);
   Progress progress("kincal camcal", args.json);
-  const CalibrationProblem problem =
+  CalibrationProblem problem =
       DetectTargets(globs, spec, options, files, &progress);
   RefuseUnconnected(args, problem, options);
   progress.Stage("calibrating (OpenCV start, Ceres refinement, covariance)");
-  const CalibrationSummary sum = CalibrateCameras(problem, options);
+  CalibrationSummary sum = CalibrateCameras(problem, options);
+  // A distorted lens bends the AprilGrid tags' sides, and lines fitted in
+  // the image meet off the corners (docs/CAMCAL.md): detected again with
+  // the lenses just calibrated, the sides are fitted where they are
+  // straight, and the cameras calibrated again from those corners.
+  const std::vector<CameraIntrinsics> lenses = CalibratedLenses(problem, sum);
+  const bool second_pass = spec.kind == CalibTargetSpec::Kind::kAprilGrid &&
+                           sum.converged && !lenses.empty();
+  if (second_pass) {
+    problem = DetectTargets(globs, spec, options, files, &progress, lenses);
+    progress.Stage("calibrating again from the corners the lenses straighten");
+    sum = CalibrateCameras(problem, options);
+  }
   progress.Done();
   const std::string failure = SolveFailure(sum, options);
   if (!failure.empty()) {
@@ -508,9 +543,16 @@ int RunCamcal(const CamcalArgs& args) {
   WriteRigYaml(args.out, sum.rig);
   if (!args.out_cameramodel.empty()) WriteCameraModels(args, sum);
   if (args.json) {
-    PrintJson(SummaryJson(args, spec, problem, files, sum));
+    nlohmann::json j = SummaryJson(args, spec, problem, files, sum);
+    j["detected_with_lenses"] = second_pass;
+    PrintJson(j);
   } else {
     PrintSummary(args, spec, options, files, sum);
+    if (second_pass) {
+      std::printf(
+          "  the AprilGrid detected again with these lenses: its tags' "
+          "sides fitted where they are straight\n");
+    }
   }
   return 0;
 }

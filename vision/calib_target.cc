@@ -181,11 +181,14 @@ struct CalibTargetDetector::Impl {
   std::vector<Eigen::Vector3d> points;
 };
 
-CalibTargetDetector::CalibTargetDetector(const CalibTargetSpec& spec)
+CalibTargetDetector::CalibTargetDetector(
+    const CalibTargetSpec& spec, const std::optional<CameraIntrinsics>& lens)
     : spec_(spec), impl_(std::make_unique<Impl>()) {
   impl_->points = spec.Points();
   if (spec.kind == CalibTargetSpec::Kind::kAprilGrid) {
-    impl_->apriltag = std::make_unique<AprilTagDetector>();
+    AprilTagOptions options;
+    options.lens = lens;
+    impl_->apriltag = std::make_unique<AprilTagDetector>(options);
   }
 }
 

@@ -34,6 +34,7 @@
 // Lengths are in target units: give them in mm and the rig is in mm.
 
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -75,7 +76,12 @@ CalibTargetSpec ParseCalibTargetSpec(const std::string& text);
 
 class CalibTargetDetector {
  public:
-  explicit CalibTargetDetector(const CalibTargetSpec& spec);
+  // `lens` (optional, AprilGrid only): the camera whose images are read,
+  // its tags' sides fitted where they are straight (AprilTagOptions::lens);
+  // camcal's second pass detects with the first pass's calibration.
+  explicit CalibTargetDetector(
+      const CalibTargetSpec& spec,
+      const std::optional<CameraIntrinsics>& lens = std::nullopt);
   ~CalibTargetDetector();
   CalibTargetDetector(const CalibTargetDetector&) = delete;
   CalibTargetDetector& operator=(const CalibTargetDetector&) = delete;
