@@ -205,10 +205,10 @@ double PhaseSharpnessRatio(const cv::Mat& gray,
   return lo > 0 ? hi / lo : 1.0;
 }
 
-// The lens whose pinhole image the sides are fitted in: options.lens when
-// it has distortion (nullptr otherwise: the image is its own pinhole image).
 namespace {
 
+// The lens whose pinhole image the sides are fitted in: options.lens when
+// it has distortion (nullptr otherwise: the image is its own pinhole image).
 const CameraIntrinsics* DistortingLens(const AprilTagOptions& options) {
   if (!options.lens) return nullptr;
   for (double k : options.lens->distortion) {
