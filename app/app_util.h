@@ -140,6 +140,11 @@ void WarnDoubtfulBayer(int doubtful, int images, BayerPattern pattern,
 // a raw Bayer mosaic (LooksLikeRawMosaic): --bayer names the pattern.
 void WarnRawMosaic(int cameras, Warnings* warnings);
 
+// `cameras` cameras' images look demosaiced by the camera
+// (SessionObservations::looks_demosaiced): warning images_demosaiced,
+// which names what the bundle loses and how to record the raw mosaic.
+void WarnDemosaiced(int cameras, Warnings* warnings);
+
 // A command's warnings list: each warning goes to stderr as it is found (in
 // JSON mode too, so that a later refusal still shows it) and into the JSON
 // result through AddWarnings.

@@ -433,6 +433,7 @@ int RunBundleCommand(BundleArgs args) {
     progress.Update(done, total, "frames (detecting tags)");
   };
   run.obs = ObserveSession(session, rig, target, oo);
+  WarnDemosaiced(run.obs.looks_demosaiced, &warnings);
   WarnDoubtfulBayer(
       run.obs.bayer_doubtful,
       static_cast<int>(run.obs.frames.size() * rig.cameras.size()), oo.bayer,

@@ -35,6 +35,8 @@ SessionObservations ObserveSession(const Session& session, const Rig& rig,
       CameraDetectors(rig, dopt);
   int done = 0;
   const int total = session.CountWithJoints();
+  // Per camera: its first image with tags checked for a camera's demosaic.
+  std::vector<char> phase_checked(nc, 0), looks_demosaiced(nc, 0);
   for (const SessionFrame& sf : session.frames) {
     if (!sf.HasJoints()) {
       ++out.without_joints;
@@ -50,6 +52,12 @@ SessionObservations ObserveSession(const Session& session, const Rig& rig,
         looks_raw[c] = LooksLikeRawMosaic(image);
       }
       dets[c] = detectors[c]->Detect(image);
+      if (options.bayer == BayerPattern::kNone && !phase_checked[c] &&
+          !dets[c].empty()) {
+        phase_checked[c] = true;
+        looks_demosaiced[c] =
+            PhaseSharpnessRatio(image, dets[c]) > dopt.demosaiced_ratio;
+      }
     });
     for (int raw : looks_raw) out.looks_raw += raw;
     for (const BayerBalance& b : balance) out.bayer_doubtful += b.doubtful;
@@ -83,6 +91,7 @@ SessionObservations ObserveSession(const Session& session, const Rig& rig,
     ++done;
     if (options.progress) options.progress(done, total);
   }
+  for (char d : looks_demosaiced) out.looks_demosaiced += d;
   out.seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start)
           .count();

@@ -51,6 +51,10 @@ struct SessionObservations {
   // Without a Bayer pattern: cameras whose first image looks like a raw
   // mosaic read as gray (LooksLikeRawMosaic).
   int looks_raw = 0;
+  // Without a Bayer pattern: cameras whose first image with tags looks
+  // demosaiced by the camera (PhaseSharpnessRatio above the detector's
+  // demosaiced_ratio).
+  int looks_demosaiced = 0;
   double seconds = 0.0;
 };
 

@@ -66,6 +66,40 @@ TEST(ObserveSession, DetectsTheToolInEveryFrameWithJoints) {
   }
 }
 
+// A colour camera's demosaiced images are told from gray ones (the
+// bundle's warning images_demosaiced); read as a raw mosaic they are not
+// checked.
+TEST(ObserveSession, TellsDemosaicedImagesFromGray) {
+  const Rig rig = ExampleStereoRig(640, 512);
+  const Target target = ExampleTarget();
+  RecordedSessionInput in;
+  in.rig_from_tool = {ExampleToolPose(0), ExampleToolPose(1)};
+  in.joint_names = {"j1", "j2"};
+  in.joints = {{10, 20}, {30, 40}};
+  const std::string dir =
+      (std::filesystem::temp_directory_path() /
+       ("kincal_observe_bayer_" +
+        std::to_string(::testing::UnitTest::GetInstance()->random_seed())))
+          .string();
+  SessionReadOptions so;
+  so.joint_names = in.joint_names;
+  int demosaiced[2] = {0, 0};
+  for (const bool bayer : {false, true}) {
+    std::filesystem::remove_all(dir);
+    RenderOptions ro;
+    ro.bayer = bayer;
+    RenderRecordedSession(rig, target, in, ro, 1, dir);
+    const SessionObservations obs =
+        ObserveSession(ReadSession(dir, so), rig, target, ObserveOptions());
+    demosaiced[bayer] = obs.looks_demosaiced;
+    ASSERT_EQ(obs.frames.size(), 2u);
+    EXPECT_TRUE(obs.frames[0].tracked) << bayer;
+  }
+  std::filesystem::remove_all(dir);
+  EXPECT_EQ(demosaiced[0], 0);
+  EXPECT_EQ(demosaiced[1], 2);
+}
+
 TEST(ObserveSession, CornerWeightFollowsTheTagsContrast) {
   ObserveOptions o;  // full weight from 100 gray levels, at least 0.1
   EXPECT_DOUBLE_EQ(CornerWeight(150, o), 1.0);
