@@ -11,6 +11,16 @@
 namespace kincal {
 namespace {
 
+// An empty path under the temporary directory, one per test and run.
+std::string FreshDir(const std::string& name) {
+  const std::filesystem::path dir =
+      std::filesystem::temp_directory_path() /
+      ("kincal_observe_" + name + "_" +
+       std::to_string(::testing::UnitTest::GetInstance()->random_seed()));
+  std::filesystem::remove_all(dir);
+  return dir.string();
+}
+
 // A rendered three-frame session: the second frame has no joint readings.
 TEST(ObserveSession, DetectsTheToolInEveryFrameWithJoints) {
   const Rig rig = ExampleStereoRig(640, 512);
@@ -20,12 +30,7 @@ TEST(ObserveSession, DetectsTheToolInEveryFrameWithJoints) {
                       ExampleToolPose(2)};
   in.joint_names = {"j1", "j2"};
   in.joints = {{10, 20}, {}, {30, 40}};
-  const std::string dir =
-      (std::filesystem::temp_directory_path() /
-       ("kincal_observe_" +
-        std::to_string(::testing::UnitTest::GetInstance()->random_seed())))
-          .string();
-  std::filesystem::remove_all(dir);
+  const std::string dir = FreshDir("frames");
   RenderRecordedSession(rig, target, in, RenderOptions(), 1, dir);
   SessionReadOptions so;
   so.joint_names = in.joint_names;
@@ -76,11 +81,7 @@ TEST(ObserveSession, TellsDemosaicedImagesFromGray) {
   in.rig_from_tool = {ExampleToolPose(0), ExampleToolPose(1)};
   in.joint_names = {"j1", "j2"};
   in.joints = {{10, 20}, {30, 40}};
-  const std::string dir =
-      (std::filesystem::temp_directory_path() /
-       ("kincal_observe_bayer_" +
-        std::to_string(::testing::UnitTest::GetInstance()->random_seed())))
-          .string();
+  const std::string dir = FreshDir("bayer");
   SessionReadOptions so;
   so.joint_names = in.joint_names;
   int demosaiced[2] = {0, 0};
