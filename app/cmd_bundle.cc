@@ -293,6 +293,19 @@ nlohmann::json NotDeterminedJson(const Rig& rig) {
   return out;
 }
 
+// The share of the session's observed corners on dim tags, weighed down
+// (BundleCorner::weight < 1); 0 without corners.
+double DimCornerShare(const std::vector<BundleFrame>& frames) {
+  int dim = 0, all = 0;
+  for (const BundleFrame& f : frames) {
+    for (const BundleCorner& c : f.corners) {
+      dim += c.weight < 1.0 ? 1 : 0;
+      ++all;
+    }
+  }
+  return all > 0 ? static_cast<double>(dim) / all : 0.0;
+}
+
 nlohmann::json SummaryJson(const BundleArgs& args, const Target& target,
                            const BundleRun& run, const Warnings& warnings) {
   const BundleResult& r = run.result;
@@ -314,6 +327,7 @@ nlohmann::json SummaryJson(const BundleArgs& args, const Target& target,
   j["corners"] = r.corners;
   j["dropped_tags"] = r.dropped_tags;
   j["dropped_corners"] = r.dropped_corners;
+  j["dim_corner_share"] = DimCornerShare(run.obs.frames);
   j["start_reproj_rms_px"] = r.start_reproj_rms_px;
   j["reproj_rms_px"] = r.reproj_rms_px;
   j["heldout_reproj_rms_px"] = r.heldout_reproj_rms_px;

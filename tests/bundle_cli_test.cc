@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <sstream>
@@ -57,6 +58,9 @@ TEST(BundleCli, BeatsTrackThenCalibrateOnTheSameImages) {
   // Corner noise of these renders is ~0.05-0.1 px.
   EXPECT_LT(j["reproj_rms_px"].get<double>(), 0.15);
   EXPECT_LT(j["heldout_reproj_rms_px"].get<double>(), 0.2);
+  // Evenly lit tags: none weighed down as dim (side light: 0.15-0.18).
+  std::printf("dim corner share %.3f\n", j["dim_corner_share"].get<double>());
+  EXPECT_LT(j["dim_corner_share"].get<double>(), 0.05);
   EXPECT_TRUE(Exists(dir + "/brig.yaml"));
 
   // The two-step pipeline on the same images.
