@@ -1082,6 +1082,15 @@ BundleResult RunBundle(const Robot& nominal, const Rig& rig,
   const int nj = st.chain.num_joints();
   if (nj > kMaxJoints) throw InputError("bundle: more than 16 joints");
   if (rig.cameras.size() > 4) throw InputError("bundle: more than 4 cameras");
+  for (const BundleFrame& f : frames) {
+    for (const BundleCorner& c : f.corners) {
+      if (!(c.weight > 0 && std::isfinite(c.weight))) {
+        throw InputError("bundle: frame " + std::to_string(f.frame) +
+                         " has a corner of weight " + std::to_string(c.weight) +
+                         " (expected > 0)");
+      }
+    }
+  }
   for (const Camera& c : rig.cameras) {
     st.intrinsics.push_back(c.intrinsics.ToArray());
     st.cam_from_rig.push_back(PoseBlockFromRigid3(c.cam_from_rig));

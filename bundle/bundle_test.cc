@@ -379,6 +379,9 @@ TEST(Bundle, CornersWeighInverseToTheirError) {
   const BundleResult plain = RunBundle(s.nominal, s.rig, s.target, alike, o);
   const double tips_weighted =
       TipRmsAgainstTruth(s, weighted.calibrated, 200, 5);
+  std::vector<BundleFrame> zero = s.frames;
+  zero[3].corners[0].weight = 0;
+  EXPECT_THROW(RunBundle(s.nominal, s.rig, s.target, zero, o), InputError);
   const double tips_plain = TipRmsAgainstTruth(s, plain.calibrated, 200, 5);
   std::printf(
       "%d dim corners: alike %.4f mm (%.3f px), weighted %.4f mm (%.3f px)\n",
