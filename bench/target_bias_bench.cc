@@ -13,8 +13,6 @@
 //   build/bin/target_bias_bench [--plain] [--noise-free] SEED...
 
 #include <cstdio>
-#include <cstdlib>
-#include <cstring>
 #include <map>
 #include <opencv2/imgproc.hpp>
 #include <string>
@@ -175,22 +173,11 @@ void RunSeed(int seed, bool plain, bool noise_free) {
 }  // namespace kincal::testing
 
 int main(int argc, char** argv) {
-  bool plain = false, noise_free = false;
-  std::vector<int> seeds;
-  for (int i = 1; i < argc; ++i) {
-    if (!std::strcmp(argv[i], "--plain")) {
-      plain = true;
-    } else if (!std::strcmp(argv[i], "--noise-free")) {
-      noise_free = true;
-    } else if (std::atoi(argv[i]) > 0) {
-      seeds.push_back(std::atoi(argv[i]));
-    } else {
-      std::fprintf(stderr,
-                   "usage: target_bias_bench [--plain] [--noise-free] "
-                   "SEED...\n");
-      return 2;
-    }
+  const kincal::testing::SeedArgs a =
+      kincal::testing::ParseSeedArgs(argc, argv, "target_bias_bench");
+  if (!a.ok) return 2;
+  for (int seed : a.seeds) {
+    kincal::testing::RunSeed(seed, a.plain, a.noise_free);
   }
-  for (int seed : seeds) kincal::testing::RunSeed(seed, plain, noise_free);
   return 0;
 }

@@ -19,7 +19,11 @@
 
 #include <chrono>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
 #include <random>
+#include <string>
 #include <vector>
 
 #include "synth/render.h"
@@ -261,6 +265,32 @@ inline McTrial RunTargetTrial(
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start)
           .count();
   return trial;
+}
+
+// The arguments of the per-seed benches: [--plain] [--noise-free] SEED...
+struct SeedArgs {
+  bool ok = true;  // false: a usage message went to stderr
+  bool plain = false, noise_free = false;
+  std::vector<int> seeds;
+};
+
+inline SeedArgs ParseSeedArgs(int argc, char** argv, const std::string& name) {
+  SeedArgs a;
+  for (int i = 1; i < argc; ++i) {
+    if (!std::strcmp(argv[i], "--plain")) {
+      a.plain = true;
+    } else if (!std::strcmp(argv[i], "--noise-free")) {
+      a.noise_free = true;
+    } else if (std::atoi(argv[i]) > 0) {
+      a.seeds.push_back(std::atoi(argv[i]));
+    } else {
+      std::fprintf(stderr, "usage: %s [--plain] [--noise-free] SEED...\n",
+                   name.c_str());
+      a.ok = false;
+      return a;
+    }
+  }
+  return a;
 }
 
 inline double RmsOf(const std::vector<double>& v) {
