@@ -44,11 +44,7 @@ void PrintBins(const char* what, const std::map<int, Bin>& bins, double width) {
 void RunSeed(int seed, bool plain, bool noise_free) {
   std::mt19937_64 rng(1000 + seed);
   const Rig rig = ExampleStereoRig(640, 512);
-  McSession s = MakeSession(seed, plain, &rng);
-  if (noise_free) {
-    s.effects.noise_sigma = 0;
-    s.effects.jpeg_quality = 0;
-  }
+  const McSession s = MakeSession(seed, plain, &rng, noise_free);
   const RenderOptions& e = s.effects;
   std::printf(
       "seed %d: blur %.2f defocus %.2f motion %.2f px at %.0f deg, noise "

@@ -140,11 +140,7 @@ void PrintFit(const char* name, const Rig& rig, const McSession& s,
 void RunSeed(int seed, bool plain, bool noise_free) {
   std::mt19937_64 rng(1000 + seed);
   const Rig rig = ExampleStereoRig(640, 512);
-  McSession s = MakeSession(seed, plain, &rng);
-  if (noise_free) {
-    s.effects.noise_sigma = 0;
-    s.effects.jpeg_quality = 0;
-  }
+  const McSession s = MakeSession(seed, plain, &rng, noise_free);
   const RenderOptions& e = s.effects;
   std::printf(
       "seed %d: %zu tags of %.1f mm; blur %.2f noise %.1f defocus %.2f motion "

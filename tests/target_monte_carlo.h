@@ -175,7 +175,10 @@ struct McSession {
   std::vector<Rigid3> views, pivot;
 };
 
-inline McSession MakeSession(int seed, bool plain, std::mt19937_64* rng) {
+// `noise_free`: without sensor noise and JPEG (only the detector's bias
+// remains; the benches' --noise-free).
+inline McSession MakeSession(int seed, bool plain, std::mt19937_64* rng,
+                             bool noise_free = false) {
   std::uniform_real_distribution<double> u(0, 2 * M_PI);
   McSession s;
   s.truth = RandomHolder(2 + seed % 3, rng);
@@ -184,6 +187,10 @@ inline McSession MakeSession(int seed, bool plain, std::mt19937_64* rng) {
     s.effects = RenderOptions();
     s.effects.blur_sigma_px = 0.5;
     s.effects.noise_sigma = 1.5;
+  }
+  if (noise_free) {
+    s.effects.noise_sigma = 0;
+    s.effects.jpeg_quality = 0;
   }
   const double phase_a = u(*rng), phase_b = u(*rng);
   for (int i = 0; i < 40; ++i) {
