@@ -492,6 +492,11 @@ void AddSimulateCommand(CLI::App& app, Runner* run) {
   sub->add_option("--render-blur", args->render_options.blur_sigma_px,
                   "optical blur sigma, px")
       ->capture_default_str();
+  sub->add_flag(
+      "!--render-blur-on-pixels", args->render_options.fine_optics,
+      "blur the pixel-integrated image instead of the light before the "
+      "pixels integrate it (the renderer before the optics were fine; for "
+      "comparisons)");
   sub->add_option("--render-exposure", args->render_options.exposure_jitter,
                   "exposure gain jitter (std of the gain)")
       ->capture_default_str();

@@ -6,6 +6,8 @@
 #include <cstdio>
 #include <filesystem>
 #include <limits>
+#include <memory>
+#include <mutex>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <optional>
@@ -431,23 +433,21 @@ cv::Mat MotionKernel(double length_px, double angle_deg) {
   return k;
 }
 
-// Exposure (gain jitter, vignetting, light gradient), optics (defocus,
-// motion, Gaussian blur) and sensor (noise, 8-bit rounding, JPEG) applied
-// to the scene radiance.
-cv::Mat ExposeAndRecord(cv::Mat radiance, const RenderOptions& options,
-                        std::mt19937_64* rng) {
-  const int width = radiance.cols, height = radiance.rows;
+// Exposure: the image's gain jitter, vignetting and light gradient.
+void Expose(const RenderOptions& options, std::mt19937_64* rng,
+            cv::Mat* radiance) {
+  const int width = radiance->cols, height = radiance->rows;
   double gain = 1.0;
   if (options.exposure_jitter > 0) {
     std::normal_distribution<double> g(1.0, options.exposure_jitter);
     gain = std::clamp(g(*rng), 0.5, 1.5);
   }
-  radiance *= gain;
+  *radiance *= gain;
   if (options.vignetting > 0 || options.light_gradient != 0) {
     const double cx = 0.5 * (width - 1), cy = 0.5 * (height - 1);
     const double r2max = cx * cx + cy * cy;
     for (int y = 0; y < height; ++y) {
-      double* row = radiance.ptr<double>(y);
+      double* row = radiance->ptr<double>(y);
       for (int x = 0; x < width; ++x) {
         const double r2 = (x - cx) * (x - cx) + (y - cy) * (y - cy);
         row[x] *= (1.0 - options.vignetting * r2 / r2max) *
@@ -456,19 +456,40 @@ cv::Mat ExposeAndRecord(cv::Mat radiance, const RenderOptions& options,
       }
     }
   }
+}
+
+// The optics (defocus, motion, Gaussian blur) on an image `scale` times
+// finer than the camera's pixels.
+void ApplyOptics(const RenderOptions& options, double scale,
+                 cv::Mat* radiance) {
   if (options.defocus_px > 0) {
-    cv::filter2D(radiance, radiance, -1, DefocusKernel(options.defocus_px),
-                 cv::Point(-1, -1), 0, cv::BORDER_REPLICATE);
+    cv::filter2D(*radiance, *radiance, -1,
+                 DefocusKernel(scale * options.defocus_px), cv::Point(-1, -1),
+                 0, cv::BORDER_REPLICATE);
   }
   if (options.motion_px > 0) {
-    cv::filter2D(radiance, radiance, -1,
-                 MotionKernel(options.motion_px, options.motion_angle_deg),
-                 cv::Point(-1, -1), 0, cv::BORDER_REPLICATE);
+    cv::filter2D(
+        *radiance, *radiance, -1,
+        MotionKernel(scale * options.motion_px, options.motion_angle_deg),
+        cv::Point(-1, -1), 0, cv::BORDER_REPLICATE);
   }
   if (options.blur_sigma_px > 0) {
-    cv::GaussianBlur(radiance, radiance, cv::Size(0, 0), options.blur_sigma_px,
-                     options.blur_sigma_px, cv::BORDER_REPLICATE);
+    const double sigma = scale * options.blur_sigma_px;
+    cv::GaussianBlur(*radiance, *radiance, cv::Size(0, 0), sigma, sigma,
+                     cv::BORDER_REPLICATE);
   }
+}
+
+bool HasOptics(const RenderOptions& options) {
+  return options.defocus_px > 0 || options.motion_px > 0 ||
+         options.blur_sigma_px > 0;
+}
+
+// The sensor: the Bayer mosaic, noise, 8-bit rounding, the demosaic and
+// JPEG, on the light the pixels integrated.
+cv::Mat Record(cv::Mat radiance, const RenderOptions& options,
+               std::mt19937_64* rng) {
+  const int width = radiance.cols, height = radiance.rows;
   if (options.bayer) {
     // RGGB photosites: R at (even x, even y), B at (odd x, odd y).
     for (int y = 0; y < height; ++y) {
@@ -576,10 +597,16 @@ std::vector<TexturedPlane> TargetPlanes(const Target& target,
   return planes;
 }
 
+struct ViewRenderer::FineView {
+  std::once_flag once;
+  std::unique_ptr<ViewRenderer> view;
+};
+
 ViewRenderer::ViewRenderer(const Camera& camera)
     : camera_(camera),
       width_(camera.intrinsics.width),
-      height_(camera.intrinsics.height) {
+      height_(camera.intrinsics.height),
+      fine_(std::make_shared<FineView>()) {
   if (width_ <= 0 || height_ <= 0) {
     throw InputError("render: camera '" + camera.intrinsics.name +
                      "' has no image size");
@@ -602,11 +629,54 @@ ViewRenderer::ViewRenderer(const Camera& camera)
   });
 }
 
-cv::Mat ViewRenderer::Render(const std::vector<TexturedPlane>& planes,
-                             const std::vector<Needle>& needles,
-                             const RenderOptions& options,
-                             std::mt19937_64* rng) const {
-  options.Check();
+ViewRenderer::ViewRenderer(const Camera& fine, const ViewRenderer& coarse)
+    : camera_(fine),
+      width_(fine.intrinsics.width),
+      height_(fine.intrinsics.height),
+      fine_(std::make_shared<FineView>()) {
+  // The fine corners' rays interpolated bilinearly between the coarse
+  // corners', as the coarse renderer reads its sub-pixel samples.
+  const int f = width_ / coarse.width_;
+  const size_t gw = coarse.width_ + 1;
+  corner_rays_.resize(static_cast<size_t>(width_ + 1) * (height_ + 1));
+  cv::parallel_for_(cv::Range(0, height_ + 1), [&](const cv::Range& range) {
+    for (int j = range.start; j < range.end; ++j) {
+      const int cj = std::min(j / f, coarse.height_ - 1);
+      const double v = static_cast<double>(j - cj * f) / f;
+      for (int i = 0; i <= width_; ++i) {
+        const int ci = std::min(i / f, coarse.width_ - 1);
+        const double u = static_cast<double>(i - ci * f) / f;
+        const auto& r = coarse.corner_rays_;
+        const size_t c00 = cj * gw + ci;
+        corner_rays_[static_cast<size_t>(j) * (width_ + 1) + i] =
+            (1 - v) * ((1 - u) * r[c00] + u * r[c00 + 1]) +
+            v * ((1 - u) * r[c00 + gw] + u * r[c00 + gw + 1]);
+      }
+    }
+  });
+}
+
+const ViewRenderer& ViewRenderer::Fine() const {
+  std::call_once(fine_->once, [this] {
+    // The same rays kFineOptics times finer: a pixel corner u - 0.5 of the
+    // fine grid is at (u - 0.5) / kFineOptics - 0.5 in this camera's pixels.
+    Camera fine = camera_;
+    CameraIntrinsics& K = fine.intrinsics;
+    const double s = kFineOptics;
+    K.width *= kFineOptics;
+    K.height *= kFineOptics;
+    K.fx *= s;
+    K.fy *= s;
+    K.cx = (K.cx + 0.5) * s - 0.5;
+    K.cy = (K.cy + 0.5) * s - 0.5;
+    fine_->view.reset(new ViewRenderer(fine, *this));
+  });
+  return *fine_->view;
+}
+
+cv::Mat ViewRenderer::Radiance(const std::vector<TexturedPlane>& planes,
+                               const std::vector<Needle>& needles,
+                               const RenderOptions& options) const {
   std::vector<PlaneInCam> in_cam;
   for (const TexturedPlane& p : planes) {
     std::optional<PlaneInCam> pc = PlaneInCamera(p, camera_, width_, height_);
@@ -617,7 +687,27 @@ cv::Mat ViewRenderer::Render(const std::vector<TexturedPlane>& planes,
   cv::Mat radiance =
       ShadePixels(in_cam, labels, corner_rays_, width_, height_, options);
   for (const Needle& needle : needles) DrawNeedle(needle, camera_, &radiance);
-  return ExposeAndRecord(radiance, options, rng);
+  return radiance;
+}
+
+cv::Mat ViewRenderer::Render(const std::vector<TexturedPlane>& planes,
+                             const std::vector<Needle>& needles,
+                             const RenderOptions& options,
+                             std::mt19937_64* rng) const {
+  options.Check();
+  cv::Mat radiance;
+  if (options.fine_optics && HasOptics(options)) {
+    // Blurred before the pixels integrate it.
+    cv::Mat fine = Fine().Radiance(planes, needles, options);
+    ApplyOptics(options, kFineOptics, &fine);
+    cv::resize(fine, radiance, cv::Size(width_, height_), 0, 0, cv::INTER_AREA);
+    Expose(options, rng, &radiance);
+  } else {
+    radiance = Radiance(planes, needles, options);
+    Expose(options, rng, &radiance);
+    ApplyOptics(options, 1.0, &radiance);
+  }
+  return Record(radiance, options, rng);
 }
 
 std::vector<TagTruth> ProjectTargetCorners(const Camera& camera,

@@ -17,6 +17,7 @@
 
 #include <Eigen/Core>
 #include <array>
+#include <memory>
 #include <opencv2/core.hpp>
 #include <random>
 #include <sstream>
@@ -92,6 +93,15 @@ struct RenderOptions {
   double vignetting = 0.0;
   double light_gradient = 0.0;
   int jpeg_quality = 0;
+  // The optics (defocus, motion, Gaussian blur) act on the light before a
+  // pixel integrates it, as in a camera: the scene is shaded on a grid
+  // kFineOptics times finer, blurred there and averaged over each pixel.
+  // false: they act on the pixel-integrated image (each pixel's light
+  // spread to its neighbours), whose spread function is a comb of pixel
+  // boxes rather than the optics' and, under ~1 px, not Gaussian (a
+  // sampled sigma of 0.5 px is the taps 0.107 / 0.786 / 0.107): a model
+  // of round optics then leans on small tags (docs/VISION.md).
+  bool fine_optics = true;
   // Light on the tags (the "light-aware" renders; all off by default, the
   // simple renderer is the fast one):
   //  - light_in_rig: the direction a distant light travels (rig frame; zero
@@ -137,6 +147,9 @@ struct RenderOptions {
 // Renders one camera. Holds the camera's per-pixel-corner undistortion grid,
 // so make one per camera and reuse it across frames. Thread-compatible
 // (Render is const).
+// Sub-pixels per pixel along x and along y for RenderOptions::fine_optics.
+constexpr int kFineOptics = 3;
+
 class ViewRenderer {
  public:
   explicit ViewRenderer(const Camera& camera);
@@ -148,11 +161,24 @@ class ViewRenderer {
   const Camera& camera() const { return camera_; }
 
  private:
+  // `fine`: the camera of `coarse` kFineOptics times finer, its corner
+  // rays interpolated from the coarse ones.
+  ViewRenderer(const Camera& fine, const ViewRenderer& coarse);
+  // The light each pixel integrates (planes shaded, needles drawn).
+  cv::Mat Radiance(const std::vector<TexturedPlane>& planes,
+                   const std::vector<Needle>& needles,
+                   const RenderOptions& options) const;
+  // The same camera kFineOptics times finer, built on first use (shared by
+  // copies; thread-safe).
+  const ViewRenderer& Fine() const;
+
   Camera camera_;
   int width_ = 0, height_ = 0;
   // Undistorted normalized (x, y) at pixel corners (u - 0.5, v - 0.5),
   // (width + 1) x (height + 1), row-major.
   std::vector<Eigen::Vector2d> corner_rays_;
+  struct FineView;
+  std::shared_ptr<FineView> fine_;
 };
 
 // Ground truth of one tag in one view.
