@@ -299,8 +299,9 @@ void WarnDemosaiced(int cameras, Warnings* warnings) {
       std::to_string(cameras) +
           " cameras' images look demosaiced by the camera (their Bayer "
           "pixel phases differ in sharpness): on our renders the bundle's "
-          "robot comes out about 2x worse from demosaiced images than from "
-          "the raw mosaic (docs/VISION.md). Record the raw mosaic (capture "
+          "robot comes out about 1.2x worse from demosaiced images than from "
+          "the raw mosaic, and a demosaic other than bilinear is not "
+          "modelled (docs/VISION.md). Record the raw mosaic (capture "
           "URI bayer=raw; GenICam BayerRG8, V4L2 RGGB) and it is read as "
           "such");
 }

@@ -457,13 +457,25 @@ bool SamePattern(const EdgeProfile& a, const EdgeProfile& b,
   return true;
 }
 
+// How far outward of the side a demosaiced image's profile reads, in
+// cells: to the white border's outer edge. Beyond it lies what the printed
+// pattern does not know (the paper's margin, the holder, a neighbouring
+// tag's border a fraction of a cell away), which the model takes as one
+// flat level; a demosaic's kernels carry it into the window. Measured on
+// the BH-7 side-light renders (four tags 0.55 cell apart, docs/VISION.md):
+// the 1.5 cells the other profiles read left corners 0.0088 px inward on
+// average and the bundle's robot about 2x the gray images'.
+constexpr double kDemosaicedOuterReachCells = 1.0;
+
 // A demosaiced image's profile: the pixels whose centres lie in the strip
-// across the side at p (|along| < half_width, |offset| <= reach), each at
-// its own offset with its Bayer phase, unsorted. Read at pixel centres, not
-// interpolated: interpolation would mix the phases' blurs into one.
+// across the side at p (|along| < half_width, -reach <= offset <=
+// outer_reach), each at its own offset with its Bayer phase, unsorted. Read
+// at pixel centres, not interpolated: interpolation would mix the phases'
+// blurs into one.
 void PixelProfile(const cv::Mat& gray, const Eigen::Vector2d& p,
                   const Eigen::Vector2d& n, const Eigen::Vector2d& dir,
-                  double reach, double half_width, EdgeProfile* prof) {
+                  double reach, double outer_reach, double half_width,
+                  EdgeProfile* prof) {
   const double rx = reach * std::abs(n.x()) + half_width * std::abs(dir.x());
   const double ry = reach * std::abs(n.y()) + half_width * std::abs(dir.y());
   for (int y = static_cast<int>(std::ceil(p.y() - ry));
@@ -472,7 +484,8 @@ void PixelProfile(const cv::Mat& gray, const Eigen::Vector2d& p,
          x <= static_cast<int>(std::floor(p.x() + rx)); ++x) {
       const Eigen::Vector2d d = Eigen::Vector2d(x, y) - p;
       const double along = dir.dot(d), o = n.dot(d);
-      if (along < -half_width || along >= half_width || std::abs(o) > reach) {
+      if (along < -half_width || along >= half_width || o < -reach ||
+          o > outer_reach) {
         continue;
       }
       prof->offsets.push_back(o);
@@ -543,6 +556,7 @@ SideProfiles ProfilesOfSide(const cv::Mat& gray, const PatternView& view,
     EdgeProfile prof;
     if (phased) {
       PixelProfile(gray, p, n, dir, reach,
+                   std::min(reach, kDemosaicedOuterReachCells * cell),
                    std::max(0.5, 0.5 * 0.8 * len / samples), &prof);
     } else {
       for (double o = -reach; o <= reach + 1e-9; o += step) {
