@@ -464,7 +464,7 @@ bool SamePattern(const EdgeProfile& a, const EdgeProfile& b,
 // flat level; a demosaic's kernels carry it into the window. Measured on
 // the BH-7 side-light renders (four tags 0.55 cell apart, docs/VISION.md):
 // the 1.5 cells the other profiles read left corners 0.0088 px inward on
-// average and the bundle's robot about 2x the gray images'.
+// average and the bundle's robot 1.7x the gray images' (1.3x now).
 constexpr double kDemosaicedOuterReachCells = 1.0;
 
 // A demosaiced image's profile: the pixels whose centres lie in the strip
