@@ -43,6 +43,16 @@ const SampleLattice& Lattice() {
   return lattice;
 }
 
+// The ray at (u, v) in [0, 1]^2 within a pixel, bilinear between the rays
+// at its corners (top-left, top-right, bottom-left, bottom-right).
+inline Eigen::Vector2d RayWithinPixel(const Eigen::Vector2d& r00,
+                                      const Eigen::Vector2d& r10,
+                                      const Eigen::Vector2d& r01,
+                                      const Eigen::Vector2d& r11, double u,
+                                      double v) {
+  return (1 - v) * ((1 - u) * r00 + u * r10) + v * ((1 - u) * r01 + u * r11);
+}
+
 // One plane as the camera sees it.
 struct PlaneInCam {
   Eigen::Matrix3d R;  // plane_from_cam
@@ -288,8 +298,7 @@ cv::Mat ShadePixels(const std::vector<PlaneInCam>& in_cam,
         double sum = 0;
         for (int k = 0; k < kNumSamples; ++k) {
           const double sx = lat.x[k], sy = lat.y[k];
-          const Eigen::Vector2d r = (1 - sy) * ((1 - sx) * r00 + sx * r10) +
-                                    sy * ((1 - sx) * r01 + sx * r11);
+          const Eigen::Vector2d r = RayWithinPixel(r00, r10, r01, r11, sx, sy);
           sum += LitRadiance(in_cam, Trace(in_cam, candidates, r.x(), r.y()),
                              r.x(), r.y(), options);
         }
@@ -634,8 +643,8 @@ ViewRenderer::ViewRenderer(const Camera& fine, const ViewRenderer& coarse)
       width_(fine.intrinsics.width),
       height_(fine.intrinsics.height),
       fine_(std::make_shared<FineView>()) {
-  // The fine corners' rays interpolated bilinearly between the coarse
-  // corners', as the coarse renderer reads its sub-pixel samples.
+  // The fine corners' rays interpolated between the coarse corners', as the
+  // coarse renderer reads its sub-pixel samples (RayWithinPixel).
   const int f = width_ / coarse.width_;
   const size_t gw = coarse.width_ + 1;
   corner_rays_.resize(static_cast<size_t>(width_ + 1) * (height_ + 1));
@@ -649,8 +658,8 @@ ViewRenderer::ViewRenderer(const Camera& fine, const ViewRenderer& coarse)
         const auto& r = coarse.corner_rays_;
         const size_t c00 = cj * gw + ci;
         corner_rays_[static_cast<size_t>(j) * (width_ + 1) + i] =
-            (1 - v) * ((1 - u) * r[c00] + u * r[c00 + 1]) +
-            v * ((1 - u) * r[c00 + gw] + u * r[c00 + gw + 1]);
+            RayWithinPixel(r[c00], r[c00 + 1], r[c00 + gw], r[c00 + gw + 1], u,
+                           v);
       }
     }
   });

@@ -144,12 +144,12 @@ struct RenderOptions {
   void Check() const;  // InputError naming the bad option
 };
 
-// Renders one camera. Holds the camera's per-pixel-corner undistortion grid,
-// so make one per camera and reuse it across frames. Thread-compatible
-// (Render is const).
 // Sub-pixels per pixel along x and along y for RenderOptions::fine_optics.
 constexpr int kFineOptics = 3;
 
+// Renders one camera. Holds the camera's per-pixel-corner undistortion grid,
+// so make one per camera and reuse it across frames. Thread-compatible
+// (Render is const).
 class ViewRenderer {
  public:
   explicit ViewRenderer(const Camera& camera);
